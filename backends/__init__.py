@@ -1,0 +1,21 @@
+"""Backends: one module per file format, imported only when that format is used."""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+_MODULES = {
+    "urdf": "mpc.backends.urdf",
+}
+
+
+class _Lazy:
+    def __init__(self, module: str) -> None:
+        self.module = module
+
+    def __call__(self) -> ModuleType:
+        return importlib.import_module(self.module)
+
+
+BACKENDS: dict[str, _Lazy] = {name: _Lazy(module) for name, module in _MODULES.items()}

@@ -1,0 +1,83 @@
+"""`package://` and relative mesh filenames → files on disk.
+
+A package is looked up, in this order, in the package map given by the user
+(`--package NAME=DIR`), in ROS_PACKAGE_PATH, in the `share/` folders of the Python
+environment (where pip-installed robot packages such as example-robot-data live,
+under `cmeel.prefix/share`), and last among the folders above the model file
+(the way PyBullet finds them). Each package name is looked up once.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import sysconfig
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mpc.ir.geometry import MeshSource
+
+
+def _environment_share_dirs() -> list[Path]:
+    dirs = []
+    for key in ("purelib", "platlib"):
+        site = Path(sysconfig.get_paths()[key])
+        dirs.append(site / "cmeel.prefix" / "share")
+    dirs.append(Path(sys.prefix) / "share")
+    seen: list[Path] = []
+    for d in dirs:
+        if d not in seen and d.is_dir():
+            seen.append(d)
+    return seen
+
+
+@dataclass
+class PackageResolver:
+    """Finds the folder of a ROS package by name (see the module docstring)."""
+
+    package_map: dict[str, Path] = field(default_factory=dict)
+    search_path: list[Path] | None = None
+    _cache: dict[str, Path | None] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.search_path is None:
+            ros = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+            self.search_path = ros + _environment_share_dirs()
+
+    def find(self, package: str, near: Path | None = None) -> Path | None:
+        """The folder of `package`, or None."""
+        if package in self.package_map:
+            return self.package_map[package]
+        if package not in self._cache:
+            self._cache[package] = self._search(package)
+        found = self._cache[package]
+        if found is None and near is not None:
+            for parent in [near, *near.parents]:
+                if parent.name == package:
+                    return parent
+        return found
+
+    def _search(self, package: str) -> Path | None:
+        assert self.search_path is not None
+        for root in self.search_path:
+            if root.name == package and root.is_dir():
+                return root
+            if (root / package).is_dir():
+                return root / package
+        return None
+
+    def resolve(self, uri: str, base_dir: Path) -> MeshSource:
+        """A mesh filename as written in a model file in `base_dir` → its MeshSource."""
+        if uri.startswith("package://"):
+            package, _, rest = uri[len("package://"):].partition("/")
+            folder = self.find(package, base_dir)
+            if folder is None:
+                return MeshSource(
+                    uri=uri, path=None,
+                    unresolved=f"package '{package}' was not found (searched the package map, "
+                    "ROS_PACKAGE_PATH, the Python environment and the folders above the model)",
+                )
+            return MeshSource(uri=uri, path=folder / rest)
+        if uri.startswith("file://"):
+            return MeshSource(uri=uri, path=Path(uri[len("file://"):]))
+        return MeshSource(uri=uri, path=(base_dir / uri))

@@ -1,0 +1,457 @@
+"""URDF file → ir.Robot, reporting every problem with its line and column.
+
+Elements URDF defines become typed IR values; everything else (top-level
+`<gazebo>`, `<transmission>`, `<ros2_control>`, vendor tags, unknown children of
+links and joints) is kept as opaque fragments that record the link and joint names
+they mention. Comments are kept. Mesh files are resolved to paths, never opened.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from lxml import etree
+
+from mpc.backends.packages import PackageResolver
+from mpc.backends.xml import XmlError, XmlSource, parse_floats
+from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.ir.fragments import Fragment, FragmentRef, RefKind
+from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.robot import (
+    JOINT_TYPES,
+    Calibration,
+    Collision,
+    Dynamics,
+    Inertia,
+    Inertial,
+    Joint,
+    Limit,
+    Link,
+    Material,
+    Mimic,
+    Pose,
+    Robot,
+    SafetyController,
+    Visual,
+)
+from mpc.ir.span import Span
+from mpc.ir.tree import check_tree
+
+_INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
+         display: str | None = None) -> Robot | None:
+    """Read the URDF at `path`; None when it has errors (all of them reported)."""
+    file = display or str(path)
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        sink.error(Span.of_file(file), "E0601", f"cannot read URDF '{file}': {e.strerror}")
+        return None
+    try:
+        src = XmlSource.parse(data, file)
+    except XmlError as e:
+        sink.error(Span(file, e.line, e.col), "E0401", f"malformed XML in '{file}': {e.message}")
+        return None
+    errors_before = sink.error_count
+    robot = _Reader(src, sink, resolver or PackageResolver(), path.parent.resolve()).robot()
+    if robot is None or sink.error_count > errors_before:
+        return None
+    return robot
+
+
+class _Reader:
+    def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
+                 base_dir: Path) -> None:
+        self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
+        self.link_names: set[str] = set()
+        self.joint_names: set[str] = set()
+
+    # -- helpers ---------------------------------------------------------------------------
+
+    def error(self, el: etree._Element, code: str, message: str, attr: str | None = None,
+              **kw: object) -> None:
+        self.sink.error(self.src.span(el, attr), code, message, **kw)  # type: ignore[arg-type]
+
+    def warn_unknown_attrs(self, el: etree._Element, known: tuple[str, ...], where: str) -> None:
+        for name in el.attrib:
+            if name not in known:
+                self.sink.warning(
+                    self.src.span(el, name), "W0401",
+                    f"attribute '{name}' of <{el.tag}> in {where} is not URDF and is dropped",
+                )
+
+    def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
+        return tuple((k, v) for k, v in el.attrib.items() if k not in known)
+
+    def floats(self, el: etree._Element, attr: str, n: int, where: str,
+               required: bool = False) -> tuple[float, ...] | None:
+        text = el.get(attr)
+        if text is None:
+            if required:
+                self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
+            return None
+        values = parse_floats(text)
+        if values is None or len(values) != n:
+            what = "a number" if n == 1 else f"{n} numbers"
+            self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
+                       f"got '{text}'", attr)
+            return None
+        return tuple(values)
+
+    def number(self, el: etree._Element, attr: str, where: str,
+               required: bool = False) -> float | None:
+        values = self.floats(el, attr, 1, where, required)
+        return values[0] if values else None
+
+    def pose(self, el: etree._Element | None, where: str) -> Pose | None:
+        if el is None:
+            return None
+        self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
+        xyz = self.floats(el, "xyz", 3, where)
+        rpy = self.floats(el, "rpy", 3, where)
+        return Pose(xyz or (0.0, 0.0, 0.0), rpy or (0.0, 0.0, 0.0),  # type: ignore[arg-type]
+                    (el.get("xyz") is not None, el.get("rpy") is not None))
+
+    def name(self, el: etree._Element, kind: str) -> str | None:
+        name = el.get("name")
+        if not name:
+            self.error(el, "E0403", f"<{kind}> without a 'name' attribute")
+            return None
+        return name
+
+    def children(self, el: etree._Element) -> list[etree._Element]:
+        return [c for c in el if isinstance(c.tag, str)]
+
+    def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
+        span = self.src.span(el)
+        xml = etree.tostring(el, encoding="unicode", with_tail=False)
+        # tostring re-declares every namespace in scope; <robot> declares them already.
+        head_end = xml.find(">")
+        head = xml[:head_end]
+        for prefix, uri in self.src.root.nsmap.items():
+            head = head.replace(f' xmlns{":" + prefix if prefix else ""}="{uri}"', "", 1)
+        xml = head + xml[head_end:]
+        indent = " " * (span.col - 1)
+        lines = xml.split("\n")
+        xml = "\n".join([lines[0]] + [ln.removeprefix(indent) for ln in lines[1:]])
+        return Fragment(tag=str(el.tag), xml=xml, refs=tuple(self.refs(el)),
+                        comments=comments, span=span)
+
+    def refs(self, el: etree._Element) -> list[FragmentRef]:
+        """Every attribute or text in the fragment that equals a link or joint name."""
+        out: list[FragmentRef] = []
+
+        def kind_of(value: str, hint: str) -> RefKind | None:
+            is_link, is_joint = value in self.link_names, value in self.joint_names
+            if is_link and is_joint:
+                return "joint" if "joint" in hint.lower() else "link"
+            return "link" if is_link else "joint" if is_joint else None
+
+        def walk(node: etree._Element, path: tuple[int, ...]) -> None:
+            tag = str(node.tag)
+            for attr, value in node.attrib.items():
+                kind = kind_of(value.strip(), tag + attr)
+                if kind:
+                    out.append(FragmentRef(path, attr, kind, value.strip()))
+            if node.text and node.text.strip():
+                kind = kind_of(node.text.strip(), tag)
+                if kind:
+                    out.append(FragmentRef(path, None, kind, node.text.strip()))
+            for i, child in enumerate(node):
+                if isinstance(child.tag, str):
+                    walk(child, (*path, i))
+
+        walk(el, ())
+        return out
+
+    def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
+        return tuple(str(c.text) for c in el.iter(etree.Comment))
+
+    # -- elements --------------------------------------------------------------------------
+
+    def robot(self) -> Robot | None:
+        root, file = self.src.root, self.src.file
+        if root.tag != "robot":
+            self.error(root, "E0402", f"'{file}' is not a URDF: its root element is "
+                       f"<{root.tag}>, not <robot>")
+            return None
+        name = root.get("name") or ""
+        if not name:
+            self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
+        elements = self.children(root)
+        self.link_names = {e.get("name", "") for e in elements if e.tag == "link"}
+        self.joint_names = {e.get("name", "") for e in elements if e.tag == "joint"}
+
+        links: dict[str, Link] = {}
+        joints: dict[str, Joint] = {}
+        materials: dict[str, Material] = {}
+        fragments: list[Fragment] = []
+        pending: list[str] = []
+        for el in root:
+            if el.tag is etree.Comment:
+                pending.append(str(el.text))
+                continue
+            if not isinstance(el.tag, str):
+                continue
+            comments, pending = tuple(pending), []
+            if el.tag == "link":
+                self.add(links, self.link(el, comments), el, "link")
+            elif el.tag == "joint":
+                self.add(joints, self.joint(el, comments), el, "joint")
+            elif el.tag == "material":
+                self.add(materials, self.material(el, comments, "<robot>"), el, "material")
+            else:
+                fragments.append(self.fragment(el, comments))
+
+        header = []
+        prev = root.getprevious()
+        while prev is not None:
+            if prev.tag is etree.Comment:
+                header.append(str(prev.text))
+            prev = prev.getprevious()
+        extra = self.extra_attrs(root, ("name",)) + tuple(
+            (f"xmlns:{p}" if p else "xmlns", uri) for p, uri in sorted(
+                root.nsmap.items(), key=lambda kv: kv[0] or ""))
+        if not links:
+            self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
+            return None
+        robot_span = self.src.span(root)
+        root_link = check_tree(links, joints, self.sink, robot_span, name)
+        if root_link is None or not name:
+            return None
+        return Robot(
+            name=name, root=root_link, links=links, joints=joints, materials=materials,
+            fragments=tuple(fragments), extra_attrs=extra, header_comments=tuple(reversed(header)),
+            trailing_comments=tuple(pending), span=robot_span,
+        )
+
+    def add(self, table: dict, item: object, el: etree._Element, kind: str) -> None:
+        if item is None:
+            return
+        name = item.name  # type: ignore[attr-defined]
+        if name in table:
+            first = table[name].span
+            self.error(el, "E0410", f"duplicate {kind} '{name}'", "name",
+                       notes=((first, f"{kind} '{name}' is first defined here"),))
+            return
+        table[name] = item
+
+    def link(self, el: etree._Element, comments: tuple[str, ...]) -> Link | None:
+        name = self.name(el, "link")
+        if name is None:
+            return None
+        where = f"link '{name}'"
+        inertial, visuals, collisions, extras = None, [], [], []
+        for child in self.children(el):
+            if child.tag == "inertial":
+                if inertial is not None:
+                    self.error(child, "E0406", f"{where} has more than one <inertial>")
+                inertial = self.inertial(child, where)
+            elif child.tag == "visual":
+                visuals.append(self.visual(child, where))
+            elif child.tag == "collision":
+                collisions.append(self.collision(child, where))
+            else:
+                extras.append(self.fragment(child))
+        return Link(
+            name=name, inertial=inertial,
+            visuals=tuple(v for v in visuals if v is not None),
+            collisions=tuple(c for c in collisions if c is not None),
+            extra_attrs=self.extra_attrs(el, ("name",)), extras=tuple(extras),
+            comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
+        )
+
+    def inertial(self, el: etree._Element, where: str) -> Inertial | None:
+        mass_el, inertia_el = el.find("mass"), el.find("inertia")
+        mass = self.number(mass_el, "value", where, True) if mass_el is not None else None
+        if mass_el is None:
+            self.error(el, "E0403", f"<inertial> in {where} has no <mass>")
+        values = []
+        if inertia_el is None:
+            self.error(el, "E0403", f"<inertial> in {where} has no <inertia>")
+        else:
+            values = [self.number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
+        extras = tuple(self.fragment(c) for c in self.children(el)
+                       if c.tag not in ("origin", "mass", "inertia"))
+        if mass is None or len(values) != 6 or None in values:
+            return None
+        return Inertial(mass=mass, inertia=Inertia(**dict(zip(_INERTIA_KEYS, values, strict=True))),
+                        origin=self.pose(el.find("origin"), where), extras=extras)
+
+    def geometry(self, el: etree._Element | None, parent: etree._Element,
+                 where: str) -> Geometry | None:
+        if el is None:
+            self.error(parent, "E0403", f"<{parent.tag}> in {where} has no <geometry>")
+            return None
+        shapes = self.children(el)
+        if len(shapes) != 1:
+            self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, "
+                       f"found {len(shapes)}")
+            return None
+        shape = shapes[0]
+        if shape.tag == "box":
+            size = self.floats(shape, "size", 3, where, True)
+            return Box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
+        if shape.tag == "cylinder":
+            r, h = self.number(shape, "radius", where, True), self.number(shape, "length", where, True)
+            if r is None or h is None:
+                return None
+            return Cylinder(radius=r, length=h,
+                            extra_attrs=self.extra_attrs(shape, ("radius", "length")))
+        if shape.tag == "sphere":
+            r = self.number(shape, "radius", where, True)
+            if r is None:
+                return None
+            return Sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
+        if shape.tag == "mesh":
+            uri = shape.get("filename")
+            if not uri:
+                self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
+                return None
+            scale = self.floats(shape, "scale", 3, where)
+            return Mesh(source=self.resolver.resolve(uri, self.base_dir),
+                        scale=scale, span=self.src.span(shape, "filename"),  # type: ignore[arg-type]
+                        extra_attrs=self.extra_attrs(shape, ("filename", "scale")))
+        self.error(shape, "E0405", f"unsupported geometry <{shape.tag}> in {where}; URDF has "
+                   "box, cylinder, sphere and mesh")
+        return None
+
+    def visual(self, el: etree._Element, where: str) -> Visual | None:
+        geometry_el = el.find("geometry")
+        geometry = self.geometry(geometry_el, el, where)
+        material, inline = None, None
+        material_el = el.find("material")
+        if material_el is not None:
+            material = material_el.get("name")
+            if material is None:
+                self.error(material_el, "E0403", f"<material> in {where} has no 'name' attribute")
+            if len(material_el):
+                inline = self.material(material_el, (), where)
+        extras = tuple(self.fragment(c) for c in self.children(el)
+                       if c.tag not in ("origin", "geometry", "material"))
+        if geometry is None:
+            return None
+        return Visual(
+            geometry=geometry, name=el.get("name"), origin=self.pose(el.find("origin"), where),
+            material=material, inline_material=inline,
+            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
+            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+        )
+
+    def collision(self, el: etree._Element, where: str) -> Collision | None:
+        geometry_el = el.find("geometry")
+        geometry = self.geometry(geometry_el, el, where)
+        extras = tuple(self.fragment(c) for c in self.children(el)
+                       if c.tag not in ("origin", "geometry"))
+        if geometry is None:
+            return None
+        return Collision(
+            geometry=geometry, name=el.get("name"), origin=self.pose(el.find("origin"), where),
+            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
+            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+        )
+
+    def material(self, el: etree._Element, comments: tuple[str, ...], where: str) -> Material | None:
+        name = el.get("name")
+        if name is None:
+            self.error(el, "E0403", f"<material> in {where} has no 'name' attribute")
+            return None
+        color, texture = el.find("color"), el.find("texture")
+        rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
+        return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
+                        texture=texture.get("filename") if texture is not None else None,
+                        comments=comments, span=self.src.span(el))
+
+    def joint(self, el: etree._Element, comments: tuple[str, ...]) -> Joint | None:
+        name = self.name(el, "joint")
+        if name is None:
+            return None
+        where = f"joint '{name}'"
+        jtype = el.get("type")
+        ok = True
+        if jtype not in JOINT_TYPES:
+            hint = did_you_mean(jtype or "", set(JOINT_TYPES))
+            self.error(el, "E0422", f"{where} has unknown type '{jtype}'{hint}", "type",
+                       hint="URDF joint types: " + ", ".join(JOINT_TYPES))
+            ok = False
+        ends = {}
+        for end in ("parent", "child"):
+            end_el = el.find(end)
+            if end_el is None or not end_el.get("link"):
+                self.error(end_el if end_el is not None else el, "E0403",
+                           f"{where} has no <{end} link=…>")
+                ok = False
+            else:
+                ends[end] = end_el.get("link")
+        axis_el = el.find("axis")
+        axis = self.floats(axis_el, "xyz", 3, where) if axis_el is not None else None
+        limit = self.limit(el.find("limit"), where)
+        if jtype in ("revolute", "prismatic") and (limit is None or limit.effort is None
+                                                   or limit.velocity is None):
+            self.error(el, "E0421", f"{where} is {jtype} but has no <limit> with effort and "
+                       "velocity", "name")
+            ok = False
+        known = ("origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
+                 "calibration", "safety_controller")
+        extras = tuple(self.fragment(c) for c in self.children(el) if c.tag not in known)
+        if not ok:
+            return None
+        return Joint(
+            name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
+            origin=self.pose(el.find("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
+            dynamics=self.dynamics(el.find("dynamics"), where), mimic=self.mimic(el.find("mimic"), where),
+            calibration=self.calibration(el.find("calibration"), where),
+            safety_controller=self.safety(el.find("safety_controller"), where),
+            extra_attrs=self.extra_attrs(el, ("name", "type")), extras=extras,
+            comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
+        )
+
+    def limit(self, el: etree._Element | None, where: str) -> Limit | None:
+        if el is None:
+            return None
+        keys = ("lower", "upper", "effort", "velocity")
+        return Limit(**{k: self.number(el, k, where) for k in keys},
+                     extra_attrs=self.extra_attrs(el, keys))
+
+    def dynamics(self, el: etree._Element | None, where: str) -> Dynamics | None:
+        if el is None:
+            return None
+        keys = ("damping", "friction")
+        return Dynamics(**{k: self.number(el, k, where) for k in keys},
+                        extra_attrs=self.extra_attrs(el, keys))
+
+    def mimic(self, el: etree._Element | None, where: str) -> Mimic | None:
+        if el is None:
+            return None
+        self.warn_unknown_attrs(el, ("joint", "multiplier", "offset"), where)
+        target = el.get("joint")
+        if not target:
+            self.error(el, "E0403", f"<mimic> in {where} has no 'joint' attribute")
+            return None
+        if target not in self.joint_names:
+            # urdfdom accepts this and simulators ignore the mimic; keep it, but say so.
+            self.sink.warning(self.src.span(el, "joint"), "W0411",
+                              f"<mimic> in {where} refers to unknown joint '{target}'"
+                              f"{did_you_mean(target, self.joint_names)}; it has no effect")
+        return Mimic(joint=target, multiplier=self.number(el, "multiplier", where),
+                     offset=self.number(el, "offset", where))
+
+    def calibration(self, el: etree._Element | None, where: str) -> Calibration | None:
+        if el is None:
+            return None
+        keys = ("rising", "falling", "reference_position")
+        self.warn_unknown_attrs(el, keys, where)
+        return Calibration(**{k: self.number(el, k, where) for k in keys})
+
+    def safety(self, el: etree._Element | None, where: str) -> SafetyController | None:
+        if el is None:
+            return None
+        keys = ("k_velocity", "k_position", "soft_lower_limit", "soft_upper_limit")
+        self.warn_unknown_attrs(el, keys, where)
+        k_velocity = self.number(el, "k_velocity", where, True)
+        if k_velocity is None:
+            return None
+        return SafetyController(k_velocity=k_velocity,
+                                **{k: self.number(el, k, where) for k in keys[1:]})

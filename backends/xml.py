@@ -1,0 +1,121 @@
+"""Safe XML parsing with located elements, and canonical number formatting.
+
+Parsing: no entity expansion, no network, no DTD. lxml knows only the line of an
+element (where its start tag ends); `XmlSource` finds where each start tag and
+attribute really begins, so that diagnostics carry a line *and* a column.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lxml import etree
+
+from mpc.ir.span import Span
+
+_PARSER = etree.XMLParser(
+    resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+    remove_blank_text=False,
+)
+# Start tags outside comments, CDATA, processing instructions and doctype, in document order.
+_TOKENS = re.compile(
+    r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE[^>]*>|<([A-Za-z_][\w:.\-]*)", re.DOTALL
+)
+
+
+class XmlError(Exception):
+    """The text is not well-formed XML; carries the position libxml2 reported."""
+
+    def __init__(self, message: str, line: int, col: int) -> None:
+        super().__init__(message)
+        self.message, self.line, self.col = message, line, col
+
+
+@dataclass
+class XmlSource:
+    """A parsed XML file that can say where each of its elements and attributes is."""
+
+    file: str
+    text: str
+    root: etree._Element
+    _line_starts: list[int] = field(default_factory=list)
+    _offsets: dict[etree._Element, int] = field(default_factory=dict)
+
+    @classmethod
+    def parse(cls, data: bytes, file: str) -> XmlSource:
+        """Parse `data`; raises XmlError when it is not well-formed."""
+        try:
+            root = etree.fromstring(data, _PARSER)
+        except etree.XMLSyntaxError as e:
+            line, col = e.position if e.position else (1, 1)
+            raise XmlError(str(e.msg).strip(), max(line, 1), max(col, 1)) from None
+        text = data.decode("utf-8", errors="replace")
+        src = cls(file, text, root)
+        src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
+        starts = [(m.start(), m.group(1)) for m in _TOKENS.finditer(text) if m.group(1)]
+        elements = [e for e in root.iter() if isinstance(e.tag, str)]
+        if len(starts) == len(elements):
+            for el, (offset, tag) in zip(elements, starts, strict=True):
+                if tag.rsplit(":", 1)[-1] == etree.QName(el).localname:
+                    src._offsets[el] = offset
+        return src
+
+    def _pos(self, offset: int) -> tuple[int, int]:
+        line = bisect.bisect_right(self._line_starts, offset)
+        return line, offset - self._line_starts[line - 1] + 1
+
+    def span(self, el: etree._Element, attr: str | None = None) -> Span:
+        """The span of an element's start tag, or of one of its attribute values."""
+        offset = self._offsets.get(el)
+        if offset is None:
+            line = el.sourceline or 1
+            return Span(self.file, line, 1)
+        end = self.text.find(">", offset)
+        if attr is not None:
+            m = re.compile(rf"\s{re.escape(attr)}\s*=\s*([\"'])(.*?)\1", re.DOTALL).search(
+                self.text, offset, end + 1 if end >= 0 else len(self.text)
+            )
+            if m:
+                line, col = self._pos(m.start(2))
+                end_line, end_col = self._pos(m.end(2))
+                return Span(self.file, line, col, end_line, end_col)
+        line, col = self._pos(offset)
+        tag_end = offset + 1 + len(str(etree.QName(el).localname))
+        return Span(self.file, line, col, line, col + (tag_end - offset))
+
+
+def fmt_float(x: float) -> str:
+    """The shortest text that reads back as exactly `x`; integers without '.0'."""
+    if x == 0.0:
+        return "0"
+    if math.isfinite(x) and x.is_integer() and abs(x) < 1e16:
+        return str(int(x))
+    return repr(x)
+
+
+def fmt_floats(xs: tuple[float, ...] | list[float]) -> str:
+    return " ".join(fmt_float(x) for x in xs)
+
+
+def parse_floats(text: str | None) -> list[float] | None:
+    """Whitespace-separated numbers, or None when any token is not a number."""
+    if text is None:
+        return None
+    out = []
+    for token in text.split():
+        if "_" in token:
+            return None
+        try:
+            out.append(float(token))
+        except ValueError:
+            return None
+    return out
+
+
+def write_path(path: Path, data: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(data, encoding="utf-8")

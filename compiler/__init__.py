@@ -1,0 +1,1 @@
+"""The mpc compiler: definition files → IR programs → model files."""

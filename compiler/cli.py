@@ -1,0 +1,81 @@
+"""The `mpc` command: argument parsing, rendering diagnostics, exit codes.
+
+Exit status: 0 success, 1 the input has errors, 2 the command line is wrong,
+3 mpc itself failed (a bug: please report it; MPC_DEBUG=1 shows the traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from mpc.compiler import render
+from mpc.compiler.diagnostics import Sink
+
+
+def _package(text: str) -> tuple[str, Path]:
+    name, sep, folder = text.partition("=")
+    if not sep or not name or not folder:
+        raise argparse.ArgumentTypeError(f"expected NAME=DIR, got '{text}'")
+    return name, Path(folder).resolve()
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    comp = sub.add_parser("compile", help="compile a model definition into model files")
+    comp.add_argument("definition", type=Path, help="the model definition (YAML)")
+    comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
+    comp.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                      help="where the ROS package NAME is (for package:// paths); repeatable")
+    comp.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                      help="how to print diagnostics (default: human)")
+    comp.add_argument("--werror", action="store_true", help="treat warnings as errors")
+    return parser
+
+
+def _print_diagnostics(sink: Sink, fmt: str) -> None:
+    if fmt == "json":
+        print(render.as_json(sink.diagnostics), file=sys.stderr)
+    elif sink.diagnostics:
+        print((render.gcc if fmt == "gcc" else render.human)(sink.diagnostics), file=sys.stderr)
+
+
+def _compile(args: argparse.Namespace) -> int:
+    from mpc.backends.packages import PackageResolver
+    from mpc.compiler.driver import Options, compile_model
+
+    sink = Sink(werror=args.werror)
+    options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
+    result = compile_model(args.definition, sink, options)
+    _print_diagnostics(sink, args.format)
+    if result.out is None:
+        if args.format == "human":
+            print(f"error: could not compile '{args.definition}' ({render.summary(sink.diagnostics)})",
+                  file=sys.stderr)
+        return 1
+    files = sorted(str(p.relative_to(result.out)) for p in result.out.rglob("*") if p.is_file())
+    models = [f for f in files if not f.startswith("meshes/")]
+    print(f"compiled '{args.definition}' into '{result.out}': {', '.join(models)} "
+          f"and {len(files) - len(models)} mesh files")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return {"compile": _compile}[args.command](args)
+    except KeyboardInterrupt:
+        return 130
+    except Exception as e:  # a bug in mpc, not a user mistake
+        if os.environ.get("MPC_DEBUG"):
+            raise
+        print(f"internal error: {type(e).__name__}: {e}\nThis is a bug in mpc; rerun with "
+              "MPC_DEBUG=1 for the traceback and please report it.", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())

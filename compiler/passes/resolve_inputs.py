@@ -1,0 +1,23 @@
+"""resolve_inputs: every input model's file exists and is a format mpc reads.
+
+    input_models: {torso: {basefile: torso.urdf}}   # no such file
+    → error[E0601]: basefile 'torso.urdf' of input model 'torso' does not exist
+"""
+
+from __future__ import annotations
+
+from mpc.compiler.passes import PassContext
+from mpc.ir.program import Program
+
+READABLE = (".urdf",)
+
+
+def resolve_inputs(program: Program, ctx: PassContext) -> Program:
+    for inp in program.inputs.values():
+        if not inp.path.is_file():
+            ctx.sink.error(inp.span, "E0601", f"basefile '{inp.path}' of input model "
+                           f"'{inp.name}' does not exist")
+        elif inp.path.suffix.lower() not in READABLE:
+            ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
+                           "supported yet; mpc reads URDF (.urdf)")
+    return program

@@ -1,0 +1,96 @@
+"""Diagnostics → text: human (source line and caret), gcc one-line, JSON.
+
+The human renderer reads the source lines it shows on demand; it never fails on a
+file it cannot read (it then prints the header line alone).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from functools import lru_cache
+
+from mpc.compiler.diagnostics import Diagnostic, Severity
+from mpc.ir.span import Span
+
+MAX_SHOWN = 50
+
+
+@lru_cache(maxsize=64)
+def _lines(file: str) -> tuple[str, ...]:
+    try:
+        with open(file, encoding="utf-8", errors="replace") as f:
+            return tuple(f.read().splitlines())
+    except OSError:
+        return ()
+
+
+def _excerpt(span: Span) -> list[str]:
+    lines = _lines(span.file)
+    if not 1 <= span.line <= len(lines):
+        return []
+    text = lines[span.line - 1].expandtabs(1)
+    width = len(str(span.line))
+    end = span.end_col if span.end_line == span.line and span.end_col > span.col else span.col + 1
+    end = min(max(end, span.col + 1), max(len(text) + 1, span.col + 1))
+    caret = " " * (span.col - 1) + "^" * (end - span.col)
+    return [f" {span.line} | {text}", f" {' ' * width} | {caret}"]
+
+
+def human(diagnostics: Iterable[Diagnostic]) -> str:
+    """rustc-like: `file:line:col: error[E0101]: message`, the line, a caret, notes."""
+    out: list[str] = []
+    diags = list(diagnostics)
+    for d in diags[:MAX_SHOWN]:
+        out.append(f"{d.span}: {d.severity.value}[{d.code}]: {d.message}")
+        out.extend(_excerpt(d.span))
+        for span, text in d.notes:
+            out.append(f"  note: {span}: {text}" if span else f"  note: {text}")
+        if d.hint:
+            out.append(f"  hint: {d.hint}")
+    if len(diags) > MAX_SHOWN:
+        out.append(f"… and {len(diags) - MAX_SHOWN} more")
+    return "\n".join(out)
+
+
+def gcc(diagnostics: Iterable[Diagnostic]) -> str:
+    """One line each, `file:line:col: severity: message [code]`, for editor matchers."""
+    return "\n".join(
+        f"{d.span}: {d.severity.value}: {d.message} [{d.code}]" for d in diagnostics
+    )
+
+
+def as_json(diagnostics: Iterable[Diagnostic]) -> str:
+    """A JSON list of objects with code, severity, message, span, notes and hint."""
+
+    def span(s: Span | None) -> dict[str, object] | None:
+        if s is None:
+            return None
+        return {"file": s.file, "line": s.line, "col": s.col,
+                "end_line": s.end_line, "end_col": s.end_col}
+
+    return json.dumps(
+        [
+            {
+                "code": d.code,
+                "severity": d.severity.value,
+                "message": d.message,
+                "span": span(d.span),
+                "notes": [{"span": span(s), "message": t} for s, t in d.notes],
+                "hint": d.hint,
+            }
+            for d in diagnostics
+        ],
+        indent=2,
+    )
+
+
+def summary(diagnostics: list[Diagnostic]) -> str:
+    errors = sum(d.severity is Severity.ERROR for d in diagnostics)
+    warnings = sum(d.severity is Severity.WARNING for d in diagnostics)
+    parts = []
+    if errors:
+        parts.append(f"{errors} error{'s' * (errors != 1)}")
+    if warnings:
+        parts.append(f"{warnings} warning{'s' * (warnings != 1)}")
+    return ", ".join(parts)

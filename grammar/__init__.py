@@ -1,0 +1,1 @@
+"""Lark grammars of mpc, shipped as package data."""

@@ -1,0 +1,81 @@
+"""Geometry values of visuals and collisions: box, cylinder, sphere, mesh.
+
+A mesh is a *value*: the file it comes from plus the chain of mesh operations
+recorded on it (mirror, scale, reduce, …). Reading a model never opens a mesh file;
+backends materialise each distinct chain once, at emission.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from mpc.ir.span import Span
+
+Vec3 = tuple[float, float, float]
+Attrs = tuple[tuple[str, str], ...]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Box:
+    """A box centred at its origin. size: edge lengths along x, y, z in metres."""
+
+    size: Vec3
+    extra_attrs: Attrs = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Cylinder:
+    """A cylinder along z, centred at its origin. radius and length in metres."""
+
+    radius: float
+    length: float
+    extra_attrs: Attrs = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Sphere:
+    """A sphere centred at its origin. radius in metres."""
+
+    radius: float
+    extra_attrs: Attrs = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MeshSource:
+    """Where a mesh file comes from.
+
+    uri: the filename as written in the source model (`package://…`, relative, `file://…`).
+    path: the file it resolves to, or None when its package could not be found.
+    unresolved: why `path` is None (a sentence for a diagnostic), else "".
+    """
+
+    uri: str
+    path: Path | None
+    unresolved: str = ""
+
+    @property
+    def format(self) -> str:
+        """The file format by extension, lower case without the dot ("stl", "dae", …)."""
+        name = self.path.name if self.path is not None else self.uri
+        return name.rsplit(".", 1)[-1].lower() if "." in name else ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Mesh:
+    """A triangle mesh.
+
+    source: the file and how it was found.
+    scale: the scale written on the element, or None when none was written.
+    ops: mesh operations recorded on this value, applied in order at emission.
+    span: the `<mesh>` element (or YAML) the mesh was read from, for diagnostics.
+    """
+
+    source: MeshSource
+    scale: Vec3 | None = None
+    ops: tuple[object, ...] = ()
+    span: Span | None = None
+    extra_attrs: Attrs = ()
+
+
+Geometry = Box | Cylinder | Sphere | Mesh

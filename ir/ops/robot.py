@@ -1,0 +1,18 @@
+"""Ops on the robot as a whole."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from mpc.ir.ops import Op
+from mpc.ir.robot import Robot
+
+
+@dataclass(frozen=True, kw_only=True)
+class SetRobotName(Op):
+    """Name the robot `name` (the `robotname` of the definition)."""
+
+    name: str
+
+    def apply(self, robot: Robot) -> Robot:
+        return robot if robot.name == self.name else replace(robot, name=self.name)

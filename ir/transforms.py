@@ -1,0 +1,74 @@
+"""Homogeneous transforms: xyz/rpy ↔ 4×4 matrices, composition, inverse.
+
+Conventions are URDF's: rpy are fixed-axis roll (x), pitch (y), yaw (z), so
+R = Rz(yaw) · Ry(pitch) · Rx(roll). Names follow Drake's monograms: `X_PC` is the
+pose of frame C in frame P.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+Vec3 = tuple[float, float, float]
+
+
+def rpy_to_matrix(rpy: Vec3) -> np.ndarray:
+    """The 3×3 rotation of fixed-axis roll, pitch, yaw."""
+    r, p, y = rpy
+    cr, sr = math.cos(r), math.sin(r)
+    cp, sp = math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def matrix_to_rpy(R: np.ndarray) -> Vec3:
+    """Fixed-axis roll, pitch, yaw of a rotation matrix (pitch in [-pi/2, pi/2])."""
+    sp = -float(R[2, 0])
+    if abs(sp) >= 1.0 - 1e-12:
+        # Gimbal lock: only roll ± yaw is defined; put it all into yaw.
+        pitch = math.copysign(math.pi / 2, sp)
+        yaw = math.atan2(-float(R[0, 1]), float(R[1, 1]))
+        return (0.0, pitch, yaw)
+    roll = math.atan2(float(R[2, 1]), float(R[2, 2]))
+    pitch = math.asin(max(-1.0, min(1.0, sp)))
+    yaw = math.atan2(float(R[1, 0]), float(R[0, 0]))
+    return (roll, pitch, yaw)
+
+
+def pose_to_matrix(xyz: Vec3, rpy: Vec3) -> np.ndarray:
+    """X_PC as a 4×4 matrix from C's origin in P (xyz) and orientation (rpy)."""
+    X = np.eye(4)
+    X[:3, :3] = rpy_to_matrix(rpy)
+    X[:3, 3] = xyz
+    return X
+
+
+def matrix_to_pose(X: np.ndarray) -> tuple[Vec3, Vec3]:
+    """(xyz, rpy) of a 4×4 homogeneous transform."""
+    xyz = (float(X[0, 3]), float(X[1, 3]), float(X[2, 3]))
+    return xyz, matrix_to_rpy(X[:3, :3])
+
+
+def inverse(X: np.ndarray) -> np.ndarray:
+    """X_CP from X_PC, using the orthonormality of the rotation."""
+    R = X[:3, :3]
+    Xi = np.eye(4)
+    Xi[:3, :3] = R.T
+    Xi[:3, 3] = -R.T @ X[:3, 3]
+    return Xi
+
+
+def compose(*Xs: np.ndarray) -> np.ndarray:
+    """X_AD = X_AB · X_BC · X_CD."""
+    out = np.eye(4)
+    for X in Xs:
+        out = out @ X
+    return out

@@ -1,0 +1,70 @@
+"""Shared fixtures: the example-robot-data models, a compile helper, and `diags`.
+
+`diags` records every diagnostic a test produces; the test takes the ones it
+expects, and teardown fails on any it did not take (as Drake's test fixture does),
+so no diagnostic goes unnoticed.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from mpc.backends.packages import PackageResolver
+from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
+from mpc.compiler.driver import Options, Result, compile_model
+
+ERD_PACKAGE = PackageResolver().find("example-robot-data")
+assert ERD_PACKAGE is not None, "example-robot-data is not installed (pip install '.[dev]')"
+ERD = ERD_PACKAGE / "robots"
+
+
+class Diags(Sink):
+    """A sink whose diagnostics a test must consume."""
+
+    def take(self, code: str, severity: Severity = Severity.ERROR) -> Diagnostic:
+        for i, d in enumerate(self.diagnostics):
+            if d.code == code and d.severity is severity:
+                return self.diagnostics.pop(i)
+        raise AssertionError(f"no {severity.value} {code} among {self.summary()}")
+
+    def take_error(self, code: str) -> Diagnostic:
+        return self.take(code, Severity.ERROR)
+
+    def summary(self) -> list[str]:
+        return [f"{d.span}: {d.code}: {d.message}" for d in self.diagnostics]
+
+
+@pytest.fixture
+def diags() -> Diags:
+    sink = Diags()
+    yield sink
+    assert not sink.diagnostics, f"diagnostics nobody took: {sink.summary()}"
+
+
+def write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(textwrap.dedent(text).lstrip("\n"))
+    return path
+
+
+def definition(basefile: str | Path, mesh_format: str = "input_type", robotname: str = "robot") -> str:
+    return textwrap.dedent(f"""\
+        model:
+          robotname: {robotname}
+          modelname: {robotname}-model
+          input_models:
+            base:
+              basefile: "{basefile}"
+          assemble:
+            model: base
+          export_config:
+            - type: urdf
+              mesh_format: {mesh_format}
+        """)
+
+
+def compile_file(path: Path, out: Path, sink: Sink) -> Result:
+    return compile_model(path, sink, Options(out=out))
