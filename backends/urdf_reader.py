@@ -38,6 +38,12 @@ from mpc.ir.span import Span
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+# Elements inside links and joints that become IR values (anything else is a fragment).
+_MODELLED = frozenset({
+    "inertial", "visual", "collision", "origin", "geometry", "material", "mass", "inertia",
+    "box", "cylinder", "sphere", "mesh", "color", "texture", "parent", "child", "axis", "limit",
+    "dynamics", "mimic", "calibration", "safety_controller",
+})
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
@@ -167,7 +173,14 @@ class _Reader:
         return out
 
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
-        return tuple(str(c.text) for c in el.iter(etree.Comment))
+        """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
+        out: list[str] = []
+        for child in el:
+            if child.tag is etree.Comment:
+                out.append(str(child.text))
+            elif child.tag in _MODELLED:
+                out.extend(self.inner_comments(child))
+        return tuple(out)
 
     # -- elements --------------------------------------------------------------------------
 
@@ -361,7 +374,7 @@ class _Reader:
         color, texture = el.find("color"), el.find("texture")
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
         return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
-                        texture=texture.get("filename") if texture is not None else None,
+                        texture=texture.get("filename", "") if texture is not None else None,
                         comments=comments, span=self.src.span(el))
 
     def joint(self, el: etree._Element, comments: tuple[str, ...]) -> Joint | None:
@@ -370,7 +383,7 @@ class _Reader:
             return None
         where = f"joint '{name}'"
         jtype = el.get("type")
-        ok = True
+        ok = True  # False: reported, but parent and child may still be known
         if jtype not in JOINT_TYPES:
             hint = did_you_mean(jtype or "", set(JOINT_TYPES))
             self.error(el, "E0422", f"{where} has unknown type '{jtype}'{hint}", "type",
@@ -396,8 +409,10 @@ class _Reader:
         known = ("origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
                  "calibration", "safety_controller")
         extras = tuple(self.fragment(c) for c in self.children(el) if c.tag not in known)
-        if not ok:
+        if len(ends) < 2:
             return None
+        if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
+            jtype = "fixed"
         return Joint(
             name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
             origin=self.pose(el.find("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]

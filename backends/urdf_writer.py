@@ -89,7 +89,7 @@ class _Writer:
         if material.rgba is not None:
             self.leaf(depth + 1, "color", [("rgba", fmt_floats(material.rgba))])
         if material.texture is not None:
-            self.leaf(depth + 1, "texture", [("filename", material.texture)])
+            self.leaf(depth + 1, "texture", [("filename", material.texture or None)])
         self.line(depth, "</material>")
 
     def inertial(self, depth: int, inertial: Inertial) -> None:

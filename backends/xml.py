@@ -52,7 +52,9 @@ class XmlSource:
             root = etree.fromstring(data, _PARSER)
         except etree.XMLSyntaxError as e:
             line, col = e.position if e.position else (1, 1)
-            raise XmlError(str(e.msg).strip(), max(line, 1), max(col, 1)) from None
+            # libxml2 appends ", line N, column M"; the span carries the position.
+            message = re.sub(r", line \d+, column \d+$", "", str(e.msg).strip())
+            raise XmlError(message, max(line, 1), max(col, 1)) from None
         text = data.decode("utf-8", errors="replace")
         src = cls(file, text, root)
         src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
@@ -103,17 +105,12 @@ def fmt_floats(xs: tuple[float, ...] | list[float]) -> str:
 
 def parse_floats(text: str | None) -> list[float] | None:
     """Whitespace-separated numbers, or None when any token is not a number."""
-    if text is None:
+    if text is None or "_" in text:  # float() would accept "1_0"; URDF does not
         return None
-    out = []
-    for token in text.split():
-        if "_" in token:
-            return None
-        try:
-            out.append(float(token))
-        except ValueError:
-            return None
-    return out
+    try:
+        return [float(token) for token in text.split()]
+    except ValueError:
+        return None
 
 
 def write_path(path: Path, data: str) -> None:

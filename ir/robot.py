@@ -67,7 +67,10 @@ class Inertial:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Material:
-    """A named material: rgba colour (0..1 each) and/or a texture filename."""
+    """A named material: rgba colour (0..1 each) and/or a texture filename.
+
+    texture: "" for a `<texture/>` without filename (iCub writes those), None for none.
+    """
 
     name: str
     rgba: tuple[float, float, float, float] | None = None
