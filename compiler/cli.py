@@ -33,6 +33,17 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--format", choices=("human", "gcc", "json"), default="human",
                       help="how to print diagnostics (default: human)")
     comp.add_argument("--werror", action="store_true", help="treat warnings as errors")
+    comp.add_argument("--emit", choices=("files", "ir"), default="files",
+                      help="what to produce: the model files (default) or the IR as text on stdout")
+    check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
+    check.add_argument("files", type=Path, nargs="+", metavar="FILE",
+                       help="model definitions, IR files or pipeline.yml files")
+    for p in (check,):
+        p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                       help="where the ROS package NAME is (for package:// paths); repeatable")
+        p.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                       help="how to print diagnostics (default: human)")
+        p.add_argument("--werror", action="store_true", help="treat warnings as errors")
     return parser
 
 
@@ -63,10 +74,25 @@ def _compile(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check(args: argparse.Namespace) -> int:
+    from mpc.backends.packages import PackageResolver
+    from mpc.compiler.driver import Options, check_file
+
+    sink = Sink(werror=args.werror)
+    options = Options(resolver=PackageResolver(package_map=dict(args.package)))
+    for path in args.files:
+        check_file(path, sink, options)
+    _print_diagnostics(sink, args.format)
+    if args.format == "human" and sink.diagnostics:
+        print(f"{render.summary(sink.diagnostics)} in {len(args.files)} file"
+              f"{'s' * (len(args.files) != 1)}", file=sys.stderr)
+    return 1 if sink.has_errors() else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"compile": _compile}[args.command](args)
+        return {"compile": _compile, "check": _check}[args.command](args)
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # a bug in mpc, not a user mistake

@@ -1,4 +1,4 @@
-"""Compile one model definition: YAML on disk → finished model files on disk.
+"""Check or compile one model definition: YAML on disk → diagnostics, or model files.
 
 `compile_model` reads as a list of named phases; each stops the build when it
 reported an error. Outputs are built in a temporary folder beside the output and
@@ -11,14 +11,19 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from mpc.backends.packages import PackageResolver
-from mpc.compiler import schema, source
-from mpc.compiler.diagnostics import Sink
+from mpc.compiler import inherit, schema, source
+from mpc.compiler.diagnostics import Severity, Sink
+from mpc.compiler.inputs import InputLoader
 from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
+from mpc.compiler.passes.check_names import symbolic
+from mpc.ir.names import Names
+from mpc.ir.ops import ROOT, Attach, LoadModel
+from mpc.ir.ops.assembly import r2r_origin
 from mpc.ir.program import Program
 from mpc.ir.robot import Robot
 
@@ -40,32 +45,85 @@ class Result:
     out: Path | None = None
 
 
-def front_end(path: Path, sink: Sink, options: Options) -> Program | None:
-    """Load, validate, lower and run passes; the program or None."""
-    doc = source.load(path, sink)                                    # load sources
+def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
+              loader: InputLoader | None = None) -> Program | None:
+    """Load, resolve defaults, validate, lower and run passes; the program or None."""
+    doc = source.load(path, sink)                                         # load sources
     if doc is None:
         return None
-    ast = schema.validate(doc, sink)                                 # validate schema
+    doc = inherit.resolve(doc, path, sink)                                # merge defaults
+    if doc is None:
+        return None
+    ast = schema.validate(doc, sink)                                      # validate schema
     if ast is None:
         return None
-    program = lower(ast, path.resolve().parent, sink, options.resolver)  # lower
+    program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
     if program is None:
         return None
-    program = run_passes(program, PassContext(sink))                 # run passes
+    loader = loader or InputLoader(sink, options, (path.resolve(),))
+    program = run_passes(program, PassContext(sink, loader.names))        # run passes
     return None if sink.has_errors() else program
 
 
-def apply(program: Program, sink: Sink, options: Options) -> Robot | None:
-    """Read the inputs and run the ops; the robot or None."""
-    from mpc.backends import urdf
+def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
+    """The names of another definition's output, found without building it."""
+    loader = InputLoader(sink, options, stack)
+    program = front_end(path, sink, options, Severity.WARNING, loader)
+    return symbolic(program, PassContext(sink, loader.names)) if program else None
 
-    base = program.inputs[program.base]
-    robot = urdf.read(base.path, sink, options.resolver)
-    if robot is None:
-        return None
+
+def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
+    """Read the inputs and run the ops; the robot or None."""
     for op in program.ops:
-        robot = op.apply(robot)
-    return robot
+        if not type(op).SUPPORTED:
+            sink.error(op.span, "E0202", f"{op.kind.replace('_', ' ')} is not supported yet")
+    if sink.has_errors():
+        return None
+    parts: dict[str, Robot] = {}
+    originals: dict[str, Robot] = {}
+    for op in program.ops:
+        if isinstance(op, LoadModel):
+            robot = loader.robot(program.inputs[op.input])
+            if robot is None:
+                return None
+            parts[op.part] = originals[op.part] = robot
+        elif isinstance(op, Attach):
+            if op.r2r is not None:
+                op = replace(op, origin=r2r_origin(op, originals[op.part], originals[op.child]))
+            parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))
+        else:
+            parts[op.part] = op.apply(parts[op.part])
+    return parts[ROOT]
+
+
+def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
+    """The robot another definition describes, built in memory (for derived_base)."""
+    loader = InputLoader(sink, options, stack)
+    program = front_end(path, sink, options, Severity.ERROR, loader)
+    return apply(program, sink, loader) if program else None
+
+
+def check_file(path: Path, sink: Sink, options: Options) -> None:
+    """Everything `mpc check` does for one file; nothing is written.
+
+    A model definition goes through the front end with names checked; a pipeline file
+    is validated and each of its model definitions checked.
+    """
+    doc = source.load(path, sink)
+    if doc is None:
+        return
+    if isinstance(doc.data, dict) and "pipeline" in doc.data:
+        pipeline = schema.validate_pipeline(doc, sink)
+        if pipeline is not None:
+            for i, name in enumerate(pipeline.pipeline.model_definitions):
+                model = (path.resolve().parent / name)
+                if not model.is_file():
+                    sink.error(doc.value_span(("pipeline", "model_definitions", i)), "E0601",
+                               f"model definition '{name}' does not exist")
+                else:
+                    front_end(model, sink, options, Severity.WARNING)
+        return
+    front_end(path, sink, options, Severity.WARNING)
 
 
 def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
@@ -104,10 +162,11 @@ def _replace(new: Path, out: Path) -> None:
 def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     result = Result()
-    result.program = front_end(path, sink, options)      # front end: load, validate, lower, passes
+    loader = InputLoader(sink, options, (path.resolve(),))
+    result.program = front_end(path, sink, options, Severity.ERROR, loader)  # front end
     if result.program is None:
         return result
-    result.robot = apply(result.program, sink, options)  # read inputs, apply ops
+    result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
     if result.robot is None:
         return result
     out = options.out or Path("build") / result.program.modelname

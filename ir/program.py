@@ -16,19 +16,35 @@ from mpc.ir.span import Span
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class RepoRef:
+    """A model in a git repository: url, a commit (or branch), the file inside it."""
+
+    git: str
+    model_in_repo: str
+    commit: str | None = None
+    branch: str | None = None
+    submechanisms_in_repo: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Input:
     """An input model.
 
     name: its key under `input_models`.
-    kind: where it comes from (only `basefile`, a file on disk, for now).
-    path: the file, resolved against the definition's folder.
-    span: the YAML value that names the file.
+    kind: `basefile` (a model file), `derived_base` (another definition's output),
+        `repo` (a model file in a git repository).
+    path: the model file (basefile) or the other definition (derived_base); None for repo.
+    repo: where a `repo` input comes from.
+    is_human: whether every link is marked as human (exoskeleton models).
+    span: the YAML value that names the source.
     """
 
     name: str
-    kind: Literal["basefile"]
-    path: Path
+    kind: Literal["basefile", "derived_base", "repo"]
+    path: Path | None
     span: Span
+    repo: RepoRef | None = None
+    is_human: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -53,15 +69,15 @@ class Program:
     """A lowered model definition.
 
     robotname, modelname: the robot's name in the files; the output's name.
-    inputs: input models by name. base: the input the assembly starts from.
-    ops: rewrites applied to the base, in order. exports: what to write.
+    inputs: input models by name.
+    ops: rewrites in order: loading and assembling parts, then editing the robot.
+    exports: what to write.
     span: the definition's `model:` section.
     """
 
     robotname: str
     modelname: str
     inputs: Mapping[str, Input]
-    base: str
     ops: tuple[Op, ...]
     exports: tuple[Export, ...]
     span: Span

@@ -8,27 +8,37 @@ It never mutates its input.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.program import Program
+from mpc.ir.names import Names
+from mpc.ir.program import Input, Program
+
+
+def _unknown(_: Input) -> Names | None:
+    return None
 
 
 @dataclass
 class PassContext:
-    """What every pass may use: the diagnostics sink."""
+    """What every pass may use: the diagnostics sink and the input models' names."""
 
     sink: Sink
+    input_names: Callable[[Input], Names | None] = field(default=_unknown)
 
 
 Pass = Callable[[Program, PassContext], Program]
 
+from mpc.compiler.passes.check_names import check_names  # noqa: E402
 from mpc.compiler.passes.resolve_inputs import resolve_inputs  # noqa: E402
 
-PASSES: tuple[Pass, ...] = (resolve_inputs,)
+PASSES: tuple[Pass, ...] = (resolve_inputs, check_names)
 
 
 def run_passes(program: Program, ctx: PassContext) -> Program:
     for p in PASSES:
+        errors = ctx.sink.error_count
         program = p(program, ctx)
+        if ctx.sink.error_count > errors:  # later passes would only repeat the consequences
+            break
     return program

@@ -14,10 +14,13 @@ READABLE = (".urdf",)
 
 def resolve_inputs(program: Program, ctx: PassContext) -> Program:
     for inp in program.inputs.values():
+        if inp.path is None:
+            continue
+        what = "basefile" if inp.kind == "basefile" else "derived_base definition"
         if not inp.path.is_file():
-            ctx.sink.error(inp.span, "E0601", f"basefile '{inp.path}' of input model "
+            ctx.sink.error(inp.span, "E0601", f"{what} '{inp.path}' of input model "
                            f"'{inp.name}' does not exist")
-        elif inp.path.suffix.lower() not in READABLE:
+        elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
                            "supported yet; mpc reads URDF (.urdf)")
     return program

@@ -2,32 +2,44 @@
 
 Every op has a `kind` (derived from its class name and registered in `OPS`, the one
 table that the IR printer and parser share), the `span` of the YAML that asked for
-it, `reads` (names that must exist before it runs), `effect` (how it changes the
-set of names) and `apply` (a pure function Robot → Robot).
+it, the `part` of the assembly it edits, `reads` (the names that must exist before
+it runs), `effect` (how it changes the names, for `mpc check`) and `apply` (a pure
+function Robot → Robot). An op whose `apply` is not written yet says so through
+`SUPPORTED`, and compiling a definition that needs it is an error, not a crash.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import ClassVar
 
+from mpc.ir.names import Kind, Names
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
 OPS: dict[str, type[Op]] = {}
+ROOT = "root"
 
 
 @dataclass(frozen=True, slots=True)
-class Names:
-    """The names of a robot, as far as symbolic checks need them."""
+class Ref:
+    """A name an op needs: its kind, the name, and the op field that holds it (for spans)."""
 
-    links: frozenset[str]
-    joints: frozenset[str]
+    kind: Kind
+    name: str
+    field: str = ""
 
-    @classmethod
-    def of(cls, robot: Robot) -> Names:
-        return cls(frozenset(robot.links), frozenset(robot.joints))
+
+class Effects:
+    """What an op's `effect` may report: errors at the op's span (or one of its fields)."""
+
+    def __init__(self, report: object, op: Op) -> None:
+        self._report, self.op = report, op
+
+    def error(self, code: str, message: str, field: str = "") -> None:
+        self._report(self.op.span_of(field), code, message)  # type: ignore[operator]
 
 
 # Ops are not slotted: `slots=True` makes the dataclass decorator build a second class,
@@ -37,17 +49,24 @@ class Op:
     """Base of every IR operation. span: the YAML that asked for this op."""
 
     kind: ClassVar[str] = "op"
+    SUPPORTED: ClassVar[bool] = True
     span: Span
+    part: str = ROOT
+    spans: Mapping[str, Span] = field(default_factory=dict)
 
     def __init_subclass__(cls) -> None:
         cls.kind = re.sub(r"(?<!^)(?=[A-Z])", "_", cls.__name__).lower()
         OPS[cls.kind] = cls
 
-    def reads(self) -> frozenset[str]:
-        """Link and joint names that must exist when the op runs."""
-        return frozenset()
+    def span_of(self, field: str) -> Span:
+        """The span of one of the op's fields, else of the op."""
+        return self.spans.get(field, self.span)
 
-    def effect(self, names: Names) -> Names:
+    def reads(self) -> tuple[Ref, ...]:
+        """Names that must exist when the op runs."""
+        return ()
+
+    def effect(self, names: Names, effects: Effects) -> Names:
         """The names after the op, computed from the names before it."""
         return names
 
@@ -55,6 +74,16 @@ class Op:
         raise NotImplementedError
 
 
-from mpc.ir.ops.robot import SetRobotName  # noqa: E402  (registers itself in OPS)
+# The op modules register their classes in OPS when imported.
+from mpc.ir.ops.assembly import (  # noqa: E402
+    Attach,
+    EditNames,
+    LoadModel,
+    Mirror,
+    RemoveBeyond,
+    TakeLeaf,
+)
+from mpc.ir.ops.robot import SetRobotName  # noqa: E402
 
-__all__ = ["OPS", "Names", "Op", "SetRobotName"]
+__all__ = ["OPS", "ROOT", "Attach", "EditNames", "Effects", "LoadModel", "Mirror", "Names", "Op",
+           "Ref", "RemoveBeyond", "SetRobotName", "TakeLeaf"]

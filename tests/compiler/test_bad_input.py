@@ -68,10 +68,18 @@ def test_unknown_key_with_did_you_mean(tmp_path: Path, diags: Diags) -> None:
 
 def test_key_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
-    _compile(tmp_path, diags, definition("arm.urdf") + "  frames: {}\n  poses: {}\n")
+    _compile(tmp_path, diags, definition("arm.urdf") + "  frames: {upper: {make_root: true}}\n"
+             "  poses: {up: {shoulder: 1}}\n")
     frames, poses = diags.take_error("E0202"), diags.take_error("E0202")
-    assert frames.message == "'frames' in model is not supported yet"
+    assert frames.message == "'frames' is not supported yet"
     assert (_where(frames), _where(poses)) == ((12, 3), (13, 3))
+
+
+def test_export_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
+    arm(tmp_path)
+    _compile(tmp_path, diags, definition("arm.urdf") + "    - type: sdf\n")
+    d = diags.take_error("E0202")
+    assert (d.message, _where(d)) == ("export type 'sdf' is not supported yet", (12, 13))
 
 
 def test_wrong_type(tmp_path: Path, diags: Diags) -> None:
@@ -84,12 +92,10 @@ def test_wrong_type(tmp_path: Path, diags: Diags) -> None:
 
 def test_unknown_export_type_and_mesh_format(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
-    text = definition("arm.urdf", "stll") + "    - type: urdff\n    - type: sdf\n"
+    text = definition("arm.urdf", "stll") + "    - type: urdff\n"
     _compile(tmp_path, diags, text)
     typo = diags.take_error("E0203")
     assert (typo.message, _where(typo)) == ("unknown export type 'urdff'; did you mean 'urdf'?", (12, 13))
-    later = diags.take_error("E0202")
-    assert (later.message, _where(later)) == ("export type 'sdf' is not supported yet", (13, 13))
     fmt = diags.take_error("E0203")
     assert fmt.message == ("'mesh_format' must be one of 'stl', 'obj', 'dae', 'bobj', 'mars_obj' or "
                            "'input_type', got 'stll'; did you mean 'stl'?")
@@ -100,7 +106,7 @@ def test_assemble_model_that_is_no_input(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
     _compile(tmp_path, diags, definition("arm.urdf").replace("model: base", "model: bsae"))
     d = diags.take_error("E0301")
-    assert d.message == ("assemble.model 'bsae' is not one of the input models (base); "
+    assert d.message == ("model 'bsae' in assemble is not one of the input models (base); "
                          "did you mean 'base'?")
     assert _where(d) == (8, 12)
 

@@ -1,0 +1,88 @@
+"""Input models, loaded once per compilation: the robot of a file, of another definition's
+output (`derived_base`), or of a file in a git repository (`repo`); or just their names.
+
+A `derived_base` is compiled in memory (its front end and ops, no emission); a cycle
+of derived_base definitions is a diagnostic naming the loop.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.names import Names
+from mpc.ir.program import Input
+from mpc.ir.robot import Robot
+
+if TYPE_CHECKING:
+    from mpc.compiler.driver import Options
+
+
+@dataclass
+class InputLoader:
+    """Loads input models for one compilation (and the derived_base definitions below it).
+
+    stack: the definitions being compiled, outermost first (to find cycles).
+    """
+
+    sink: Sink
+    options: Options
+    stack: tuple[Path, ...] = ()
+    _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
+    _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
+
+    def _key(self, inp: Input) -> tuple[str, str]:
+        return (inp.kind, str(inp.path) if inp.path else repr(inp.repo))
+
+    def _cycle(self, inp: Input) -> bool:
+        assert inp.path is not None
+        if inp.path in self.stack:
+            loop = [p.name for p in self.stack[self.stack.index(inp.path):]] + [inp.path.name]
+            self.sink.error(inp.span, "E0308", "derived_base cycle: " + " → ".join(loop))
+            return True
+        return False
+
+    def robot(self, inp: Input) -> Robot | None:
+        """The input's robot, read or compiled once; None after reporting why."""
+        key = self._key(inp)
+        if key not in self._robots:
+            self._robots[key] = self._load(inp)
+        return self._robots[key]
+
+    def _load(self, inp: Input) -> Robot | None:
+        from mpc.compiler import driver
+
+        if inp.kind == "basefile":
+            from mpc.backends import urdf
+
+            assert inp.path is not None
+            return urdf.read(inp.path, self.sink, self.options.resolver)
+        if inp.kind == "derived_base":
+            assert inp.path is not None
+            if self._cycle(inp):
+                return None
+            return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
+        self.sink.error(inp.span, "E0202", "repo inputs are not supported yet")
+        return None
+
+    def names(self, inp: Input) -> Names | None:
+        """The input's names, without applying any op that changes geometry."""
+        key = self._key(inp)
+        if key not in self._names:
+            self._names[key] = self._load_names(inp)
+        return self._names[key]
+
+    def _load_names(self, inp: Input) -> Names | None:
+        from mpc.compiler import driver
+
+        if inp.kind == "derived_base":
+            assert inp.path is not None
+            if self._cycle(inp):
+                return None
+            return driver.names_of(inp.path, self.sink, self.options, (*self.stack, inp.path))
+        if inp.kind == "repo":
+            return None  # not cloned by `mpc check`; names are checked when compiling
+        robot = self.robot(inp)
+        return Names.of(robot) if robot is not None else None

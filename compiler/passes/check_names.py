@@ -1,0 +1,75 @@
+"""check_names: run every op on the input models' *names* and report what is missing.
+
+No geometry is read: each part starts from the names of its input model (or nothing
+when they cannot be known, e.g. a repo not cloned yet), each op's `reads` are looked
+up and its `effect` gives the names after it, attaches merge parts.
+
+    input_models: {arm: {basefile: arm.urdf}}            # links: base, upper, lower
+    assemble: {model: arm, take_leaf: uper}
+    → error[E0310]: take_leaf refers to unknown link 'uper'; did you mean 'upper'?
+"""
+
+from __future__ import annotations
+
+from mpc.compiler.diagnostics import did_you_mean
+from mpc.compiler.passes import PassContext
+from mpc.ir.names import Names
+from mpc.ir.ops import Attach, Effects, LoadModel, Op
+from mpc.ir.program import Program
+
+_WHAT = {"attach": "the attaching joint's parent", "take_leaf": "take_leaf",
+         "remove_beyond": "remove_beyond", "edit_names": "name_editing"}
+
+
+def symbolic(program: Program, ctx: PassContext) -> Names | None:
+    """The names of the finished robot (None when an input's names are unknown)."""
+    parts: dict[str, Names | None] = {}
+    origins: dict[str, str] = {}
+    for op in program.ops:
+        if isinstance(op, LoadModel):
+            parts[op.part] = ctx.input_names(program.inputs[op.input])
+            origins[op.part] = f"'{op.input}'"
+            continue
+        names = parts.get(op.part)
+        effects = Effects(ctx.sink.error, op)
+        if isinstance(op, Attach):
+            child = parts.pop(op.child, None)
+            if names is not None and child is not None and _reads_ok(op, names, ctx):
+                parts[op.part] = op.merge(names, child, effects,
+                                          (origins[op.part], origins.pop(op.child, "?")))
+            else:
+                parts[op.part] = None
+            continue
+        if names is not None:
+            parts[op.part] = op.effect(names, effects) if _reads_ok(op, names, ctx) else None
+    return parts.get("root")
+
+
+def _reads_ok(op: Op, names: Names, ctx: PassContext) -> bool:
+    ok = True
+    for ref in op.reads():
+        pool = names.all(ref.kind)
+        if ref.name not in pool:
+            what = _WHAT.get(op.kind, op.kind)
+            ctx.sink.error(op.span_of(ref.field), "E0310",
+                           f"{what} refers to unknown {ref.kind} '{ref.name}'"
+                           f"{did_you_mean(ref.name, pool)}",
+                           hint=_nearest_first(ref.name, pool))
+            ok = False
+    return ok
+
+
+def _nearest_first(name: str, pool: frozenset[str], shown: int = 8) -> str | None:
+    """The names there are, nearest to `name` first."""
+    if not pool:
+        return None
+    from difflib import SequenceMatcher
+
+    ranked = sorted(pool, key=lambda n: (-SequenceMatcher(None, name, n).ratio(), n))
+    more = f" and {len(pool) - shown} more" if len(pool) > shown else ""
+    return "there are: " + ", ".join(ranked[:shown]) + more
+
+
+def check_names(program: Program, ctx: PassContext) -> Program:
+    symbolic(program, ctx)
+    return program

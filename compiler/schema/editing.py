@@ -1,0 +1,226 @@
+"""AST of the editing sections: materials, frames (links), joints, collisions, visuals.
+
+Each section is keyed by the names it edits; `$keys` are section-wide settings.
+Entries keep undeclared keys as free annotations for SMURF.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import BeforeValidator, Field
+
+from mpc.compiler.schema.assembly import JointTypeName, NameEditing
+from mpc.compiler.schema.base import Expr, Node, OneOrMore, OpenNode, Vec3, str_or_list
+
+Color = Annotated[list[Expr], Field(min_length=3, max_length=4)]
+
+
+class Transform(Node):
+    """A rigid transform: translation xyz (m) and fixed-axis rpy (rad)."""
+
+    SECTION: ClassVar[str] = "a transform"
+    xyz: Vec3 = [0, 0, 0]
+    rpy: Vec3 = [0, 0, 0]
+
+
+class MaterialDef(OpenNode):
+    """Edit or create a material."""
+
+    SECTION: ClassVar[str] = "a material"
+    ANNOTATIONS: ClassVar[bool] = True
+    ALIASES: ClassVar[dict[str, str]] = {"diffuseColor": "diffuse", "ambientColor": "ambient",
+                                         "specularColor": "specular", "emissionColor": "emissive",
+                                         "diffuseTexture": "texture"}
+    diffuse: Color | None = None
+    ambient: Color | None = None
+    specular: Color | None = None
+    emissive: Color | None = None
+    texture: str | None = None
+    normalTexture: str | None = None  # the language's spelling
+    shininess: Expr | None = None
+    transparency: Expr | None = None
+
+
+class NewFrameJoint(Node):
+    """The joint of a new frame: its parent, pose and type."""
+
+    SECTION: ClassVar[str] = "a new frame's joint"
+    parent: str
+    name: str | None = None
+    xyz: Vec3
+    rpy: Vec3
+    type: JointTypeName = "fixed"
+    axis: Vec3 | None = None
+
+
+class FrameDef(OpenNode):
+    """Operations and annotations of one link; a name not in the robot is a new frame."""
+
+    SECTION: ClassVar[str] = "a frame"
+    ANNOTATIONS: ClassVar[bool] = True
+    ALIASES: ClassVar[dict[str, str]] = {"estimate_missing_com": "estimate_missing_coms"}
+    transform_link: Transform | None = None
+    transform_frame: Transform | None = None
+    reparent_to: str | None = None
+    make_root: bool = False
+    estimate_missing_coms: bool | None = None
+    material: str | None = None
+    name_editing: NameEditing | None = None
+    # a new frame, given as `joint: {parent, xyz, rpy, type}` or flat (`parent`, `jointname`, …)
+    joint: NewFrameJoint | None = None
+    parent: str | None = None
+    jointname: str | None = None
+    xyz: Vec3 | None = None
+    rpy: Vec3 | None = None
+    type: JointTypeName | None = None
+    mass: Expr | None = None
+
+
+class FramesSection(OpenNode):
+    """`frames` (alias `links`): per-link operations, `$default` for every link."""
+
+    SECTION: ClassVar[str] = "frames"
+    ENTRIES: ClassVar[type | None] = FrameDef
+    __pydantic_extra__: dict[str, FrameDef]
+    default: FrameDef | None = Field(None, alias="$default")
+    name_editing: NameEditing | None = Field(None, alias="$name_editing")
+
+
+class MimicDef(Node):
+    """This joint follows `joint`: q = multiplier · q_joint + offset."""
+
+    SECTION: ClassVar[str] = "mimic"
+    ALIASES: ClassVar[dict[str, str]] = {"joint_name": "joint"}
+    joint: str
+    multiplier: Expr = 1
+    offset: Expr = 0
+
+
+class MotorDef(OpenNode):
+    """A motor on a joint: name (default `<joint>_motor`), controller gains, annotations."""
+
+    SECTION: ClassVar[str] = "a motor"
+    ANNOTATIONS: ClassVar[bool] = True
+    name: str | None = None
+    type: str | None = None
+    p: Expr | None = None
+    i: Expr | None = None
+    d: Expr | None = None
+    maxEffort: Expr | None = None  # the language's spelling
+    maxSpeed: Expr | None = None
+
+
+class ConstraintAxis(Node):
+    SECTION: ClassVar[str] = "a constraint axis"
+    name: str | None = None
+    axis: Vec3
+
+
+class Limits(Node):
+    """Joint limit values: positions (rad or m), effort, velocity."""
+
+    SECTION: ClassVar[str] = "limits"
+    min: Expr | None = None
+    max: Expr | None = None
+    eff: Expr | None = None
+    vel: Expr | None = None
+
+
+class JointDef(OpenNode):
+    """Settings of one joint; a `cut_joint` that does not exist yet is a loop closure."""
+
+    SECTION: ClassVar[str] = "a joint"
+    ANNOTATIONS: ClassVar[bool] = True
+    ALIASES: ClassVar[dict[str, str]] = {"lower": "min", "upper": "max", "effort": "eff",
+                                         "velocity": "vel"}
+    min: Expr | None = None
+    max: Expr | None = None
+    eff: Expr | None = None
+    vel: Expr | None = None
+    friction: Expr | None = None
+    damping: Expr | None = None
+    spring_stiffness: Expr | None = None
+    spring_reference: Expr | None = None
+    type: JointTypeName | None = None
+    axis: Vec3 | None = None
+    remove: bool = False
+    cut_joint: bool = False
+    parent: str | None = None
+    child: str | None = None
+    constraint_axes: list[ConstraintAxis] | None = None
+    move_joint_axis_to_intersection: Annotated[list[str], Field(min_length=2, max_length=2)] | None = None
+    mimic: MimicDef | None = None
+    movement_depends_on: Annotated[list[MimicDef], BeforeValidator(
+        lambda v: [v] if isinstance(v, dict) else v)] | None = None
+    active: bool | MotorDef | None = None
+    motor: MotorDef | None = None
+    name_editing: NameEditing | None = None
+
+
+class JointsSection(OpenNode):
+    """`joints`: per-joint settings plus section-wide `$keys`."""
+
+    SECTION: ClassVar[str] = "joints"
+    ENTRIES: ClassVar[type | None] = JointDef
+    __pydantic_extra__: dict[str, JointDef]
+    default: JointDef | None = Field(None, alias="$default")
+    replace_joint_types: dict[JointTypeName, JointTypeName] | None = Field(
+        None, alias="$replace_joint_types")
+    all: bool = Field(False, alias="$all")
+    name_editing: NameEditing | None = Field(None, alias="$name_editing")
+    backup: Limits | None = Field(None, alias="$backup")
+
+
+RemoveWhat = Annotated[bool | list[str], BeforeValidator(
+    lambda v: str_or_list(v) if isinstance(v, str) else v)]
+ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
+
+
+class CollisionDef(OpenNode):
+    """Operations and annotations of a link's collisions (or of one collision by name)."""
+
+    SECTION: ClassVar[str] = "a collision entry"
+    ANNOTATIONS: ClassVar[bool] = True
+    remove: RemoveWhat = False
+    shape: ShapeName | None = None
+    oriented: bool = True
+    scale: Expr = 1
+    join: bool = False
+    bitmask: int | None = None
+    ccfm: Expr | None = None
+
+
+class CollisionsSection(OpenNode):
+    """`collisions`: per-link (or per-collision) entries, bitmasks, section-wide `$keys`."""
+
+    SECTION: ClassVar[str] = "collisions"
+    ENTRIES: ClassVar[type | None] = CollisionDef
+    __pydantic_extra__: dict[str, CollisionDef]
+    default: CollisionDef | None = Field(None, alias="$default")
+    exclude: OneOrMore = Field([], alias="$exclude")
+    name_editing: NameEditing | None = Field(None, alias="$name_editing")
+    auto_bitmask: bool = False
+    apply_primitives: bool = False
+    no_collision_between: dict[str, OneOrMore] = {}
+    collision_between: dict[str, OneOrMore] = {}
+
+
+class VisualDef(OpenNode):
+    """Operations and annotations of a link's visuals."""
+
+    SECTION: ClassVar[str] = "a visual entry"
+    ANNOTATIONS: ClassVar[bool] = True
+    remove: RemoveWhat = False
+    material: str | None = None
+
+
+class VisualsSection(OpenNode):
+    """`visuals`: per-link entries and section-wide `$keys`."""
+
+    SECTION: ClassVar[str] = "visuals"
+    ENTRIES: ClassVar[type | None] = VisualDef
+    __pydantic_extra__: dict[str, VisualDef]
+    default: VisualDef | None = Field(None, alias="$default")
+    exclude: OneOrMore = Field([], alias="$exclude")
+    name_editing: NameEditing | None = Field(None, alias="$name_editing")

@@ -1,0 +1,126 @@
+"""AST of `export_config`: one entry per output, told apart by `type`."""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import Field
+
+from mpc.compiler.schema.base import Expr, Node, OneOrMore
+
+
+class _Export(Node):
+    TYPE_WORD: ClassVar[str] = "export type"
+
+
+MeshFormat = Literal["stl", "obj", "dae", "bobj", "mars_obj", "input_type"]
+
+
+class _Kinematic(_Export):
+    """Options shared by the URDF, SDF and MJCF exports."""
+
+    ALIASES: ClassVar[dict[str, str]] = {"add_floatingbase": "add_floating_base"}
+    mesh_format: MeshFormat = "input_type"
+    additional_meshes: Annotated[list[MeshFormat], Field()] | MeshFormat | None = None
+    link_in_smurf: bool = False
+    include_cut_joints: bool = False
+    filename_suffix: str = ""
+    filename: str | None = None
+    ros_pathes: bool = False
+    copy_with_other_pathes: bool = False
+    enforce_zero: bool = False
+    add_floating_base: bool = False
+    correct_inertials: bool = False
+    float_fmt_dict: dict[str, str] | None = None
+
+
+class UrdfExport(_Kinematic):
+    SECTION: ClassVar[str] = "a urdf export"
+    type: Literal["urdf"]
+
+
+class SdfExport(_Kinematic):
+    SECTION: ClassVar[str] = "an sdf export"
+    type: Literal["sdf"]
+    version: Literal["1.6", "1.7", "1.9"] = "1.9"
+
+
+class MjcfExport(_Kinematic):
+    SECTION: ClassVar[str] = "an mjcf export"
+    type: Literal["mjcf"]
+
+
+class SmurfExport(_Export):
+    """SMURF is always written; the entry exists for old files and changes nothing."""
+
+    SECTION: ClassVar[str] = "a smurf export"
+    type: Literal["smurf"]
+
+
+class PdfExport(_Export):
+    SECTION: ClassVar[str] = "a pdf export"
+    type: Literal["pdf"]
+
+
+class JointLimitsExport(_Export):
+    SECTION: ClassVar[str] = "a joint_limits export"
+    type: Literal["joint_limits"]
+    joints: OneOrMore = ["ALL"]
+    file_name: str = "joint_limits.yml"
+
+
+class BrakingModel(Node):
+    SECTION: ClassVar[str] = "braking_model"
+    linearFactor: Expr = 0  # the language's spelling
+    invDeceleration: Expr = 0
+    uncertainty: Expr = 0
+    latency: Expr = 0
+
+
+class KccdExport(_Export):
+    SECTION: ClassVar[str] = "a kccd export"
+    type: Literal["kccd"]
+    join_before_convexhull: bool = True
+    remove_joints: list[str] = []
+    merge_additionally: list[str] = []
+    keep_stls: bool = False
+    keep_urdf: bool = False
+    dirname: str = "kccd"
+    reduce_meshes: Expr | None = None
+    edit_collisions: dict[str, dict[str, int | str]] = {}
+    braking_model: BrakingModel | None = None
+    simplify_swept_from: list[str] = []
+    safety_distance: Expr = 0
+    report_up_to: Expr = 0
+    computation_budget: Expr = -1
+    max_approximation_order: int = 1
+    no_collision_between: dict[str, list[str]] = {}
+
+
+class SubmodelExport(_Export):
+    SECTION: ClassVar[str] = "a submodel export"
+    type: Literal["submodel"]
+    name: str
+    start: str | None = None
+    stop: OneOrMore | None = None
+    include_unstopped_branches: bool = False
+    no_submechanisms: bool = False
+    abstract_model: bool = False
+    include_human_in_abstract: bool = False
+    remove_fixed: bool = False
+    remove_joints: OneOrMore = []
+    remove_links: OneOrMore = []
+    move_joint_axis_to_intersection: dict[str, list[str]] = {}
+    name_replacements: dict[str, str] = {}
+    add_floating_base: bool = False
+    filename: str | None = None
+    only_urdf: bool = False
+    export_config: list[ExportEntry] | None = None
+
+
+ExportEntry = Annotated[
+    UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | JointLimitsExport | KccdExport
+    | SubmodelExport,
+    Field(discriminator="type"),
+]
+SubmodelExport.model_rebuild()

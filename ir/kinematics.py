@@ -1,0 +1,29 @@
+"""Link poses at the zero configuration: X_RL, the pose of link L in the root frame R."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mpc.ir import transforms as tf
+from mpc.ir.robot import Pose, Robot
+from mpc.ir.tree import parent_joint
+
+
+def pose_matrix(pose: Pose | None) -> np.ndarray:
+    return np.eye(4) if pose is None else tf.pose_to_matrix(pose.xyz, pose.rpy)
+
+
+def link_in_root(robot: Robot, link: str) -> np.ndarray:
+    """X_RL at q = 0: the product of the joint origins from the root down to `link`."""
+    parents = parent_joint(robot)
+    chain = []
+    while link in parents:
+        joint = parents[link]
+        chain.append(pose_matrix(joint.origin))
+        link = joint.parent
+    return tf.compose(*reversed(chain)) if chain else np.eye(4)
+
+
+def matrix_pose(X: np.ndarray) -> Pose:
+    xyz, rpy = tf.matrix_to_pose(X)
+    return Pose(xyz, rpy)

@@ -1,0 +1,222 @@
+"""Assembly ops: load an input into a part, edit its names, cut it, mirror it, attach it.
+
+A definition's `assemble` tree becomes parts named by their place in the tree
+(`root`, `root/0`, `root/0/1`, …). Each part is loaded from an input model, edited,
+and attached to its parent part; after the last attach only `root` remains.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+
+from mpc.compiler.diagnostics import did_you_mean
+from mpc.ir import transforms as tf
+from mpc.ir.kinematics import link_in_root, matrix_pose
+from mpc.ir.names import Names
+from mpc.ir.naming import NameRule, edit_name
+from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.rename import rename_robot
+from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot
+
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadModel(Op):
+    """Start part `part` from input model `input` (the driver reads it)."""
+
+    input: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class EditNames(Op):
+    """Rename names of the part by `rules`; `only` limits it to these names (all when empty)."""
+
+    rules: tuple[NameRule, ...]
+    only: tuple[str, ...] = ()
+
+    def _edit(self, kind: str):
+        only = frozenset(self.only)
+        return lambda name: name if only and name not in only else edit_name(name, kind, self.rules)
+
+    def reads(self) -> tuple[Ref, ...]:
+        return tuple(Ref("link", n, "only") for n in self.only)
+
+    def effect(self, names: Names, effects: Effects) -> Names:
+        link, joint = self._edit("link"), self._edit("joint")
+        maps = {"link": {n: link(n) for n in names.links},
+                "joint": {n: joint(n) for n in names.joints}}
+        for kind, mapping in maps.items():
+            seen: dict[str, str] = {}
+            for old, new in sorted(mapping.items()):
+                if new in seen:
+                    effects.error("E0302", f"name editing gives two {kind}s the name '{new}' "
+                                  f"('{seen[new]}' and '{old}')")
+                seen[new] = old
+        collision, visual = self._edit("collision"), self._edit("visual")
+        return replace(
+            names, links=frozenset(maps["link"].values()), root=link(names.root),
+            joints={joint(j): (link(p), link(c)) for j, (p, c) in names.joints.items()},
+            collisions={link(k): frozenset(map(collision, v)) for k, v in names.collisions.items()},
+            visuals={link(k): frozenset(map(visual, v)) for k, v in names.visuals.items()},
+        )
+
+    def apply(self, robot: Robot) -> Robot:
+        return rename_robot(robot, self._edit("link"), self._edit("joint"),
+                            self._edit("collision"), self._edit("visual"))
+
+
+@dataclass(frozen=True, kw_only=True)
+class RemoveBeyond(Op):
+    """Keep the links up to and including `links`; remove everything below them."""
+
+    links: tuple[str, ...]
+
+    def reads(self) -> tuple[Ref, ...]:
+        return tuple(Ref("link", n, "links") for n in self.links)
+
+    def _kept(self, names: Names) -> set[str]:
+        below: set[str] = set()
+        for link in self.links:
+            below |= names.subtree(link) - {link}
+        return set(names.links) - below
+
+    def effect(self, names: Names, effects: Effects) -> Names:
+        return names.keep(self._kept(names))
+
+    def apply(self, robot: Robot) -> Robot:
+        return keep_links(robot, self._kept(Names.of(robot)), robot.root)
+
+
+@dataclass(frozen=True, kw_only=True)
+class TakeLeaf(Op):
+    """Keep the subtree rooted at `link`; it becomes the root."""
+
+    link: str
+
+    def reads(self) -> tuple[Ref, ...]:
+        return (Ref("link", self.link, "link"),)
+
+    def effect(self, names: Names, effects: Effects) -> Names:
+        return names.keep(names.subtree(self.link), root=self.link)
+
+    def apply(self, robot: Robot) -> Robot:
+        return keep_links(robot, Names.of(robot).subtree(self.link), self.link)
+
+
+def keep_links(robot: Robot, kept: set[str], root: str) -> Robot:
+    """The robot cut down to `kept` links (a connected part of the tree containing `root`).
+
+    Fragments that name a removed link or joint go with it.
+    """
+    joints = {n: j for n, j in robot.joints.items() if j.parent in kept and j.child in kept}
+    gone_links = set(robot.links) - kept
+    gone_joints = set(robot.joints) - set(joints)
+    fragments = tuple(f for f in robot.fragments
+                      if not (f.names("link") & gone_links or f.names("joint") & gone_joints))
+    return replace(robot, root=root, links={n: lk for n, lk in robot.links.items() if n in kept},
+                   joints=joints, fragments=fragments)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mirror(Op):
+    """Mirror the part at the plane through its root with normal `plane`.
+
+    flip_axis: the frame axis flipped afterwards so every frame stays right-handed.
+    exclude_meshes: meshes used as they are (symmetric ones), or ("ALL",).
+    name_replacements: (pattern, replacement) pairs applied to every name.
+    """
+
+    SUPPORTED = False
+    plane: Vec3 = (0.0, 1.0, 0.0)
+    flip_axis: Literal[0, 1, 2] = 1
+    exclude_meshes: tuple[str, ...] = ()
+    name_replacements: tuple[tuple[str, str], ...] = ()
+
+    def effect(self, names: Names, effects: Effects) -> Names:
+        if not self.name_replacements:
+            return names
+        rule = (NameRule(replacements=self.name_replacements),)
+        return EditNames(span=self.span, part=self.part, rules=rule).effect(names, effects)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Attach(Op):
+    """Attach part `child` to `part` with a new joint from link `parent` to link `child_link`.
+
+    child_link: the child part's link the joint ends in (None: the child part's root).
+    name: the joint's name (None: `<parent>2<child_link>`).
+    origin: X_PJ, the joint frame in the parent link; None with `r2r` given.
+    r2r: X_RpRc, the child model's root in the parent model's root (a 4×4 row list),
+        computed from the input models as they were read (before any editing).
+    """
+
+    child: str
+    parent: str
+    child_link: str | None = None
+    name: str | None = None
+    type: str = "fixed"
+    origin: Pose = IDENTITY
+    r2r: tuple[tuple[float, ...], ...] | None = None
+    axis: Vec3 | None = None
+    limit: Limit | None = None
+
+    def reads(self) -> tuple[Ref, ...]:
+        return (Ref("link", self.parent, "parent"),)
+
+    def joint_name(self, child_root: str) -> str:
+        return self.name or f"{self.parent}2{self.child_link or child_root}"
+
+    def merge(self, parent: Names, child: Names, effects: Effects, origins: tuple[str, str]) -> Names:
+        """The names after attaching; a name in both parts is an error naming both."""
+        child_link = self.child_link or child.root
+        if child_link not in child.links:
+            effects.error("E0303", f"attach: the child model has no link '{child_link}'"
+                          f"{did_you_mean(child_link, child.links)}", "child_link")
+        elif child_link != child.root:
+            effects.error("E0202", f"attaching at '{child_link}', which is not the child model's "
+                          f"root '{child.root}', is not supported yet", "child_link")
+        joint = self.joint_name(child.root)
+        for kind, a, b in (("link", parent.links, child.links),
+                           ("joint", frozenset(parent.joints), frozenset(child.joints))):
+            for name in sorted(a & b):
+                effects.error("E0304", f"{kind} '{name}' would exist twice after attaching: in "
+                              f"{origins[0]} and in {origins[1]}; rename one with name_editing")
+        if joint in parent.joints or joint in child.joints:
+            effects.error("E0304", f"the attaching joint '{joint}' would exist twice: a joint of "
+                          f"that name is already in {origins[0] if joint in parent.joints else origins[1]}",
+                          "name")
+        return replace(
+            parent, links=parent.links | child.links,
+            joints={**child.joints, **parent.joints, joint: (self.parent, child_link)},
+            collisions={**child.collisions, **parent.collisions},
+            visuals={**child.visuals, **parent.visuals},
+            materials=parent.materials | child.materials,
+        )
+
+    def attach(self, parent: Robot, child: Robot) -> Robot:
+        """The parent robot with the child robot hung below `parent` (origin already resolved)."""
+        child_link = self.child_link or child.root
+        joint = Joint(name=self.joint_name(child.root), type=self.type,  # type: ignore[arg-type]
+                      parent=self.parent, child=child_link, origin=self.origin, axis=self.axis,
+                      limit=self.limit, span=self.span)
+        materials = {**child.materials, **parent.materials}
+        return replace(parent, links={**parent.links, **child.links},
+                       joints={**parent.joints, **child.joints, joint.name: joint},
+                       materials=materials, fragments=parent.fragments + child.fragments)
+
+
+def r2r_origin(attach: Attach, parent_input: Robot, child_input: Robot) -> Pose:
+    """X_PJ from a root-to-root transform: X_PJ = X_RpP⁻¹ · X_RpRc · X_RcC.
+
+    X_RpP and X_RcC are the attach links in their input models as read, so the
+    transform the user measured between the two roots is kept whatever the editing.
+    """
+    assert attach.r2r is not None
+    X_RpRc = np.array(attach.r2r, dtype=float)
+    X_RpP = link_in_root(parent_input, attach.parent)
+    X_RcC = link_in_root(child_input, attach.child_link or child_input.root)
+    return matrix_pose(tf.compose(tf.inverse(X_RpP), X_RpRc, X_RcC))
