@@ -38,6 +38,9 @@ def _parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")
+    schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
+    schema.add_argument("-o", "--out", type=Path, default=Path("specs/model-definition.schema.json"),
+                        help="where to write it (default: specs/model-definition.schema.json); - for stdout")
     for p in (check,):
         p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
                        help="where the ROS package NAME is (for package:// paths); repeatable")
@@ -89,10 +92,23 @@ def _check(args: argparse.Namespace) -> int:
     return 1 if sink.has_errors() else 0
 
 
+def _schema(args: argparse.Namespace) -> int:
+    from mpc.compiler.jsonschema import render as render_schema
+
+    text = render_schema()
+    if str(args.out) == "-":
+        sys.stdout.write(text)
+    else:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(text, encoding="utf-8")
+        print(f"wrote {args.out}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"compile": _compile, "check": _check}[args.command](args)
+        return {"compile": _compile, "check": _check, "schema": _schema}[args.command](args)
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # a bug in mpc, not a user mistake

@@ -13,13 +13,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache, lru_cache
 from pathlib import Path
-
-from lark import Lark, Token, Transformer, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
-from lark.tree import Meta
+from typing import TYPE_CHECKING
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.span import Span
+
+if TYPE_CHECKING:
+    from lark import Lark
 
 CONSTANTS: dict[str, float] = {"pi": math.pi}
 UNITS: dict[str, Callable[[float], float]] = {"deg": math.radians, "rad": float}
@@ -30,7 +30,6 @@ FUNCTIONS: dict[str, tuple[int, int | None, Callable[..., float]]] = {
     "asin": (1, 1, math.asin), "acos": (1, 1, math.acos), "atan": (1, 1, math.atan),
     "atan2": (2, 2, math.atan2), "abs": (1, 1, math.fabs), "min": (2, None, min), "max": (2, None, max),
 }
-_CHAR_HINTS = {"^": "use ** for powers", "π": "write pi"}
 
 
 # Nodes. `start`/`end` are 0-based offsets into the expression text (end exclusive);
@@ -88,37 +87,18 @@ class Call:
 Node = Num | Name | Unary | Binary | Call
 
 
-@v_args(meta=True, inline=True)
-class ExprTransformer(Transformer[Token, Node]):
-    """Parse tree of expr.lark → typed nodes; shape only, no checks of names or arity."""
-
-    def number(self, meta: Meta, tok: Token) -> Num:
-        return Num(float(tok), meta.start_pos, meta.end_pos)
-
-    def name(self, meta: Meta, tok: Token) -> Name:
-        return Name(str(tok), meta.start_pos, meta.end_pos)
-
-    def unary(self, meta: Meta, op: Token, operand: Node) -> Unary:
-        return Unary(str(op), operand, meta.start_pos, meta.end_pos)
-
-    def binary(self, meta: Meta, left: Node, op: Token, right: Node) -> Binary:
-        return Binary(str(op), left, right, meta.start_pos, meta.end_pos)
-
-    def call(self, meta: Meta, func: Token, args: tuple[Node, ...] | None) -> Call:
-        return Call(str(func), args or (), meta.start_pos, meta.end_pos)
-
-    def args(self, meta: Meta, *args: Node) -> tuple[Node, ...]:
-        return args
-
-
 @cache
 def parser() -> Lark:
-    """The expression grammar, loaded once."""
-    return Lark.open_from_package("mpc.grammar", "expr.lark", parser="lalr", propagate_positions=True)
+    """The expression grammar, loaded once (lark is imported only when a string is parsed)."""
+    from mpc.compiler.expr_syntax import load
+
+    return load()
 
 
 def parse(text: str) -> Node:
     """Expression text → node tree; raises lark's UnexpectedInput on a syntax error."""
+    from mpc.compiler.expr_syntax import ExprTransformer
+
     return ExprTransformer().transform(parser().parse(text))
 
 
@@ -218,11 +198,15 @@ def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None
     if not text.strip():
         sink.error(where.span, "E0210", f"empty expression for {what}")
         return None
+    from lark.exceptions import UnexpectedInput
+
+    from mpc.compiler.expr_syntax import syntax_error
+
     try:
         node = parse(text)
         result = _Evaluator(shown, where, sink, what).value(node)
     except UnexpectedInput as e:
-        at, found, hint = _syntax_error(e, text)
+        at, found, hint = syntax_error(e, text)
         sink.error(where.at(at, at + 1), "E0210", f"invalid expression '{shown}' for {what}: {found}",
                    hint=hint)
         return None
@@ -234,17 +218,6 @@ def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None
                    f"cannot evaluate '{shown}' for {what}: the result is not finite")
         return None
     return result
-
-
-def _syntax_error(e: UnexpectedInput, text: str) -> tuple[int, str, str | None]:
-    """(offset, 'unexpected …', hint) of a lark error."""
-    if isinstance(e, UnexpectedCharacters):
-        char = text[e.pos_in_stream]
-        return e.pos_in_stream, f"unexpected '{char}'", _CHAR_HINTS.get(char)
-    if isinstance(e, UnexpectedToken) and e.token.type != "$END":
-        return e.token.start_pos or 0, f"unexpected '{e.token}'", None
-    assert isinstance(e, UnexpectedToken | UnexpectedEOF), e
-    return len(text.rstrip()), "unexpected end of expression", None
 
 
 @dataclass

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import BeforeValidator, Field, model_validator
+from pydantic import BeforeValidator, Field, WithJsonSchema, model_validator
 
 from mpc.compiler.schema.base import Expr, Node, OneOrMore, Vec3
 
@@ -19,7 +19,9 @@ def _dict_or_list_of_dicts(value: Any) -> Any:
     return value
 
 
-Replacements = Annotated[list[dict[str, str]], BeforeValidator(_dict_or_list_of_dicts)]
+_STR_MAP = {"type": "object", "additionalProperties": {"type": "string"}}
+Replacements = Annotated[list[dict[str, str]], BeforeValidator(_dict_or_list_of_dicts),
+                         WithJsonSchema({"anyOf": [_STR_MAP, {"type": "array", "items": _STR_MAP}]})]
 
 
 class Repo(Node):

@@ -10,11 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from typing import Literal
 
-import numpy as np
-
 from mpc.compiler.diagnostics import did_you_mean
-from mpc.ir import transforms as tf
-from mpc.ir.kinematics import link_in_root, matrix_pose
 from mpc.ir.names import Names
 from mpc.ir.naming import NameRule, edit_name
 from mpc.ir.ops import Effects, Op, Ref
@@ -215,6 +211,11 @@ def r2r_origin(attach: Attach, parent_input: Robot, child_input: Robot) -> Pose:
     X_RpP and X_RcC are the attach links in their input models as read, so the
     transform the user measured between the two roots is kept whatever the editing.
     """
+    import numpy as np  # not at the top: `mpc check` never needs it
+
+    from mpc.ir import transforms as tf
+    from mpc.ir.kinematics import link_in_root, matrix_pose
+
     assert attach.r2r is not None
     X_RpRc = np.array(attach.r2r, dtype=float)
     X_RpP = link_in_root(parent_input, attach.parent)

@@ -1,0 +1,44 @@
+"""Cold wall time of `mpc check` on the bundled example: a fresh process, so imports count.
+
+Target (issue 3): under 250 ms, and never importing Pinocchio, PyBullet, trimesh or numpy.
+Run: python bench/bench_check.py [runs]
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("pinocchio", "pybullet", "trimesh", "numpy", "lark")
+PROBE = (
+    "import sys\n"
+    "from mpc.compiler.cli import main\n"
+    f"code = main(['check', {str(ROOT / 'examples/talos.yml')!r}])\n"
+    f"print(','.join(m for m in {HEAVY!r} if m in sys.modules))\n"
+    "sys.exit(code)\n"
+)
+
+
+def main(runs: int = 7) -> None:
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True)
+        times.append((time.perf_counter() - t0) * 1e3)
+        assert done.returncode == 0, done.stderr
+    startup = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", "pass"], check=True)
+        startup.append((time.perf_counter() - t0) * 1e3)
+    print(f"mpc check examples/talos.yml, cold, median of {runs}: {statistics.median(times):.0f} ms "
+          f"(target < 250 ms; a bare python start is {statistics.median(startup):.0f} ms)")
+    print(f"heavy modules imported: {done.stdout.strip() or 'none'}")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 7)
