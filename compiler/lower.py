@@ -15,6 +15,7 @@ from typing import Any
 from mpc.backends.packages import PackageResolver
 from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
 from mpc.compiler.expr import evaluate
+from mpc.compiler.lower_edits import EditLowering
 from mpc.compiler.schema import Definition
 from mpc.compiler.schema.assembly import AssembleChild, AttachJoint, NameEditing, _Part
 from mpc.compiler.schema.base import Node
@@ -25,9 +26,8 @@ from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
-LATER_SECTIONS = ("materials", "frames", "joints", "collisions", "visuals", "submechanisms",
-                  "exoskeletons", "submechanisms_file", "sensors", "poses", "annotations",
-                  "post_processing", "test", "deployment", "append_export_config")
+LATER_SECTIONS = ("post_processing", "test", "deployment", "append_export_config", "reduce_meshes",
+                  "apply_scale", "swing_my_robot")
 
 
 def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
@@ -59,6 +59,13 @@ class _Lowering:
     def num(self, node: Node, key: str, what: str) -> float | None:
         value = getattr(node, key)
         return None if value is None else evaluate(value, node.value_span(key), self.sink, what=what)
+
+    def num_value(self, value: object, span: Span, what: str) -> float | None:
+        return evaluate(value, span, self.sink, what=what)
+
+    @staticmethod
+    def item_span(node: Node, key: str, i: int) -> Span:
+        return _item_span(node, key, i)
 
     def vec(self, node: Node, key: str, what: str) -> tuple[float, ...] | None:
         values = getattr(node, key)
@@ -198,18 +205,18 @@ class _Lowering:
             out.append(UrdfExport(mesh_format=entry.mesh_format, span=entry.span))
         return tuple(out)
 
-    def program(self) -> Program | None:
-        errors = self.sink.error_count
+    def program(self) -> Program:
+        """The program, also after errors (values that failed are None), so that the names
+        in it can still be checked; the errors stop the build later."""
         inputs = self.inputs()
         self.part(self.model.assemble, ROOT, inputs)
         self.ops.append(SetRobotName(span=self.model.value_span("robotname"), name=self.model.robotname))
+        EditLowering(self).run()
         for key in LATER_SECTIONS:
             value = getattr(self.model, key)
             if value:
                 self.not_yet(self.model.key_span(key), f"'{key}'")
         exports = self.exports()
-        if self.sink.error_count > errors:
-            return None
         return Program(robotname=self.model.robotname, modelname=self.model.modelname,
                        inputs=inputs, ops=tuple(self.ops), exports=exports, span=self.model.span)
 

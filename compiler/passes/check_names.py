@@ -17,9 +17,6 @@ from mpc.ir.names import Names
 from mpc.ir.ops import Attach, Effects, LoadModel, Op
 from mpc.ir.program import Program
 
-_WHAT = {"attach": "the attaching joint's parent", "take_leaf": "take_leaf",
-         "remove_beyond": "remove_beyond", "edit_names": "name_editing"}
-
 
 def symbolic(program: Program, ctx: PassContext) -> Names | None:
     """The names of the finished robot (None when an input's names are unknown)."""
@@ -40,8 +37,8 @@ def symbolic(program: Program, ctx: PassContext) -> Names | None:
             else:
                 parts[op.part] = None
             continue
-        if names is not None:
-            parts[op.part] = op.effect(names, effects) if _reads_ok(op, names, ctx) else None
+        if names is not None and (_reads_ok(op, names, ctx) or not type(op).EFFECT_NEEDS_READS):
+            parts[op.part] = op.effect(names, effects)
     return parts.get("root")
 
 
@@ -50,7 +47,7 @@ def _reads_ok(op: Op, names: Names, ctx: PassContext) -> bool:
     for ref in op.reads():
         pool = names.all(ref.kind)
         if ref.name not in pool:
-            what = _WHAT.get(op.kind, op.kind)
+            what = op.what()
             ctx.sink.error(op.span_of(ref.field), "E0310",
                            f"{what} refers to unknown {ref.kind} '{ref.name}'"
                            f"{did_you_mean(ref.name, pool)}",

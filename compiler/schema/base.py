@@ -144,6 +144,8 @@ def _union_members(tp: Any) -> list[Any]:
 
 def _tagged(members: list[Any]) -> dict[str, type[Node]] | None:
     """For a union of nodes told apart by a `type` literal: tag → node class."""
+    if len(members) < 2:
+        return None
     table: dict[str, type[Node]] = {}
     for m in members:
         if not (isinstance(m, type) and issubclass(m, Node)):

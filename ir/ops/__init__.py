@@ -50,6 +50,8 @@ class Op:
 
     kind: ClassVar[str] = "op"
     SUPPORTED: ClassVar[bool] = True
+    WHAT: ClassVar[str] = ""  # how messages name the op; default: its kind in words
+    EFFECT_NEEDS_READS: ClassVar[bool] = True  # False: `effect` is sound even if a read is missing
     span: Span
     part: str = ROOT
     spans: Mapping[str, Span] = field(default_factory=dict)
@@ -57,6 +59,10 @@ class Op:
     def __init_subclass__(cls) -> None:
         cls.kind = re.sub(r"(?<!^)(?=[A-Z])", "_", cls.__name__).lower()
         OPS[cls.kind] = cls
+
+    @classmethod
+    def what(cls) -> str:
+        return cls.WHAT or cls.kind.replace("_", " ")
 
     def span_of(self, field: str) -> Span:
         """The span of one of the op's fields, else of the op."""
@@ -75,6 +81,17 @@ class Op:
 
 
 # The op modules register their classes in OPS when imported.
+from mpc.ir.ops.annotate import (  # noqa: E402
+    AddAnnotations,
+    AddPose,
+    AddSensor,
+    AddSubmechanism,
+    AutoBitmask,
+    EditCollisions,
+    EditMaterial,
+    EditVisuals,
+    SubmechanismsFile,
+)
 from mpc.ir.ops.assembly import (  # noqa: E402
     Attach,
     EditNames,
@@ -83,7 +100,32 @@ from mpc.ir.ops.assembly import (  # noqa: E402
     RemoveBeyond,
     TakeLeaf,
 )
+from mpc.ir.ops.frames import (  # noqa: E402
+    AddFrame,
+    AnnotateLinks,
+    EstimateMissingComs,
+    MakeRoot,
+    ReparentLink,
+    TransformFrame,
+    TransformLink,
+)
+from mpc.ir.ops.joints import (  # noqa: E402
+    AddCutJoint,
+    EditJoint,
+    JointDefaults,
+    MoveJointAxisToIntersection,
+    RemoveJoint,
+    ReplaceJointTypes,
+    SetMotor,
+)
 from mpc.ir.ops.robot import SetRobotName  # noqa: E402
+
+EDITING_OPS = (
+    AddAnnotations, AddCutJoint, AddFrame, AddPose, AddSensor, AddSubmechanism, AnnotateLinks,
+    AutoBitmask, EditCollisions, EditJoint, EditMaterial, EditVisuals, EstimateMissingComs,
+    JointDefaults, MakeRoot, MoveJointAxisToIntersection, RemoveJoint, ReparentLink,
+    ReplaceJointTypes, SetMotor, SubmechanismsFile, TransformFrame, TransformLink,
+)
 
 __all__ = ["OPS", "ROOT", "Attach", "EditNames", "Effects", "LoadModel", "Mirror", "Names", "Op",
            "Ref", "RemoveBeyond", "SetRobotName", "TakeLeaf"]

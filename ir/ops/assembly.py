@@ -29,17 +29,27 @@ class LoadModel(Op):
 
 @dataclass(frozen=True, kw_only=True)
 class EditNames(Op):
-    """Rename names of the part by `rules`; `only` limits it to these names (all when empty)."""
+    """Rename names of the part by `rules`.
+
+    kinds: the kinds of names edited (all when empty): link, joint, collision, visual.
+    only: the names edited (all when empty), of the one kind in `kinds`.
+    """
+
+    WHAT = "name_editing"
 
     rules: tuple[NameRule, ...]
+    kinds: tuple[str, ...] = ()
     only: tuple[str, ...] = ()
 
     def _edit(self, kind: str):
         only = frozenset(self.only)
+        if self.kinds and kind not in self.kinds:
+            return lambda name: name
         return lambda name: name if only and name not in only else edit_name(name, kind, self.rules)
 
     def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "only") for n in self.only)
+        kind = self.kinds[0] if len(self.kinds) == 1 else "link"
+        return tuple(Ref(kind, n, "only") for n in self.only)  # type: ignore[arg-type]
 
     def effect(self, names: Names, effects: Effects) -> Names:
         link, joint = self._edit("link"), self._edit("joint")
@@ -69,6 +79,8 @@ class EditNames(Op):
 class RemoveBeyond(Op):
     """Keep the links up to and including `links`; remove everything below them."""
 
+    WHAT = "remove_beyond"
+
     links: tuple[str, ...]
 
     def reads(self) -> tuple[Ref, ...]:
@@ -90,6 +102,8 @@ class RemoveBeyond(Op):
 @dataclass(frozen=True, kw_only=True)
 class TakeLeaf(Op):
     """Keep the subtree rooted at `link`; it becomes the root."""
+
+    WHAT = "take_leaf"
 
     link: str
 
@@ -149,6 +163,8 @@ class Attach(Op):
     r2r: X_RpRc, the child model's root in the parent model's root (a 4×4 row list),
         computed from the input models as they were read (before any editing).
     """
+
+    WHAT = "the attaching joint's parent"
 
     child: str
     parent: str
