@@ -1,9 +1,12 @@
 """Meshes of a robot → files in the output folder, with unique, stable names.
 
-Each mesh goes to `meshes/<format>/<basename>`, the extension in lower case. Two
-different files with the same basename are told apart by a content hash in their
-names; the same file used twice is written once. Converting between formats is not
-done here yet: a mesh whose format differs from the export's is a diagnostic.
+A mesh value is a source file plus a chain of mesh ops. Each distinct value goes to
+`meshes/<format>/<basename>` (extension in lower case; `_mirrored` added for a
+reflected mesh, as Phobos names them). Two different values with the same name are
+told apart by a content hash in their names; a value used twice is written once.
+A mesh without ops is copied byte for byte; one with ops is computed with trimesh.
+Converting between formats is not done here yet: a mesh without ops whose format
+differs from the export's is a diagnostic.
 """
 
 from __future__ import annotations
@@ -16,12 +19,19 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import Mesh
+from mpc.ir.geometry import Mesh, MeshOp, ReflectMesh
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 KEEP_FORMAT = "input_type"
+WRITABLE = ("stl", "obj", "dae", "ply")  # formats trimesh writes, for meshes with ops
+MeshKey = tuple[Path, tuple[MeshOp, ...]]
+
+
+def key(mesh: Mesh) -> MeshKey:
+    assert mesh.source.path is not None
+    return (mesh.source.path, mesh.ops)
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,13 +57,13 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:10]
 
 
-def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[Path, str] | None:
-    """Map each mesh file to its path in the output (relative, `meshes/<fmt>/<name>`).
+def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[MeshKey, str] | None:
+    """Map each mesh value to its path in the output (relative, `meshes/<fmt>/<name>`).
 
     Reports meshes that cannot be found or would need a conversion; None if any.
     """
     ok = True
-    wanted: dict[Path, str] = {}
+    wanted: dict[MeshKey, str] = {}
     conversions: dict[str, MeshUse] = {}
     for use in mesh_uses(robot):
         src = use.mesh.source
@@ -64,7 +74,8 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
                        hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH")
             ok = False
             continue
-        if src.path in wanted:
+        k = key(use.mesh)
+        if k in wanted:
             continue
         if not src.path.is_file():
             sink.error(span, "E0602", f"mesh file '{src.path}' of a {use.element} of link "
@@ -72,11 +83,13 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
             ok = False
             continue
         fmt = src.format if mesh_format == KEEP_FORMAT else mesh_format
-        if fmt != src.format:
+        if use.mesh.ops:
+            fmt = fmt if fmt in WRITABLE else "stl"
+        elif fmt != src.format:
             conversions.setdefault(src.format, use)
             continue
-        stem = src.path.name.rsplit(".", 1)[0]
-        wanted[src.path] = f"meshes/{fmt}/{stem}.{fmt}"
+        stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
+        wanted[k] = f"meshes/{fmt}/{stem}.{fmt}"
     for fmt, use in sorted(conversions.items()):
         sink.error(export_span, "E0501", f"converting '{fmt}' meshes to '{mesh_format}' is not "
                    f"supported yet (first: '{use.mesh.source.uri}' of link '{use.link}')",
@@ -88,27 +101,67 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
     return _disambiguate(wanted)
 
 
-def _disambiguate(wanted: dict[Path, str]) -> dict[Path, str]:
-    by_name: dict[str, list[Path]] = {}
-    for path, name in wanted.items():
-        by_name.setdefault(name, []).append(path)
+def _suffix(ops: tuple[MeshOp, ...]) -> str:
+    return "".join("_mirrored" for op in ops if isinstance(op, ReflectMesh))
+
+
+def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
+    by_name: dict[str, list[MeshKey]] = {}
+    for k, name in wanted.items():
+        by_name.setdefault(name, []).append(k)
     out = dict(wanted)
-    for name, paths in by_name.items():
-        if len(paths) == 1:
+    for name, keys in by_name.items():
+        if len(keys) == 1:
             continue
-        first = paths[0]
-        if all(filecmp.cmp(first, p, shallow=False) for p in paths[1:]):
+        paths = {p for p, _ in keys}
+        first = keys[0][0]
+        if len(set(ops for _, ops in keys)) == 1 and all(
+                filecmp.cmp(first, p, shallow=False) for p in paths):
             continue
         stem, ext = name.rsplit(".", 1)
-        for p in paths:
-            out[p] = f"{stem}_{_digest(p)}.{ext}"
+        for k in keys:
+            out[k] = f"{stem}_{_digest(k)}.{ext}"
     return out
 
 
-def copy(files: dict[Path, str], out: Path) -> None:
-    """Copy each planned mesh file into `out` (content only, no metadata)."""
-    for src, rel in sorted(files.items(), key=lambda kv: kv[1]):
+def _digest(k: MeshKey) -> str:
+    h = hashlib.sha256(k[0].read_bytes())
+    h.update(repr(k[1]).encode())
+    return h.hexdigest()[:10]
+
+
+def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) -> bool:
+    """Write each planned mesh into `out`: a copy, or the result of its ops."""
+    ok = True
+    for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
         dest = out / rel
         dest.parent.mkdir(parents=True, exist_ok=True)
-        if not dest.exists():
+        if dest.exists():
+            continue
+        if not ops:
             shutil.copyfile(src, dest)
+            continue
+        problem = _materialise(src, ops, dest)
+        if problem:
+            sink.error(export_span, "E0603", f"cannot compute mesh '{rel}' from '{src}': {problem}")
+            ok = False
+    return ok
+
+
+def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
+    """Apply `ops` to the mesh in `src` and write it to `dest`; why not, or None."""
+    import numpy as np
+    import trimesh
+
+    try:
+        mesh = trimesh.load(src, force="mesh", process=False)
+    except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
+        return f"cannot read it ({type(e).__name__}: {e})"
+    for op in ops:
+        if isinstance(op, ReflectMesh):
+            T = np.eye(4)
+            T[op.axis, op.axis] = -1.0
+            mesh.apply_transform(T)  # trimesh reverses the winding for a reflection
+    data = mesh.export(file_type=dest.suffix[1:])
+    dest.write_bytes(data if isinstance(data, bytes) else data.encode())
+    return None

@@ -23,12 +23,10 @@ __all__ = ["emit", "read", "to_string"]
 def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None:
+    if files is None or not meshes.copy(files, out, sink, export.span):
         return
-    meshes.copy(files, out)
 
     def mesh_name(mesh: Mesh) -> str:
-        assert mesh.source.path is not None
-        return "../" + files[mesh.source.path]
+        return "../" + files[meshes.key(mesh)]
 
     write_path(out / "urdf" / f"{robot.name}.urdf", to_string(robot, mesh_name))

@@ -26,7 +26,7 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     comp = sub.add_parser("compile", help="compile a model definition into model files")
-    comp.add_argument("definition", type=Path, help="the model definition (YAML)")
+    comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
     comp.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
                       help="where the ROS package NAME is (for package:// paths); repeatable")
@@ -63,6 +63,16 @@ def _compile(args: argparse.Namespace) -> int:
 
     sink = Sink(werror=args.werror)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
+    if args.emit == "ir":
+        from mpc.compiler.driver import load_program
+        from mpc.ir.text import dump
+
+        program = load_program(args.definition, sink, options)
+        _print_diagnostics(sink, args.format)
+        if program is None:
+            return 1
+        sys.stdout.write(dump(program))
+        return 0
     result = compile_model(args.definition, sink, options)
     _print_diagnostics(sink, args.format)
     if result.out is None:

@@ -26,6 +26,7 @@ from mpc.ir.ops import ROOT, Attach, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
 from mpc.ir.program import Program
 from mpc.ir.robot import Robot
+from mpc.ir.span import Span
 
 
 @dataclass
@@ -46,9 +47,13 @@ class Result:
 
 
 def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
-              loader: InputLoader | None = None) -> Program | None:
-    """Load, resolve defaults, validate, lower and run passes; the program or None."""
-    doc = source.load(path, sink)                                         # load sources
+              loader: InputLoader | None = None, doc: source.Document | None = None) -> Program | None:
+    """Load, resolve defaults, validate, lower and run passes; the program or None.
+
+    later: how to report what compiling does not support yet (check: a warning).
+    doc: the file, when the caller loaded it already.
+    """
+    doc = doc or source.load(path, sink)                                  # load sources
     if doc is None:
         return None
     doc = inherit.resolve(doc, path, sink)                                # merge defaults
@@ -60,25 +65,40 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
     if program is None:
         return None
-    loader = loader or InputLoader(sink, options, (path.resolve(),))
-    program = run_passes(program, PassContext(sink, loader.names))        # run passes
+    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
+    return None if sink.has_errors() else program
+
+
+def load_program(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
+                 loader: InputLoader | None = None) -> Program | None:
+    """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints)."""
+    if path.suffix != ".ir":
+        return front_end(path, sink, options, later, loader)
+    from mpc.ir.text import parse
+
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as e:
+        sink.error(Span.of_file(str(path)), "E0601", f"cannot read '{path}': {e.strerror}")
+        return None
+    program = parse(text, str(path), sink)                              # parse the IR
+    if program is None:
+        return None
+    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
 
 def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
     """The names of another definition's output, found without building it."""
-    loader = InputLoader(sink, options, stack)
+    loader = InputLoader(sink, options, stack, symbolic=True)
     program = front_end(path, sink, options, Severity.WARNING, loader)
-    return symbolic(program, PassContext(sink, loader.names)) if program else None
+    return symbolic(program, PassContext(sink, loader.names, Severity.WARNING)) if program else None
 
 
 def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
     """Read the inputs and run the ops; the robot or None."""
-    for op in program.ops:
-        if not type(op).SUPPORTED:
-            sink.error(op.span, "E0202", f"{op.kind.replace('_', ' ')} is not supported yet")
-    if sink.has_errors():
-        return None
     parts: dict[str, Robot] = {}
     originals: dict[str, Robot] = {}
     for op in program.ops:
@@ -109,6 +129,9 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
     A model definition goes through the front end with names checked; a pipeline file
     is validated and each of its model definitions checked.
     """
+    if path.suffix == ".ir":
+        load_program(path, sink, options, Severity.WARNING)
+        return
     doc = source.load(path, sink)
     if doc is None:
         return
@@ -123,7 +146,7 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
                 else:
                     front_end(model, sink, options, Severity.WARNING)
         return
-    front_end(path, sink, options, Severity.WARNING)
+    front_end(path, sink, options, Severity.WARNING, doc=doc)
 
 
 def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
@@ -163,7 +186,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     result = Result()
     loader = InputLoader(sink, options, (path.resolve(),))
-    result.program = front_end(path, sink, options, Severity.ERROR, loader)  # front end
+    result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
     if result.program is None:
         return result
     result.robot = apply(result.program, sink, loader)   # read inputs, apply ops

@@ -25,11 +25,13 @@ class InputLoader:
     """Loads input models for one compilation (and the derived_base definitions below it).
 
     stack: the definitions being compiled, outermost first (to find cycles).
+    symbolic: find the names of derived_base inputs without building them (`mpc check`).
     """
 
     sink: Sink
     options: Options
     stack: tuple[Path, ...] = ()
+    symbolic: bool = False
     _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
     _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
 
@@ -57,15 +59,34 @@ class InputLoader:
         if inp.kind == "basefile":
             from mpc.backends import urdf
 
-            assert inp.path is not None
+            if inp.path is None:  # its package was not found; reported when lowering
+                return None
             return urdf.read(inp.path, self.sink, self.options.resolver)
         if inp.kind == "derived_base":
             assert inp.path is not None
             if self._cycle(inp):
                 return None
             return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
-        self.sink.error(inp.span, "E0202", "repo inputs are not supported yet")
-        return None
+        path = self._repo_file(inp, fetch=True)
+        if path is None:
+            return None
+        from mpc.backends import urdf
+
+        return urdf.read(path, self.sink, self.options.resolver)
+
+    def _repo_file(self, inp: Input, fetch: bool) -> Path | None:
+        from mpc.compiler.repos import checkout
+
+        assert inp.repo is not None
+        tree = checkout(inp.repo, self.sink, inp.span, fetch=fetch)
+        if tree is None:
+            return None
+        path = tree / inp.repo.model_in_repo
+        if not path.is_file():
+            self.sink.error(inp.span, "E0601", f"'{inp.repo.model_in_repo}' is not in repository "
+                            f"'{inp.repo.git}' at '{inp.repo.commit or inp.repo.branch or 'HEAD'}'")
+            return None
+        return path
 
     def names(self, inp: Input) -> Names | None:
         """The input's names, without applying any op that changes geometry."""
@@ -77,12 +98,12 @@ class InputLoader:
     def _load_names(self, inp: Input) -> Names | None:
         from mpc.compiler import driver
 
-        if inp.kind == "derived_base":
+        if inp.kind == "derived_base" and self.symbolic:
             assert inp.path is not None
             if self._cycle(inp):
                 return None
             return driver.names_of(inp.path, self.sink, self.options, (*self.stack, inp.path))
-        if inp.kind == "repo":
-            return None  # not cloned by `mpc check`; names are checked when compiling
+        if inp.kind == "repo" and self._repo_file(inp, fetch=False) is None:
+            return None  # `mpc check` does not clone; names are checked once it is cached
         robot = self.robot(inp)
         return Names.of(robot) if robot is not None else None

@@ -81,9 +81,16 @@ class _Lowering:
         out = {}
         for name, entry in self.model.input_models.items():
             if entry.basefile is not None:
+                path: Path | None = resolve_file(entry.basefile, self.base_dir, self.resolver)
+                source = self.resolver.resolve(entry.basefile, self.base_dir)
+                if entry.basefile.startswith("package://") and source.path is None:
+                    self.sink.error(entry.value_span("basefile"), "E0601",
+                                    f"basefile '{entry.basefile}' of input model '{name}' cannot be "
+                                    f"found: {source.unresolved}",
+                                    hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH")
+                    path = None
                 out[name] = Input(name=name, kind="basefile", span=entry.value_span("basefile"),
-                                  path=resolve_file(entry.basefile, self.base_dir, self.resolver),
-                                  is_human=entry.is_human)
+                                  path=path, is_human=entry.is_human)
             elif entry.derived_base is not None:
                 out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
                                   path=(self.base_dir / entry.derived_base).resolve(),
@@ -112,6 +119,7 @@ class _Lowering:
                     if problem:
                         self.sink.error(_item_span(editing, f"{key}replacements", i), "E0305",
                                         f"'{pattern}' is not a regular expression: {problem}")
+                        continue
                     pairs.append((pattern, str(replacement)))
             if prefix or suffix or pairs:
                 rules.append(NameRule(scope=scope, prefix=prefix or "", suffix=suffix or "",
@@ -135,17 +143,28 @@ class _Lowering:
                 self.ops.append(EditNames(span=node.name_editing.span, part=part, rules=rules))
         self.rules[part] = rules
         if node.remove_beyond is not None:
-            self.ops.append(RemoveBeyond(span=node.value_span("remove_beyond"), part=part,
+            written_as_list = isinstance(node._doc.data_at((*node._path, "remove_beyond")), list)  # type: ignore[union-attr]
+            spans = {f"links/{i}": _item_span(node, "remove_beyond", i) if written_as_list
+                     else node.value_span("remove_beyond") for i in range(len(node.remove_beyond))}
+            self.ops.append(RemoveBeyond(span=node.value_span("remove_beyond"), part=part, spans=spans,
                                          links=tuple(node.remove_beyond)))
         if node.take_leaf is not None:
             self.ops.append(TakeLeaf(span=node.value_span("take_leaf"), part=part, link=node.take_leaf))
         if node.mirror is not None:
             m = node.mirror
             plane = self.vec(m, "plane", "mirror plane")
-            pairs = tuple((p, str(r)) for item in (m.name_replacements or []) for p, r in item.items())
+            pairs = []
+            for i, item in enumerate(m.name_replacements or []):
+                for pattern, replacement in item.items():
+                    problem = bad_pattern(pattern)
+                    if problem:
+                        self.sink.error(_item_span(m, "name_replacements", i), "E0305",
+                                        f"'{pattern}' is not a regular expression: {problem}")
+                    else:
+                        pairs.append((pattern, str(replacement)))
             self.ops.append(Mirror(span=m.span, part=part, plane=plane or (0.0, 1.0, 0.0),
                                    flip_axis=m.flip_axis, exclude_meshes=tuple(m.exclude_meshes),
-                                   name_replacements=pairs))
+                                   name_replacements=tuple(pairs)))
         for i, child in enumerate(node.children):
             child_part = f"{part}/{i}"
             self.part(child, child_part, inputs)
@@ -185,6 +204,8 @@ class _Lowering:
         self.ops.append(Attach(
             span=j.span, part=part, spans=spans, child=child_part, parent=parent,
             child_link=child_link, name=j.name, type=j.type,
+            parent_written=j.parent if parent != j.parent else "",
+            child_written=j.child if j.child and child_link != j.child else "",
             origin=Pose(xyz, rpy), r2r=r2r,  # type: ignore[arg-type]
             axis=self.vec(j, "axis", f"{what} axis"), limit=limit,  # type: ignore[arg-type]
         ))

@@ -71,6 +71,16 @@ class Document:
                 return self.values[p]
         return Span.of_file(self.file)
 
+    def data_at(self, path: Path_) -> Any:
+        """The data at `path`, or None."""
+        node = self.data
+        for key in path:
+            try:
+                node = node[key]
+            except (KeyError, IndexError, TypeError):
+                return None
+        return node
+
     def value_span(self, path: Path_) -> Span:
         """The value at `path`, else the nearest enclosing part."""
         return self.values.get(tuple(path)) or self.span(path)

@@ -61,6 +61,20 @@ class MeshSource:
         return name.rsplit(".", 1)[-1].lower() if "." in name else ""
 
 
+@dataclass(frozen=True, slots=True)
+class ReflectMesh:
+    """Mesh op: reflect the mesh's vertices along one of its axes (0 x, 1 y, 2 z).
+
+    Materialised with the triangle winding reversed, so normals point outwards and the
+    volume stays positive.
+    """
+
+    axis: int
+
+
+MeshOp = ReflectMesh
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Mesh:
     """A triangle mesh.
@@ -73,7 +87,7 @@ class Mesh:
 
     source: MeshSource
     scale: Vec3 | None = None
-    ops: tuple[object, ...] = ()
+    ops: tuple[MeshOp, ...] = ()
     span: Span | None = None
     extra_attrs: Attrs = ()
 

@@ -32,6 +32,7 @@ class Names:
     visuals: Mapping[str, frozenset[str]] = field(default_factory=dict)
     materials: frozenset[str] = frozenset()
     others: Mapping[str, frozenset[str]] = field(default_factory=dict)
+    gone: Mapping[str, str] = field(default_factory=dict)  # removed name → what removed it
 
     @classmethod
     def of(cls, robot: Robot) -> Names:
@@ -77,11 +78,14 @@ class Names:
                     stack.append(c)
         return seen
 
-    def keep(self, links: Iterable[str], root: str | None = None) -> Names:
-        """Only `links` and the joints between them (a cut of the tree)."""
+    def keep(self, links: Iterable[str], root: str | None = None, why: str = "") -> Names:
+        """Only `links` and the joints between them (a cut of the tree); `why` says what cut."""
         kept = frozenset(links)
+        joints = {j for j, (p, c) in self.joints.items() if p in kept and c in kept}
+        gone = dict(self.gone)
+        gone.update((n, why) for n in (self.links - kept) | (set(self.joints) - joints))
         return replace(
-            self, links=kept, root=root or self.root,
+            self, links=kept, root=root or self.root, gone=gone,
             joints={j: pc for j, pc in self.joints.items() if pc[0] in kept and pc[1] in kept},
             collisions={k: v for k, v in self.collisions.items() if k in kept},
             visuals={k: v for k, v in self.visuals.items() if k in kept},

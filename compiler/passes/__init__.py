@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from mpc.compiler.diagnostics import Sink
+from mpc.compiler.diagnostics import Severity, Sink
 from mpc.ir.names import Names
 from mpc.ir.program import Input, Program
 
@@ -21,10 +21,12 @@ def _unknown(_: Input) -> Names | None:
 
 @dataclass
 class PassContext:
-    """What every pass may use: the diagnostics sink and the input models' names."""
+    """What every pass may use: the diagnostics sink, the input models' names, and whether
+    what compiling does not support yet is an error (compile) or a warning (check)."""
 
     sink: Sink
     input_names: Callable[[Input], Names | None] = field(default=_unknown)
+    later: Severity = Severity.ERROR
 
 
 Pass = Callable[[Program, PassContext], Program]

@@ -11,7 +11,7 @@ up and its `effect` gives the names after it, attaches merge parts.
 
 from __future__ import annotations
 
-from mpc.compiler.diagnostics import did_you_mean
+from mpc.compiler.diagnostics import Severity, did_you_mean
 from mpc.compiler.passes import PassContext
 from mpc.ir.names import Names
 from mpc.ir.ops import Attach, Effects, LoadModel, Op
@@ -22,13 +22,16 @@ def symbolic(program: Program, ctx: PassContext) -> Names | None:
     """The names of the finished robot (None when an input's names are unknown)."""
     parts: dict[str, Names | None] = {}
     origins: dict[str, str] = {}
+    unsupported: dict[str, list[Op]] = {}
     for op in program.ops:
         if isinstance(op, LoadModel):
             parts[op.part] = ctx.input_names(program.inputs[op.input])
             origins[op.part] = f"'{op.input}'"
             continue
         names = parts.get(op.part)
-        effects = Effects(ctx.sink.error, op)
+        effects = Effects(ctx.sink, op, ctx.later is Severity.ERROR)
+        if not type(op).SUPPORTED:
+            unsupported.setdefault(op.kind, []).append(op)
         if isinstance(op, Attach):
             child = parts.pop(op.child, None)
             if names is not None and child is not None and _reads_ok(op, names, ctx):
@@ -39,6 +42,9 @@ def symbolic(program: Program, ctx: PassContext) -> Names | None:
             continue
         if names is not None and (_reads_ok(op, names, ctx) or not type(op).EFFECT_NEEDS_READS):
             parts[op.part] = op.effect(names, effects)
+    for kind, ops in unsupported.items():  # once per kind, where it is first used
+        uses = f" ({len(ops)} uses)" if len(ops) > 1 else ""
+        Effects(ctx.sink, ops[0], ctx.later is Severity.ERROR).unsupported(f"the {kind} operation{uses}")
     return parts.get("root")
 
 
@@ -46,10 +52,17 @@ def _reads_ok(op: Op, names: Names, ctx: PassContext) -> bool:
     ok = True
     for ref in op.reads():
         pool = names.all(ref.kind)
-        if ref.name not in pool:
-            what = op.what()
+        if ref.name not in pool and ref.name in names.gone:
             ctx.sink.error(op.span_of(ref.field), "E0310",
-                           f"{what} refers to unknown {ref.kind} '{ref.name}'"
+                           f"{op.what()} refers to {ref.kind} '{ref.name}', which "
+                           f"{names.gone[ref.name]} removed")
+            ok = False
+        elif ref.name not in pool:
+            what = op.what()
+            shown = (f"'{ref.written}' ('{ref.name}' after name editing)" if ref.written
+                     else f"'{ref.name}'")
+            ctx.sink.error(op.span_of(ref.field), "E0310",
+                           f"{what} refers to unknown {ref.kind} {shown}"
                            f"{did_you_mean(ref.name, pool)}",
                            hint=_nearest_first(ref.name, pool))
             ok = False

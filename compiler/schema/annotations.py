@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import Field
+from pydantic import Discriminator, Field, Tag
 
 from mpc.compiler.schema.base import Expr, Node, OneOrMore, OpenNode, Vec3
 from mpc.compiler.schema.editing import ConstraintAxis
@@ -36,7 +36,16 @@ class SensorDef(OpenNode):
     orientation_offset: Annotated[list[Expr], Field(min_length=3, max_length=4)] | None = None
 
 
-SensorsSection = list[SensorDef] | dict[SensorType, SensorDef | list[SensorDef]]
+def _shape(value: Any) -> str:
+    return "list" if isinstance(value, list) else "other"
+
+
+# The section is a list of sensors or a mapping type → sensor(s); validated as the form it has.
+SensorsSection = Annotated[
+    Annotated[list[SensorDef], Tag("list")]
+    | Annotated[dict[SensorType, SensorDef | list[SensorDef]], Tag("other")],
+    Discriminator(_shape),
+]
 
 
 def sensor_entries(section: SensorsSection) -> list[tuple[str | None, SensorDef]]:
@@ -108,7 +117,8 @@ class PostProcessing(Node):
     """A command run after export: an argument list, or a string run by a shell when `shell`."""
 
     SECTION: ClassVar[str] = "a post_processing command"
-    cmd: str | Annotated[list[str], Field(min_length=1)]
+    cmd: Annotated[Annotated[str, Tag("other")] | Annotated[list[str], Field(min_length=1), Tag("list")],
+                   Discriminator(_shape)]
     cwd: str | None = None
     shell: bool = False
     executable: str | None = None

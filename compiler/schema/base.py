@@ -301,7 +301,7 @@ def _message(err: dict[str, Any], loc: tuple, sections: str) -> str:
         return f"'{key}' must be one of {expected}, got '{value}'" + did_you_mean(str(value), options)
     if kind in _WANTED:
         return f"'{key}' must be {_WANTED[kind]}, got {describe(value)}"
-    if kind in ("too_short", "string_too_short") and isinstance(value, list | str) and not value:
+    if kind in ("too_short", "string_too_short") and isinstance(value, list | str | dict) and not value:
         return f"'{key}' must not be empty"
     if kind in ("too_short", "too_long") and isinstance(value, list):
         want = err["msg"].split("have ", 1)[-1].split(" after")[0]

@@ -20,25 +20,30 @@ DYNAMICS_CHECKS = frozenset({
 })
 
 
-def _test_items(items: list[Any], names: frozenset[str] = TESTS) -> list[Any]:
-    for item in items:
-        if isinstance(item, dict) and len(item) != 1:
-            raise ValueError("a test with an argument is a mapping with one key, e.g. "
-                             "`- total_mass: 12.5`")
-        name = item if isinstance(item, str) else next(iter(item)) if isinstance(item, dict) else None
-        if not isinstance(name, str):
-            raise ValueError(f"a test is a name or a mapping with one key, got {item!r}")
-        if name not in names:
-            raise ValueError(f"unknown test '{name}'{did_you_mean(name, names)}")
-        if name == "hyrodynChecks":
-            value = item["hyrodynChecks"] if isinstance(item, dict) else None
-            if not isinstance(value, list):
-                raise ValueError("hyrodynChecks takes a list of dynamics checks")
-            _test_items(value, DYNAMICS_CHECKS)
-    return items
+def _check_item(item: Any, names: frozenset[str], what: str) -> None:
+    if isinstance(item, dict) and len(item) != 1:
+        raise ValueError(f"a {what} with an argument is a mapping with one key, e.g. `- total_mass: 12.5`")
+    name = item if isinstance(item, str) else next(iter(item)) if isinstance(item, dict) else None
+    if not isinstance(name, str):
+        raise ValueError(f"a {what} is a name or a mapping with one key, got {item!r}")
+    if name not in names:
+        raise ValueError(f"unknown {what} '{name}'{did_you_mean(name, names)}")
 
 
-TestList = Annotated[list[str | dict[str, Any]], AfterValidator(_test_items)]
+def _test_item(item: Any) -> Any:
+    _check_item(item, TESTS, "test")
+    if isinstance(item, dict) and "hyrodynChecks" in item:
+        checks = item["hyrodynChecks"]
+        if not isinstance(checks, list):
+            raise ValueError("hyrodynChecks takes a list of dynamics checks")
+        for check in checks:
+            _check_item(check, DYNAMICS_CHECKS, "dynamics check")
+    elif item == "hyrodynChecks":
+        raise ValueError("hyrodynChecks takes a list of dynamics checks")
+    return item
+
+
+TestList = list[Annotated[str | dict[str, Any], AfterValidator(_test_item)]]
 
 
 class Tolerances(Node):

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
+from mpc.compiler.diagnostics import Sink
 from mpc.ir.names import Kind, Names
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
@@ -30,16 +31,28 @@ class Ref:
     kind: Kind
     name: str
     field: str = ""
+    written: str = ""  # the name as the user wrote it, when an edit changed it
 
 
 class Effects:
-    """What an op's `effect` may report: errors at the op's span (or one of its fields)."""
+    """What an op's `effect` may report, at the op's span or one of its fields.
 
-    def __init__(self, report: object, op: Op) -> None:
-        self._report, self.op = report, op
+    later_is_error: whether a part of the language that `apply` does not support yet is
+    an error (compiling) or a warning (`mpc check`).
+    """
+
+    def __init__(self, sink: Sink, op: Op, later_is_error: bool = True) -> None:
+        self.sink, self.op, self.later_is_error = sink, op, later_is_error
 
     def error(self, code: str, message: str, field: str = "") -> None:
-        self._report(self.op.span_of(field), code, message)  # type: ignore[operator]
+        self.sink.error(self.op.span_of(field), code, message)
+
+    def unsupported(self, what: str, field: str = "") -> None:
+        if self.later_is_error:
+            self.sink.error(self.op.span_of(field), "E0202", f"{what} is not supported yet")
+        else:
+            self.sink.warning(self.op.span_of(field), "W0202",
+                              f"{what} is not supported by `mpc compile` yet")
 
 
 # Ops are not slotted: `slots=True` makes the dataclass decorator build a second class,

@@ -84,7 +84,7 @@ class RemoveBeyond(Op):
     links: tuple[str, ...]
 
     def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "links") for n in self.links)
+        return tuple(Ref("link", n, f"links/{i}") for i, n in enumerate(self.links))
 
     def _kept(self, names: Names) -> set[str]:
         below: set[str] = set()
@@ -93,7 +93,7 @@ class RemoveBeyond(Op):
         return set(names.links) - below
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        return names.keep(self._kept(names))
+        return names.keep(self._kept(names), why=f"remove_beyond (line {self.span.line})")
 
     def apply(self, robot: Robot) -> Robot:
         return keep_links(robot, self._kept(Names.of(robot)), robot.root)
@@ -111,10 +111,15 @@ class TakeLeaf(Op):
         return (Ref("link", self.link, "link"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        return names.keep(names.subtree(self.link), root=self.link)
+        return names.keep(names.subtree(self.link), root=self.link,
+                          why=f"take_leaf (line {self.span.line})")
 
     def apply(self, robot: Robot) -> Robot:
         return keep_links(robot, Names.of(robot).subtree(self.link), self.link)
+
+
+def _as_written(name: str, written: str) -> str:
+    return f"'{written}' ('{name}' after name editing)" if written and written != name else f"'{name}'"
 
 
 def keep_links(robot: Robot, kept: set[str], root: str) -> Robot:
@@ -140,7 +145,6 @@ class Mirror(Op):
     name_replacements: (pattern, replacement) pairs applied to every name.
     """
 
-    SUPPORTED = False
     plane: Vec3 = (0.0, 1.0, 0.0)
     flip_axis: Literal[0, 1, 2] = 1
     exclude_meshes: tuple[str, ...] = ()
@@ -152,6 +156,15 @@ class Mirror(Op):
         rule = (NameRule(replacements=self.name_replacements),)
         return EditNames(span=self.span, part=self.part, rules=rule).effect(names, effects)
 
+    def apply(self, robot: Robot) -> Robot:
+        from mpc.ir.mirror import mirror_robot  # numpy: not on the path of `mpc check`
+
+        mirrored = mirror_robot(robot, self.plane, self.flip_axis, self.exclude_meshes)
+        if not self.name_replacements:
+            return mirrored
+        rule = (NameRule(replacements=self.name_replacements),)
+        return EditNames(span=self.span, part=self.part, rules=rule).apply(mirrored)
+
 
 @dataclass(frozen=True, kw_only=True)
 class Attach(Op):
@@ -162,6 +175,7 @@ class Attach(Op):
     origin: X_PJ, the joint frame in the parent link; None with `r2r` given.
     r2r: X_RpRc, the child model's root in the parent model's root (a 4×4 row list),
         computed from the input models as they were read (before any editing).
+    parent_written, child_written: the link names as written, when name editing changed them.
     """
 
     WHAT = "the attaching joint's parent"
@@ -169,6 +183,8 @@ class Attach(Op):
     child: str
     parent: str
     child_link: str | None = None
+    parent_written: str = ""
+    child_written: str = ""
     name: str | None = None
     type: str = "fixed"
     origin: Pose = IDENTITY
@@ -177,7 +193,7 @@ class Attach(Op):
     limit: Limit | None = None
 
     def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.parent, "parent"),)
+        return (Ref("link", self.parent, "parent", self.parent_written),)
 
     def joint_name(self, child_root: str) -> str:
         return self.name or f"{self.parent}2{self.child_link or child_root}"
@@ -186,11 +202,12 @@ class Attach(Op):
         """The names after attaching; a name in both parts is an error naming both."""
         child_link = self.child_link or child.root
         if child_link not in child.links:
-            effects.error("E0303", f"attach: the child model has no link '{child_link}'"
+            shown = _as_written(child_link, self.child_written)
+            effects.error("E0303", f"attach: the child model has no link {shown}"
                           f"{did_you_mean(child_link, child.links)}", "child_link")
         elif child_link != child.root:
-            effects.error("E0202", f"attaching at '{child_link}', which is not the child model's "
-                          f"root '{child.root}', is not supported yet", "child_link")
+            effects.unsupported(f"attaching at '{child_link}', which is not the child model's root "
+                                f"'{child.root}',", "child_link")
         joint = self.joint_name(child.root)
         for kind, a, b in (("link", parent.links, child.links),
                            ("joint", frozenset(parent.joints), frozenset(child.joints))):

@@ -132,8 +132,10 @@ class RemoveJoint(Op):
             child, frozenset())
         visuals = {k: v for k, v in names.visuals.items() if k != child}
         visuals[parent] = names.visuals.get(parent, frozenset()) | names.visuals.get(child, frozenset())
+        gone = {**names.gone, child: f"the removal of joint '{self.joint}' (line {self.span.line})",
+                self.joint: f"its removal (line {self.span.line})"}
         return replace(names, links=names.links - {child}, joints=joints, collisions=collisions,
-                       visuals=visuals)
+                       visuals=visuals, gone=gone)
 
 
 @dataclass(frozen=True, kw_only=True)

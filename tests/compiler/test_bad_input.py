@@ -71,8 +71,8 @@ def test_key_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
     _compile(tmp_path, diags, definition("arm.urdf") + "  frames: {upper: {make_root: true}}\n"
              "  poses: {up: {shoulder: 1}}\n")
     frames, poses = diags.take_error("E0202"), diags.take_error("E0202")
-    assert (frames.message, poses.message) == ("make root is not supported yet",
-                                               "add pose is not supported yet")
+    assert (frames.message, poses.message) == ("the make_root operation is not supported yet",
+                                               "the add_pose operation is not supported yet")
     assert (_where(frames), _where(poses)) == ((12, 20), (13, 11))
 
 
