@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import Mesh, MeshOp, ReflectMesh
+from mpc.ir.geometry import ConvexHull, Mesh, MeshOp, ReflectMesh
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
@@ -102,7 +102,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
 
 
 def _suffix(ops: tuple[MeshOp, ...]) -> str:
-    return "".join("_mirrored" for op in ops if isinstance(op, ReflectMesh))
+    return "".join("_mirrored" if isinstance(op, ReflectMesh) else "_hull" for op in ops)
 
 
 def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
@@ -162,6 +162,8 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
             T = np.eye(4)
             T[op.axis, op.axis] = -1.0
             mesh.apply_transform(T)  # trimesh reverses the winding for a reflection
+        elif isinstance(op, ConvexHull):
+            mesh = mesh.convex_hull
     data = mesh.export(file_type=dest.suffix[1:])
     dest.write_bytes(data if isinstance(data, bytes) else data.encode())
     return None

@@ -20,8 +20,45 @@ from mpc.ir.robot import Robot
 __all__ = ["emit", "read", "to_string"]
 
 
+def left_out(robot: Robot) -> list[str]:
+    """What the robot holds that URDF cannot: motors, sensors, annotations, …"""
+    counts = {
+        "motor": len(robot.motors), "sensor": len(robot.sensors), "pose": len(robot.poses),
+        "loop-closure joint": len(robot.cut_joints), "submechanism": len(robot.submechanisms),
+        "annotation category": len(robot.annotations),
+        "annotated link": sum(bool(lk.annotations) for lk in robot.links.values()),
+        "annotated joint": sum(bool(j.annotations) for j in robot.joints.values()),
+        "collision with bitmask or annotations": sum(
+            bool(c.annotations) or c.bitmask is not None
+            for lk in robot.links.values() for c in lk.collisions),
+    }
+    out = [f"{n} {what}{'s' * (n != 1)}" for what, n in counts.items() if n]
+    if robot.submechanisms_file:
+        out.append("the submechanisms file")
+    return out
+
+
+def check(robot: Robot, export: UrdfExport, sink: Sink) -> bool:
+    """Whether `robot` can be written as valid URDF (urdfdom's rules)."""
+    ok = True
+    for joint in robot.joints.values():
+        if joint.type in ("revolute", "prismatic") and (
+                joint.limit is None or joint.limit.effort is None or joint.limit.velocity is None):
+            sink.error(joint.span or export.span, "E0502", f"joint '{joint.name}' is {joint.type} but "
+                       "has no limit with effort and velocity, which URDF requires",
+                       hint=f"set them under `joints: {joint.name}: {{eff: …, vel: …}}`")
+            ok = False
+    return ok
+
+
 def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
+    if not check(robot, export, sink):
+        return
+    missing = left_out(robot)
+    if missing:
+        sink.warning(export.span, "W0500", "the URDF leaves out what URDF cannot hold: "
+                     + ", ".join(missing) + "; no export that holds them (SMURF) is implemented yet")
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span):
         return

@@ -22,7 +22,7 @@ from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
 from mpc.ir.names import Names
-from mpc.ir.ops import ROOT, Attach, LoadModel
+from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
 from mpc.ir.program import Program
 from mpc.ir.robot import Robot
@@ -112,8 +112,8 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
                 op = replace(op, origin=r2r_origin(op, originals[op.part], originals[op.child]))
             parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))
         else:
-            parts[op.part] = op.apply(parts[op.part])
-    return parts[ROOT]
+            parts[op.part] = op.apply(parts[op.part], Effects(sink, op))
+    return None if sink.has_errors() else parts[ROOT]
 
 
 def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:

@@ -269,7 +269,7 @@ class EditLowering:
             remove = d.remove if isinstance(d.remove, bool) else tuple(d.remove)
             self.add(EditCollisions(
                 span=d.span, target=target, exclude=tuple(section.exclude) if not target else (),
-                remove=remove, shape=d.shape, oriented=d.oriented,
+                remove=remove, shape=d.shape, oriented=d.oriented, replace=section.apply_primitives,
                 scale=self.lw.num(d, "scale", f"collision '{target}' scale") or 1.0, join=d.join,
                 bitmask=d.bitmask, annotations=d.entries,
                 spans={"target": d.span, "exclude": section.value_span("$exclude")}))

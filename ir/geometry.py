@@ -72,7 +72,12 @@ class ReflectMesh:
     axis: int
 
 
-MeshOp = ReflectMesh
+@dataclass(frozen=True, slots=True)
+class ConvexHull:
+    """Mesh op: replace the mesh by its convex hull."""
+
+
+MeshOp = ReflectMesh | ConvexHull
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

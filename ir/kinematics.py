@@ -27,3 +27,12 @@ def link_in_root(robot: Robot, link: str) -> np.ndarray:
 def matrix_pose(X: np.ndarray) -> Pose:
     xyz, rpy = tf.matrix_to_pose(X)
     return Pose(xyz, rpy)
+
+
+def compose_poses(*poses: Pose | None) -> Pose:
+    """X_AC from X_AB, X_BC, … (None is the identity)."""
+    return matrix_pose(tf.compose(*(pose_matrix(p) for p in poses)))
+
+
+def inverse_pose(pose: Pose | None) -> Pose:
+    return matrix_pose(tf.inverse(pose_matrix(pose)))

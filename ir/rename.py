@@ -22,7 +22,8 @@ def _same(name: str) -> str:
     return name
 
 
-def _xmlns(robot: Robot) -> str:
+def xmlns_of(robot: Robot) -> str:
+    """The namespace declarations of `<robot>`, which fragments may use."""
     return "".join(f' {k}="{v}"' for k, v in robot.extra_attrs if k.startswith("xmlns"))
 
 
@@ -55,7 +56,7 @@ def rename_fragment(frag: Fragment, link: Rename, joint: Rename, xmlns: str = ""
 def rename_robot(robot: Robot, link: Rename = _same, joint: Rename = _same,
                  collision: Rename = _same, visual: Rename = _same) -> Robot:
     """`robot` with names mapped; the caller guarantees the maps create no duplicates."""
-    xmlns = _xmlns(robot)
+    xmlns = xmlns_of(robot)
 
     def frags(items: tuple[Fragment, ...]) -> tuple[Fragment, ...]:
         return tuple(rename_fragment(f, link, joint, xmlns) for f in items)

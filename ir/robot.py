@@ -10,13 +10,14 @@ Fields common to several elements:
 - inner_comments: XML comments inside the element (written back at its top).
 - extra_attrs: attributes URDF does not define, kept as (name, value) pairs.
 - extras: child elements URDF does not define, kept as opaque fragments.
+- annotations: free data from the definition (for SMURF), never written to URDF.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Geometry, Vec3
@@ -75,6 +76,13 @@ class Material:
     name: str
     rgba: tuple[float, float, float, float] | None = None
     texture: str | None = None
+    ambient: tuple[float, ...] | None = None
+    specular: tuple[float, ...] | None = None
+    emissive: tuple[float, ...] | None = None
+    shininess: float | None = None
+    transparency: float | None = None
+    normal_texture: str | None = None
+    annotations: Mapping[str, object] = field(default_factory=dict)
     comments: tuple[str, ...] = ()
     span: Span | None = None
 
@@ -95,6 +103,7 @@ class Visual:
     geometry_attrs: Attrs = ()
     extra_attrs: Attrs = ()
     extras: tuple[Fragment, ...] = ()
+    annotations: Mapping[str, object] = field(default_factory=dict)
     span: Span | None = None
 
 
@@ -108,6 +117,8 @@ class Collision:
     geometry_attrs: Attrs = ()
     extra_attrs: Attrs = ()
     extras: tuple[Fragment, ...] = ()
+    bitmask: int | None = None
+    annotations: Mapping[str, object] = field(default_factory=dict)
     span: Span | None = None
 
 
@@ -121,6 +132,7 @@ class Link:
     collisions: tuple[Collision, ...] = ()
     extra_attrs: Attrs = ()
     extras: tuple[Fragment, ...] = ()
+    annotations: Mapping[str, object] = field(default_factory=dict)
     comments: tuple[str, ...] = ()
     inner_comments: tuple[str, ...] = ()
     span: Span | None = None
@@ -194,6 +206,7 @@ class Joint:
     safety_controller: SafetyController | None = None
     extra_attrs: Attrs = ()
     extras: tuple[Fragment, ...] = ()
+    annotations: Mapping[str, object] = field(default_factory=dict)
     comments: tuple[str, ...] = ()
     inner_comments: tuple[str, ...] = ()
     span: Span | None = None
@@ -207,6 +220,9 @@ class Robot:
     root: the root link's name.
     links, joints, materials: elements keyed by name (mappings are never mutated).
     fragments: top-level elements mpc does not model, in source order.
+    motors, sensors, cut_joints: by name (ir/extras.py). poses: named joint configurations.
+    submechanisms: in definition order; submechanisms_file: used as it is, when given.
+    annotations: named annotation categories.
     extra_attrs: attributes of `<robot>` other than name (namespaces, version).
     header_comments: comments before `<robot>`; trailing_comments: at its end.
     """
@@ -220,4 +236,11 @@ class Robot:
     extra_attrs: Attrs = ()
     header_comments: tuple[str, ...] = ()
     trailing_comments: tuple[str, ...] = ()
+    motors: Mapping[str, Any] = field(default_factory=dict)
+    sensors: Mapping[str, Any] = field(default_factory=dict)
+    cut_joints: Mapping[str, Any] = field(default_factory=dict)
+    poses: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    submechanisms: tuple[Any, ...] = ()
+    submechanisms_file: str | None = None
+    annotations: Mapping[str, Mapping[str, object]] = field(default_factory=dict)
     span: Span | None = None

@@ -89,7 +89,8 @@ class Op:
         """The names after the op, computed from the names before it."""
         return names
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """The robot after the op; problems only the values reveal go to `effects`."""
         raise NotImplementedError
 
 

@@ -1,18 +1,34 @@
 """Ops on collisions, visuals, materials, sensors, poses, submechanisms and annotations.
 
-Their `apply` is written by the model-editing work; until then `SUPPORTED` is False
-and compiling a definition that uses them is a "not supported yet" error, while
-`mpc check` already checks every name they use.
+An op whose `SUPPORTED` is False is checked by `mpc check` but cannot be compiled yet.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from mpc.compiler.diagnostics import did_you_mean
+from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.robot import Collision, Material, Pose, Robot
+
+
+def _matches(name: str | None, remove: bool | tuple[str, ...]) -> bool:
+    """Whether a visual or collision named `name` is removed: all, or by name or pattern."""
+    if remove is True:
+        return True
+    if not remove or name is None:
+        return False
+    return any(name == p or re.fullmatch(p, name) for p in remove)
+
+
+def _rgba(colour: tuple[float, ...] | None) -> tuple[float, float, float, float] | None:
+    if colour is None:
+        return None
+    return (*colour[:3], colour[3] if len(colour) > 3 else 1.0)  # type: ignore[return-value]
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
@@ -32,7 +48,6 @@ class EditMaterial(Op):
     WHAT = "material"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     name: str
     diffuse: tuple[float, ...] | None = None
     ambient: tuple[float, ...] | None = None
@@ -45,29 +60,39 @@ class EditMaterial(Op):
     annotations: Annotations = field(default_factory=dict)
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        from dataclasses import replace
-
         return replace(names, materials=names.materials | {self.name})
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        old = robot.materials.get(self.name) or Material(name=self.name, span=self.span)
+        changes = {k: v for k, v in (
+            ("rgba", _rgba(self.diffuse)), ("ambient", self.ambient), ("specular", self.specular),
+            ("emissive", self.emissive), ("texture", self.texture), ("normal_texture", self.normal_texture),
+            ("shininess", self.shininess), ("transparency", self.transparency)) if v is not None}
+        material = replace(old, **changes, annotations={**old.annotations, **self.annotations})
+        return replace(robot, materials={**robot.materials, self.name: material})
 
 
 @dataclass(frozen=True, kw_only=True)
 class EditCollisions(Op):
     """Edit the collisions of link `target` (or the one collision named `target`).
 
-    targets: several links (`$default`: all links but `exclude`) instead of one.
+    target: empty for every link but `exclude` (`$default`).
     remove: True removes them all; names or regular expressions remove those matching.
-    shape: replace meshes by their bounding box, cylinder or sphere (oriented or not, scaled),
-        their convex hull, or a convex decomposition.
-    join: merge the link's collisions into one convex hull.
+    shape: box, cylinder or sphere: the bounding primitive of each shape (`oriented`: the
+        smallest in any orientation, else along the shape's axes; `scale` multiplies it);
+        with `replace` (`apply_primitives`) it replaces the shape, otherwise it is recorded
+        next to it as the `primitives` annotation (Phobos's meaning). `convex`: the mesh's
+        convex hull. `remove`: as remove: true. `mesh`: unchanged.
+    join: merge the link's collisions into one convex hull (not supported yet).
     """
 
-    SUPPORTED = False
     target: str = ""
     exclude: tuple[str, ...] = ()
     remove: bool | tuple[str, ...] = False
     shape: str | None = None
     oriented: bool = True
     scale: float = 1.0
+    replace: bool = False
     join: bool = False
     bitmask: int | None = None
     annotations: Annotations = field(default_factory=dict)
@@ -78,7 +103,72 @@ class EditCollisions(Op):
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.target:
             _link_or_collision(names, self.target, effects, "target")
+        if self.join:
+            effects.unsupported("joining collisions (join: true)", "target")
+        if self.shape == "convex_decomposition":
+            effects.unsupported("shape: convex_decomposition", "target")
         return names
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        links = dict(robot.links)
+        for name, link in robot.links.items():
+            if self.target in ("", name):
+                if not self.target and name in self.exclude:
+                    continue
+                chosen = lambda c: True  # noqa: E731
+            elif any(c.name == self.target for c in link.collisions):
+                chosen = lambda c: c.name == self.target  # noqa: E731
+            else:
+                continue
+            kept = []
+            for c in link.collisions:
+                if not chosen(c):
+                    kept.append(c)
+                elif not _matches(c.name, self.remove) and self.shape != "remove":
+                    edited = self._edit(c, name, effects)
+                    if edited is not None:
+                        kept.append(edited)
+            links[name] = replace(link, collisions=tuple(kept))
+        return replace(robot, links=links)
+
+    def _edit(self, c: Collision, link: str, effects: Effects) -> Collision | None:
+        from mpc.ir.geometry import ConvexHull, Mesh
+
+        annotations = {**c.annotations, **self.annotations}
+        c = replace(c, bitmask=self.bitmask if self.bitmask is not None else c.bitmask)
+        if self.shape in ("box", "cylinder", "sphere"):
+            primitive = self._primitive(c, link, effects)
+            if primitive is None:
+                return None
+            if self.replace:
+                return replace(primitive, annotations=annotations)
+            annotations["primitives"] = [_describe(primitive)]
+        elif self.shape == "convex" and isinstance(c.geometry, Mesh):
+            c = replace(c, geometry=replace(c.geometry, ops=(*c.geometry.ops, ConvexHull())))
+        return replace(c, annotations=annotations)
+
+    def _primitive(self, c: Collision, link: str, effects: Effects) -> Collision | None:
+        from mpc.ir.kinematics import matrix_pose, pose_matrix
+        from mpc.ir.mesh_props import MeshError, bounding, scaled
+
+        try:
+            shape, X_GB = bounding(c.geometry, self.shape or "box", self.oriented)
+        except MeshError as e:
+            effects.error("E0602", f"collision of link '{link}': {e}", "target")
+            return None
+        return replace(c, geometry=scaled(shape, self.scale),
+                       origin=matrix_pose(pose_matrix(c.origin) @ X_GB))
+
+
+def _describe(c: Collision) -> dict[str, object]:
+    g = c.geometry
+    origin = c.origin or Pose()
+    pose = {"xyz": list(origin.xyz), "rpy": list(origin.rpy)}
+    if hasattr(g, "size"):
+        return {"type": "box", "size": list(g.size), "pose": pose}
+    if hasattr(g, "length"):
+        return {"type": "cylinder", "radius": g.radius, "length": g.length, "pose": pose}
+    return {"type": "sphere", "radius": g.radius, "pose": pose}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -105,12 +195,23 @@ class EditVisuals(Op):
 
     WHAT = "visuals"
 
-    SUPPORTED = False
     targets: tuple[str, ...] = ()
     exclude: tuple[str, ...] = ()
     remove: bool | tuple[str, ...] = False
     material: str | None = None
     annotations: Annotations = field(default_factory=dict)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        links = dict(robot.links)
+        for name in self.targets or [n for n in robot.links if n not in self.exclude]:
+            link = links[name]
+            visuals = tuple(
+                replace(v, material=self.material or v.material,
+                        inline_material=None if self.material else v.inline_material,
+                        annotations={**v.annotations, **self.annotations})
+                for v in link.visuals if not _matches(v.name, self.remove))
+            links[name] = replace(link, visuals=visuals)
+        return replace(robot, links=links)
 
     def reads(self) -> tuple[Ref, ...]:
         refs = [Ref("link", n, "targets") for n in self.targets]
@@ -130,7 +231,6 @@ class AddSensor(Op):
     WHAT = "sensor"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     type: str
     name: str
     link: str | None = None
@@ -159,6 +259,15 @@ class AddSensor(Op):
             effects.error("E0311", f"sensor '{self.name}' is defined twice", "name")
         return names.with_other("sensor", [self.name])
 
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        targets = self.targets
+        if targets == ("All",):
+            targets = tuple(n for n, j in robot.joints.items() if j.type != "fixed")
+        sensor = Sensor(name=self.name, type=self.type, link=self.link, joint=self.joint, frame=self.frame,
+                        targets=targets, position_offset=self.position_offset,
+                        orientation_offset=self.orientation_offset, annotations=dict(self.annotations))
+        return replace(robot, sensors={**robot.sensors, self.name: sensor})
+
 
 @dataclass(frozen=True, kw_only=True)
 class AddPose(Op):
@@ -166,13 +275,39 @@ class AddPose(Op):
 
     WHAT = "pose"
 
-    SUPPORTED = False
     name: str
     positions: Mapping[str, float] = field(default_factory=dict)
     default: float | None = None
 
     def reads(self) -> tuple[Ref, ...]:
         return tuple(Ref("joint", j, f"positions/{j}") for j in self.positions)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """Values are clamped to the joint's limits (a warning says so); fixed joints are
+        not configurations (a warning too)."""
+        values: dict[str, float] = {}
+        if self.default is not None:
+            values = {n: self.default for n, j in robot.joints.items() if j.type != "fixed"}
+        for joint_name, value in self.positions.items():
+            joint = robot.joints[joint_name]
+            if joint.type == "fixed":
+                effects.sink.warning(self.span_of(f"positions/{joint_name}"), "W0303",
+                                     f"pose '{self.name}' sets fixed joint '{joint_name}'; ignored")
+                continue
+            values[joint_name] = value
+        for joint_name, value in list(values.items()):
+            limit = robot.joints[joint_name].limit
+            if limit is None or robot.joints[joint_name].type == "continuous":
+                continue
+            lo = limit.lower if limit.lower is not None else value
+            hi = limit.upper if limit.upper is not None else value
+            clamped = min(max(value, lo), hi)
+            if clamped != value:
+                effects.sink.warning(self.span_of(f"positions/{joint_name}"), "W0302",
+                                     f"pose '{self.name}': {joint_name} = {value:g} is outside "
+                                     f"[{lo:g}, {hi:g}] and is clamped to {clamped:g}")
+                values[joint_name] = clamped
+        return replace(robot, poses={**robot.poses, self.name: values})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -186,7 +321,6 @@ class AddSubmechanism(Op):
     WHAT = "submechanism"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     name: str
     exoskeleton: bool = False
     joints: tuple[str, ...] = ()
@@ -198,19 +332,28 @@ class AddSubmechanism(Op):
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("submechanism", [self.name])
 
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        item = Submechanism(name=self.name, exoskeleton=self.exoskeleton, definition=dict(self.definition))
+        return replace(robot, submechanisms=(*robot.submechanisms, item))
+
 
 @dataclass(frozen=True, kw_only=True)
 class SubmechanismsFile(Op):
     """Use the submechanisms file at `path` as it is."""
 
-    SUPPORTED = False
     path: str
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        return replace(robot, submechanisms_file=self.path)
 
 
 @dataclass(frozen=True, kw_only=True)
 class AddAnnotations(Op):
     """A free annotation category `category` (SMURF `<robot>_<category>.yml`)."""
 
-    SUPPORTED = False
     category: str
     content: Annotations = field(default_factory=dict)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        merged = {**robot.annotations.get(self.category, {}), **self.content}
+        return replace(robot, annotations={**robot.annotations, self.category: merged})

@@ -70,7 +70,7 @@ class EditNames(Op):
             visuals={link(k): frozenset(map(visual, v)) for k, v in names.visuals.items()},
         )
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
         return rename_robot(robot, self._edit("link"), self._edit("joint"),
                             self._edit("collision"), self._edit("visual"))
 
@@ -95,7 +95,7 @@ class RemoveBeyond(Op):
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.keep(self._kept(names), why=f"remove_beyond (line {self.span.line})")
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
         return keep_links(robot, self._kept(Names.of(robot)), robot.root)
 
 
@@ -114,7 +114,7 @@ class TakeLeaf(Op):
         return names.keep(names.subtree(self.link), root=self.link,
                           why=f"take_leaf (line {self.span.line})")
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
         return keep_links(robot, Names.of(robot).subtree(self.link), self.link)
 
 
@@ -156,14 +156,14 @@ class Mirror(Op):
         rule = (NameRule(replacements=self.name_replacements),)
         return EditNames(span=self.span, part=self.part, rules=rule).effect(names, effects)
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
         from mpc.ir.mirror import mirror_robot  # numpy: not on the path of `mpc check`
 
         mirrored = mirror_robot(robot, self.plane, self.flip_axis, self.exclude_meshes)
         if not self.name_replacements:
             return mirrored
         rule = (NameRule(replacements=self.name_replacements),)
-        return EditNames(span=self.span, part=self.part, rules=rule).apply(mirrored)
+        return EditNames(span=self.span, part=self.part, rules=rule).apply(mirrored, effects)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,8 +1,8 @@
 """Frame (link) ops: new frames, moving frames and links, re-rooting, annotations.
 
-Their `apply` is written by the model-editing work; until then `SUPPORTED` is False
-and compiling a definition that uses them is a "not supported yet" error, while
-`mpc check` already checks every name they use.
+Geometry is done at the zero configuration, with Drake's monograms: X_PL is the pose
+of link L in its parent P, T the transform the definition gives. An op whose
+`SUPPORTED` is False is checked by `mpc check` but cannot be compiled yet.
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ from dataclasses import dataclass, field, replace
 
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
+from mpc.ir.tree import parent_joint
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
@@ -27,7 +29,6 @@ class AddFrame(Op):
     WHAT = "new frame"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     link: str
     parent: str
     joint: str
@@ -52,6 +53,18 @@ class AddFrame(Op):
             return names
         return replace(names, links=names.links | {self.link},
                        joints={**names.joints, self.joint: (self.parent, self.link)})
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        inertial = None
+        if self.mass is not None:
+            small = 1e-6  # Phobos's inertia for a point mass frame
+            inertial = Inertial(mass=self.mass, origin=Pose(),
+                                inertia=Inertia(ixx=small, ixy=0.0, ixz=0.0, iyy=small, iyz=0.0, izz=small))
+        link = Link(name=self.link, inertial=inertial, annotations=dict(self.annotations), span=self.span)
+        joint = Joint(name=self.joint, type=self.type, parent=self.parent, child=self.link,  # type: ignore[arg-type]
+                      origin=Pose(self.xyz, self.rpy), axis=self.axis, span=self.span)
+        return replace(robot, links={**robot.links, self.link: link},
+                       joints={**robot.joints, self.joint: joint})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -83,7 +96,6 @@ class TransformLink(Op):
 
     WHAT = "transform"
 
-    SUPPORTED = False
     link: str
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
@@ -91,10 +103,57 @@ class TransformLink(Op):
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("link", self.link, "link"),)
 
+    def effect(self, names: Names, effects: Effects) -> Names:
+        if self.link == names.root and type(self) is TransformLink:
+            effects.error("E0318", f"cannot transform the root link '{self.link}' with its content: "
+                          "it has no parent to move it against (use transform_frame)", "link")
+        return names
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """X_PL' = X_PL · T: the link and everything below it move."""
+        from mpc.ir.kinematics import compose_poses  # numpy: not on the path of `mpc check`
+
+        joint = parent_joint(robot).get(self.link)
+        if joint is None:
+            return robot
+        origin = compose_poses(joint.origin, Pose(self.xyz, self.rpy))
+        return replace(robot, joints={**robot.joints, joint.name: replace(joint, origin=origin)})
+
 
 @dataclass(frozen=True, kw_only=True)
 class TransformFrame(TransformLink):
-    """Move only the frame of `link`: its children, visuals, collisions and inertial stay put."""
+    """Move only the frame of `link`: its children, visuals, collisions and inertial stay put.
+
+    X_PL' = X_PL · T, and everything given in L is re-expressed: X_L'V = T⁻¹ · X_LV, for
+    visuals, collisions, the inertial and child joints; the axis of L's joint turns with
+    it, so the motion — and the dynamics — are unchanged.
+    """
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        from mpc.ir.kinematics import compose_poses, inverse_pose, pose_matrix
+
+        T = Pose(self.xyz, self.rpy)
+        T_inv = inverse_pose(T)
+        R_inv = pose_matrix(T_inv)[:3, :3]
+        joints = dict(robot.joints)
+        parent = parent_joint(robot).get(self.link)
+        if parent is not None:
+            axis = parent.axis
+            if axis is not None or parent.type not in ("fixed", "floating"):
+                axis = tuple(float(x) for x in R_inv @ (axis or (1.0, 0.0, 0.0)))
+            joints[parent.name] = replace(parent, origin=compose_poses(parent.origin, T),
+                                          axis=axis)  # type: ignore[arg-type]
+        for name, j in robot.joints.items():
+            if j.parent == self.link:
+                joints[name] = replace(j, origin=compose_poses(T_inv, j.origin))
+        link = robot.links[self.link]
+        inertial = link.inertial
+        link = replace(
+            link,
+            inertial=inertial and replace(inertial, origin=compose_poses(T_inv, inertial.origin)),
+            visuals=tuple(replace(v, origin=compose_poses(T_inv, v.origin)) for v in link.visuals),
+            collisions=tuple(replace(c, origin=compose_poses(T_inv, c.origin)) for c in link.collisions))
+        return replace(robot, joints=joints, links={**robot.links, self.link: link})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -103,7 +162,6 @@ class ReparentLink(Op):
 
     WHAT = "reparent_to"
 
-    SUPPORTED = False
     link: str
     parent: str
 
@@ -121,6 +179,16 @@ class ReparentLink(Op):
         return replace(names, joints={j: ((self.parent, c) if c == self.link else (p, c))
                                       for j, (p, c) in names.joints.items()})
 
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """X_NL = X_RN⁻¹ · X_RL: L keeps its pose in the root frame R under its new parent N."""
+        from mpc.ir import transforms as tf
+        from mpc.ir.kinematics import link_in_root, matrix_pose
+
+        joint = parent_joint(robot)[self.link]
+        X_NL = matrix_pose(tf.inverse(link_in_root(robot, self.parent)) @ link_in_root(robot, self.link))
+        moved = replace(joint, parent=self.parent, origin=X_NL)
+        return replace(robot, joints={**robot.joints, joint.name: moved})
+
 
 @dataclass(frozen=True, kw_only=True)
 class EstimateMissingComs(Op):
@@ -129,11 +197,41 @@ class EstimateMissingComs(Op):
 
     WHAT = "estimate_missing_coms"
 
-    SUPPORTED = False
     links: tuple[str, ...] = ()
 
     def reads(self) -> tuple[Ref, ...]:
         return tuple(Ref("link", n, "links") for n in self.links)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """The COM of a link whose COM is at its origin becomes the centre of volume of its
+        collision shapes (each a solid of uniform density); the inertia tensor is kept."""
+        import numpy as np
+
+        from mpc.ir.kinematics import pose_matrix
+        from mpc.ir.mesh_props import MeshError, volume_and_centre
+
+        links = dict(robot.links)
+        for name in self.links or tuple(robot.links):
+            link = links[name]
+            inertial = link.inertial
+            if inertial is None or not link.collisions or (
+                    inertial.origin is not None and any(inertial.origin.xyz)):
+                continue
+            total, moment = 0.0, np.zeros(3)
+            try:
+                for c in link.collisions:
+                    volume, centre = volume_and_centre(c.geometry)
+                    total += volume
+                    moment += volume * (pose_matrix(c.origin) @ np.append(centre, 1.0))[:3]
+            except MeshError as e:
+                effects.error("E0602", f"estimate_missing_coms of link '{name}': {e}", "links")
+                continue
+            if total <= 0:
+                continue
+            com = tuple(float(x) for x in moment / total)
+            origin = replace(inertial.origin or Pose(), xyz=com, written=(True, True))
+            links[name] = replace(link, inertial=replace(inertial, origin=origin))
+        return replace(robot, links=links)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -142,10 +240,20 @@ class AnnotateLinks(Op):
 
     WHAT = "frames"
 
-    SUPPORTED = False
     links: tuple[str, ...] = ()
     material: str | None = None
     annotations: Annotations = field(default_factory=dict)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        links = dict(robot.links)
+        for name in self.links or tuple(robot.links):
+            link = links[name]
+            visuals = link.visuals
+            if self.material is not None:
+                visuals = tuple(replace(v, material=self.material, inline_material=None) for v in visuals)
+            links[name] = replace(link, visuals=visuals,
+                                  annotations={**link.annotations, **self.annotations})
+        return replace(robot, links=links)
 
     def reads(self) -> tuple[Ref, ...]:
         refs = [Ref("link", n, "links") for n in self.links]

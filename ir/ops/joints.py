@@ -1,8 +1,6 @@
 """Joint ops: types, limits, dynamics, mimic, motors, removal, loop closures.
 
-Their `apply` is written by the model-editing work; until then `SUPPORTED` is False
-and compiling a definition that uses them is a "not supported yet" error, while
-`mpc check` already checks every name they use.
+An op whose `SUPPORTED` is False is checked by `mpc check` but cannot be compiled yet.
 """
 
 from __future__ import annotations
@@ -10,14 +8,45 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
+from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Robot
+
+MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
+
+
+def set_values(joint: Joint, v: JointValues, fill_only: bool = False) -> Joint:
+    """`joint` with the values of `v` that are given; fill_only: only where the joint has
+    none (or, for position limits, where both are zero)."""
+    limit = joint.limit or Limit()
+    zero_range = not limit.lower and not limit.upper
+
+    def pick(old: float | None, new: float | None, zero_is_unset: bool = False) -> float | None:
+        if new is None:
+            return old
+        if fill_only and old is not None and not (zero_is_unset and old == 0):
+            return old
+        return new
+
+    new_limit = replace(
+        limit,
+        lower=pick(limit.lower, v.lower, zero_range), upper=pick(limit.upper, v.upper, zero_range),
+        effort=pick(limit.effort, v.effort, True), velocity=pick(limit.velocity, v.velocity, True))
+    dyn = joint.dynamics or Dynamics()
+    new_dyn = replace(dyn, damping=pick(dyn.damping, v.damping), friction=pick(dyn.friction, v.friction))
+    springs = {k: getattr(v, k) for k in ("spring_stiffness", "spring_reference")
+               if getattr(v, k) is not None and not (fill_only and k in joint.annotations)}
+    return replace(
+        joint, limit=None if new_limit == Limit() and joint.limit is None else new_limit,
+        dynamics=None if new_dyn == Dynamics() and joint.dynamics is None else new_dyn,
+        annotations={**joint.annotations, **springs})
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, slots=True)
 class JointValues:
     """Values of a joint that an edit may set; None leaves a value as it is.
 
@@ -47,8 +76,12 @@ class Dependency:
 class ReplaceJointTypes(Op):
     """Every joint of type `old` becomes type `new`, for each (old, new) pair."""
 
-    SUPPORTED = False
     mapping: tuple[tuple[str, str], ...]
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        table = dict(self.mapping)
+        return replace(robot, joints={n: replace(j, type=table[j.type]) if j.type in table else j  # type: ignore[arg-type]
+                                      for n, j in robot.joints.items()})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,13 +94,21 @@ class JointDefaults(Op):
 
     WHAT = "joints $default"
 
-    SUPPORTED = False
     values: JointValues
     joints: tuple[str, ...] = ()
     backup: bool = False
 
     def reads(self) -> tuple[Ref, ...]:
         return tuple(Ref("joint", n, "joints") for n in self.joints)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        joints = dict(robot.joints)
+        for name in self.joints or tuple(robot.joints):
+            joint = joints[name]
+            if joint.type not in MOVABLE or (self.backup and joint.limit is not None):
+                continue
+            joints[name] = set_values(joint, self.values, fill_only=True)
+        return replace(robot, joints=joints)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -76,7 +117,6 @@ class EditJoint(Op):
 
     WHAT = "joints"
 
-    SUPPORTED = False
     joint: str
     values: JointValues = field(default_factory=JointValues)
     type: str | None = None
@@ -90,6 +130,23 @@ class EditJoint(Op):
         refs += [Ref("joint", d.joint, "mimic") for d in (self.mimic, *self.depends_on) if d]
         return tuple(refs)
 
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        joint = set_values(robot.joints[self.joint], self.values)
+        if self.type is not None:
+            joint = replace(joint, type=self.type)  # type: ignore[arg-type]
+        if self.axis is not None:
+            joint = replace(joint, axis=self.axis)
+        if self.mimic is not None:
+            joint = replace(joint, mimic=Mimic(joint=self.mimic.joint, multiplier=self.mimic.multiplier,
+                                               offset=self.mimic.offset))
+        annotations = dict(self.annotations)
+        if self.depends_on:
+            annotations["movement_depends_on"] = [
+                {"joint_name": d.joint, "multiplier": d.multiplier, "offset": d.offset}
+                for d in self.depends_on]
+        joint = replace(joint, annotations={**joint.annotations, **annotations})
+        return replace(robot, joints={**robot.joints, self.joint: joint})
+
 
 @dataclass(frozen=True, kw_only=True)
 class SetMotor(Op):
@@ -98,10 +155,13 @@ class SetMotor(Op):
     WHAT = "motor"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     joint: str
     name: str
     settings: Annotations = field(default_factory=dict)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        motor = Motor(name=self.name, joint=self.joint, settings=dict(self.settings))
+        return replace(robot, motors={**robot.motors, self.name: motor})
 
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("joint", self.joint, "joint"),)
@@ -117,11 +177,51 @@ class RemoveJoint(Op):
 
     WHAT = "joint removal"
 
-    SUPPORTED = False
     joint: str
 
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("joint", self.joint, "joint"),)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """At q = 0: the child's inertial joins the parent's (parallel-axis theorem), its
+        visuals, collisions and child joints are re-expressed in the parent (X_PV = X_PC·X_CV).
+        Fragments that name the removed joint go; those that name the child link now name
+        the parent."""
+        from mpc.ir.inertia import body, combine, inertial
+        from mpc.ir.kinematics import compose_poses
+        from mpc.ir.rename import rename_fragment, xmlns_of
+
+        removed = robot.joints[self.joint]
+        for other in robot.joints.values():
+            if other.mimic is not None and other.mimic.joint == self.joint:
+                effects.error("E0319", f"cannot remove joint '{self.joint}': joint '{other.name}' "
+                              "mimics it", "joint")
+                return robot
+        parent, child = robot.links[removed.parent], robot.links[removed.child]
+        X_PC = removed.origin
+        merged = parent.inertial
+        if child.inertial is not None:
+            merged = inertial(combine(body(parent.inertial), body(child.inertial, X_PC)))
+
+        def moved(items: tuple) -> tuple:
+            return tuple(replace(v, origin=compose_poses(X_PC, v.origin)) for v in items)
+
+        links = {n: lk for n, lk in robot.links.items() if n != child.name}
+        links[parent.name] = replace(
+            parent, inertial=merged, visuals=parent.visuals + moved(child.visuals),
+            collisions=parent.collisions + moved(child.collisions), extras=parent.extras + child.extras,
+            annotations={**child.annotations, **parent.annotations})
+        joints = {}
+        for n, j in robot.joints.items():
+            if n == self.joint:
+                continue
+            if j.parent == child.name:
+                j = replace(j, parent=parent.name, origin=compose_poses(X_PC, j.origin))
+            joints[n] = j
+        to_parent = (lambda name: parent.name if name == child.name else name)  # noqa: E731
+        fragments = tuple(rename_fragment(f, to_parent, lambda name: name, xmlns_of(robot))
+                          for f in robot.fragments if self.joint not in f.names("joint"))
+        return replace(robot, links=links, joints=joints, fragments=fragments)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         parent, child = names.joints[self.joint]
@@ -148,7 +248,6 @@ class AddCutJoint(Op):
     WHAT = "cut joint"
     EFFECT_NEEDS_READS = False
 
-    SUPPORTED = False
     joint: str
     parent: str
     child: str
@@ -164,6 +263,17 @@ class AddCutJoint(Op):
             effects.error("E0311", f"cut joint '{self.joint}' exists already as a joint of the tree",
                           "joint")
         return names.with_other("cut_joint", [self.joint])
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """The loop closure's origin is X_PC = X_RP⁻¹ · X_RC at the zero configuration."""
+        from mpc.ir import transforms as tf
+        from mpc.ir.kinematics import link_in_root, matrix_pose
+
+        X_PC = tf.inverse(link_in_root(robot, self.parent)) @ link_in_root(robot, self.child)
+        cut = CutJoint(name=self.joint, type=self.type, parent=self.parent, child=self.child,
+                       origin=matrix_pose(X_PC), constraint_axes=self.constraint_axes,
+                       annotations=dict(self.annotations), span=self.span)
+        return replace(robot, cut_joints={**robot.cut_joints, self.joint: cut})
 
 
 @dataclass(frozen=True, kw_only=True)

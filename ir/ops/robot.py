@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from mpc.ir.ops import Op
+from mpc.ir.ops import Effects, Op
 from mpc.ir.robot import Robot
 
 
@@ -14,5 +14,5 @@ class SetRobotName(Op):
 
     name: str
 
-    def apply(self, robot: Robot) -> Robot:
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
         return robot if robot.name == self.name else replace(robot, name=self.name)

@@ -69,11 +69,11 @@ def test_unknown_key_with_did_you_mean(tmp_path: Path, diags: Diags) -> None:
 def test_key_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
     _compile(tmp_path, diags, definition("arm.urdf") + "  frames: {upper: {make_root: true}}\n"
-             "  poses: {up: {shoulder: 1}}\n")
-    frames, poses = diags.take_error("E0202"), diags.take_error("E0202")
-    assert (frames.message, poses.message) == ("the make_root operation is not supported yet",
-                                               "the add_pose operation is not supported yet")
-    assert (_where(frames), _where(poses)) == ((12, 20), (13, 11))
+             "  collisions: {auto_bitmask: true}\n")
+    frames, bitmask = diags.take_error("E0202"), diags.take_error("E0202")
+    assert (frames.message, bitmask.message) == ("the make_root operation is not supported yet",
+                                                 "the auto_bitmask operation is not supported yet")
+    assert (_where(frames), _where(bitmask)) == ((12, 20), (13, 16))
 
 
 def test_export_of_a_later_version(tmp_path: Path, diags: Diags) -> None:

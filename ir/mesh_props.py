@@ -1,0 +1,97 @@
+"""Shapes as triangle meshes (trimesh), for the ops that need geometry: bounding
+primitives, centres of mass from collision volumes. Imported only by those ops."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from mpc.ir.geometry import Box, ConvexHull, Cylinder, Geometry, Mesh, ReflectMesh, Sphere
+
+
+class MeshError(Exception):
+    """A mesh file cannot be read (the caller turns it into a diagnostic)."""
+
+
+def as_trimesh(geometry: Geometry) -> trimesh.Trimesh:
+    """The shape in its own frame, scaled, with its mesh ops applied."""
+    if isinstance(geometry, Box):
+        return trimesh.creation.box(extents=geometry.size)
+    if isinstance(geometry, Cylinder):
+        return trimesh.creation.cylinder(radius=geometry.radius, height=geometry.length, sections=64)
+    if isinstance(geometry, Sphere):
+        return trimesh.creation.icosphere(subdivisions=3, radius=geometry.radius)
+    assert isinstance(geometry, Mesh)
+    path = geometry.source.path
+    if path is None or not path.is_file():
+        raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
+    try:
+        mesh = trimesh.load(path, force="mesh", process=False)
+    except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
+        raise MeshError(f"cannot read mesh '{path}': {e}") from None
+    if geometry.scale is not None:
+        mesh.apply_scale(np.asarray(geometry.scale))
+    for op in geometry.ops:
+        if isinstance(op, ReflectMesh):
+            T = np.eye(4)
+            T[op.axis, op.axis] = -1.0
+            mesh.apply_transform(T)
+        elif isinstance(op, ConvexHull):
+            mesh = mesh.convex_hull
+    return mesh
+
+
+def volume_and_centre(geometry: Geometry) -> tuple[float, np.ndarray]:
+    """(volume, centre of volume) in the shape's frame; for an open mesh, its convex hull's."""
+    if isinstance(geometry, Box):
+        return float(np.prod(geometry.size)), np.zeros(3)
+    if isinstance(geometry, Cylinder):
+        return float(np.pi * geometry.radius**2 * geometry.length), np.zeros(3)
+    if isinstance(geometry, Sphere):
+        return float(4.0 / 3.0 * np.pi * geometry.radius**3), np.zeros(3)
+    mesh = as_trimesh(geometry)
+    solid = mesh if mesh.is_volume else mesh.convex_hull
+    return float(abs(solid.volume)), np.asarray(solid.center_mass, dtype=float)
+
+
+def bounding(geometry: Geometry, shape: str, oriented: bool) -> tuple[Geometry, np.ndarray]:
+    """The bounding box, cylinder or sphere of a shape, and its pose X_GB in the shape's frame.
+
+    oriented: the smallest box (or cylinder) in any orientation; otherwise aligned with the
+    shape's own axes.
+    """
+    mesh = as_trimesh(geometry)
+    if shape == "sphere":
+        centre, radius = trimesh.nsphere.minimum_nsphere(mesh.vertices)
+        X = np.eye(4)
+        X[:3, 3] = centre
+        return Sphere(radius=float(radius)), X
+    if shape == "box":
+        if oriented:
+            X, extents = trimesh.bounds.oriented_bounds(mesh)
+            return Box(size=tuple(float(e) for e in extents)), np.linalg.inv(X)  # type: ignore[arg-type]
+        lo, hi = mesh.bounds
+        X = np.eye(4)
+        X[:3, 3] = (lo + hi) / 2
+        return Box(size=tuple(float(e) for e in hi - lo)), X  # type: ignore[arg-type]
+    if oriented:
+        fit = trimesh.bounds.minimum_cylinder(mesh)
+        return Cylinder(radius=float(fit["radius"]), length=float(fit["height"])), fit["transform"]
+    lo, hi = mesh.bounds  # along the shape's z axis
+    centre = (lo + hi) / 2
+    radius = float(np.max(np.linalg.norm(mesh.vertices[:, :2] - centre[:2], axis=1)))
+    X = np.eye(4)
+    X[:3, 3] = centre
+    return Cylinder(radius=radius, length=float(hi[2] - lo[2])), X
+
+
+def scaled(shape: Geometry, factor: float) -> Geometry:
+    """A primitive with its dimensions multiplied by `factor`."""
+    if factor == 1.0:
+        return shape
+    if isinstance(shape, Box):
+        return Box(size=tuple(factor * x for x in shape.size))  # type: ignore[arg-type]
+    if isinstance(shape, Cylinder):
+        return Cylinder(radius=factor * shape.radius, length=factor * shape.length)
+    assert isinstance(shape, Sphere)
+    return Sphere(radius=factor * shape.radius)
