@@ -137,6 +137,16 @@ class TransformFrame(TransformLink):
         R_inv = pose_matrix(T_inv)[:3, :3]
         joints = dict(robot.joints)
         parent = parent_joint(robot).get(self.link)
+        if parent is not None and parent.type in ("revolute", "continuous"):
+            import numpy as np
+
+            a = np.asarray(parent.axis or (1.0, 0.0, 0.0), dtype=float)
+            p = np.asarray(self.xyz, dtype=float)
+            if np.linalg.norm(np.cross(a / np.linalg.norm(a), p)) > 1e-12:
+                effects.error("E0320", f"transform_frame of '{self.link}' would move the axis of "
+                              f"{parent.type} joint '{parent.name}' off its line and change the motion; "
+                              "translate the frame only along the axis", "link")
+                return robot
         if parent is not None:
             axis = parent.axis
             if axis is not None or parent.type not in ("fixed", "floating"):

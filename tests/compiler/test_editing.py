@@ -1,0 +1,176 @@
+"""Model editing on real models: physical invariants checked with Pinocchio."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import trimesh
+from lxml import etree
+
+from mpc.ir import transforms as tf
+from tests.backends.pin_compare import load, random_configurations
+from tests.conftest import ERD, Diags, compile_file, write
+
+TALOS = ERD / "talos_data/robots/talos_full_v2.urdf"
+
+
+def _compile(tmp_path: Path, source: Path, sections: str, name: str = "talos") -> Path:
+    spec = write(tmp_path / "edit.yml", f"""
+        model:
+          robotname: {name}
+          modelname: {name}-edited
+          input_models: {{src: {{basefile: "{source}"}}}}
+          assemble: {{model: src}}
+        """ + sections)
+    sink = Diags()
+    result = compile_file(spec, tmp_path / "out", sink)
+    assert result.out is not None, sink.summary()
+    return result.out / "urdf" / f"{name}.urdf"
+
+
+def _frames(model: pin.Model, q: np.ndarray) -> dict[str, np.ndarray]:
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    return {f.name: data.oMf[i].homogeneous.copy() for i, f in enumerate(model.frames)}
+
+
+def test_removing_a_fixed_joint_keeps_mass_com_and_composite_inertia(tmp_path: Path) -> None:
+    """The gripper's fixed base link merges into the wrist link."""
+    out = _compile(tmp_path, TALOS, """
+          joints:
+            gripper_left_base_link_joint: {remove: true}
+        """)
+    a, b = load(TALOS), load(out)
+    assert "gripper_left_base_link" not in {f.name for f in b.frames}
+    assert abs(pin.computeTotalMass(a) - pin.computeTotalMass(b)) < 1e-12
+    da, db = a.createData(), b.createData()
+    for q in [pin.neutral(a), *random_configurations(a, 3, seed=2)]:
+        np.testing.assert_allclose(pin.centerOfMass(a, da, q), pin.centerOfMass(b, db, q), atol=1e-12)
+        np.testing.assert_allclose(pin.computeGeneralizedGravity(a, da, q),
+                                   pin.computeGeneralizedGravity(b, db, q), atol=1e-11)
+    # The composite spatial inertia of the body the link merged into (Pinocchio lumps fixed
+    # children into their joint's body, so both models hold the merged body there).
+    jid = a.getJointId("arm_left_7_joint")
+    np.testing.assert_allclose(a.inertias[jid].matrix(), b.inertias[b.getJointId("arm_left_7_joint")].matrix(),
+                               atol=1e-12)
+
+
+@pytest.mark.parametrize(("link", "joint", "xyz"), [
+    ("arm_left_4_link", "arm_left_4_joint", (0.0, 0.03, 0.0)),  # revolute: along its axis only
+    ("wrist_left_ft_tool_link", "wrist_left_tool_joint", (0.01, -0.02, 0.03)),  # fixed: any
+])
+def test_transform_frame_changes_no_other_frame_and_no_dynamics(
+        tmp_path: Path, link: str, joint: str, xyz: tuple) -> None:
+    out = _compile(tmp_path, TALOS, f"""
+          frames:
+            {link}:
+              transform_frame: {{xyz: {list(xyz)}, rpy: [0.1, -0.2, 0.3]}}
+        """)
+    a, b = load(TALOS), load(out)
+    T = tf.pose_to_matrix(xyz, (0.1, -0.2, 0.3))
+    for q in random_configurations(a, 4, seed=9):
+        fa, fb = _frames(a, q), _frames(b, q)
+        for name, X in fa.items():
+            expected = X @ T if name in (link, joint) else X
+            np.testing.assert_allclose(fb[name], expected, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(pin.computeGeneralizedGravity(a, a.createData(), q),
+                                   pin.computeGeneralizedGravity(b, b.createData(), q), atol=1e-12)
+        np.testing.assert_allclose(pin.centerOfMass(a, a.createData(), q),
+                                   pin.centerOfMass(b, b.createData(), q), atol=1e-12)
+
+
+def test_transform_frame_off_a_revolute_axis_is_refused(tmp_path: Path, diags: Diags) -> None:
+    spec = write(tmp_path / "edit.yml", f"""
+        model:
+          robotname: talos
+          modelname: talos-edited
+          input_models: {{src: {{basefile: "{TALOS}"}}}}
+          assemble: {{model: src}}
+          frames:
+            arm_left_4_link:
+              transform_frame: {{xyz: [0.01, 0, 0]}}
+        """)
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    d = diags.take_error("E0320")
+    assert d.message == ("transform_frame of 'arm_left_4_link' would move the axis of revolute joint "
+                         "'arm_left_4_joint' off its line and change the motion; translate the frame "
+                         "only along the axis")
+    assert (d.span.line, d.span.col) == (7, 5)
+
+
+def test_transform_link_moves_exactly_its_subtree(tmp_path: Path) -> None:
+    out = _compile(tmp_path, TALOS, """
+          frames:
+            arm_left_4_link:
+              transform_link: {xyz: [0, 0, 0.05], rpy: [0, 0, 0.5]}
+        """)
+    a, b = load(TALOS), load(out)
+    T = tf.pose_to_matrix((0, 0, 0.05), (0, 0, 0.5))
+    q = pin.neutral(a)
+    fa, fb = _frames(a, q), _frames(b, q)
+    X_R4 = fa["arm_left_4_link"]
+    below = {f.name for f in a.frames if f.name.startswith(("arm_left_4", "arm_left_5", "arm_left_6",
+                                                            "arm_left_7", "gripper_left", "wrist_left"))}
+    assert {"gripper_left_base_link", "arm_left_7_link"} <= below
+    for name, X in fa.items():
+        expected = X_R4 @ T @ np.linalg.inv(X_R4) @ X if name in below else X
+        np.testing.assert_allclose(fb[name], expected, atol=1e-12, err_msg=name)
+    assert abs(pin.computeTotalMass(a) - pin.computeTotalMass(b)) < 1e-12
+
+
+def test_reparent_keeps_the_root_relative_transform(tmp_path: Path) -> None:
+    out = _compile(tmp_path, TALOS, """
+          frames:
+            imu_link:
+              reparent_to: torso_2_link
+        """)
+    a, b = load(TALOS), load(out)
+    joint = next(j for j in etree.parse(str(out)).getroot().findall("joint")
+                 if j.find("child").get("link") == "imu_link")
+    assert joint.find("parent").get("link") == "torso_2_link"
+    fa, fb = _frames(a, pin.neutral(a)), _frames(b, pin.neutral(b))
+    for name, X in fa.items():
+        np.testing.assert_allclose(fb[name], X, atol=1e-12, err_msg=name)
+
+
+def test_estimated_com_of_a_box_mesh_is_the_box_centre(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(0.2, 0.1, 0.4))
+    box.apply_translation((0.05, -0.03, 0.2))
+    box.export(tmp_path / "box.stl")
+    urdf = write(tmp_path / "boxy.urdf", """
+        <robot name="boxy">
+          <link name="base">
+            <inertial><mass value="3"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+            <collision><origin xyz="0 0 0.1"/><geometry><mesh filename="box.stl"/></geometry></collision>
+          </link>
+        </robot>
+        """)
+    out = _compile(tmp_path, urdf, """
+          frames:
+            $default: {estimate_missing_coms: true}
+        """, name="boxy")
+    origin = etree.parse(str(out)).getroot().find("link/inertial/origin")
+    np.testing.assert_allclose([float(x) for x in origin.get("xyz").split()], [0.05, -0.03, 0.3],
+                               atol=1e-12)
+
+
+def test_joint_limits_with_units_and_defaults(tmp_path: Path) -> None:
+    arm = ERD / "talos_data/robots/talos_left_arm.urdf"
+    out = _compile(tmp_path, arm, """
+          joints:
+            $default: {eff: 99}
+            $all: true
+            arm_left_2_joint: {min: ["deg", -45], max: deg(45), vel: 2*pi, damping: 0.5}
+        """, name="arm")
+    joints = {j.get("name"): j for j in etree.parse(str(out)).getroot().findall("joint")}
+    limit = joints["arm_left_2_joint"].find("limit")
+    assert float(limit.get("lower")) == pytest.approx(-np.pi / 4, abs=1e-15)
+    assert float(limit.get("upper")) == pytest.approx(np.pi / 4, abs=1e-15)
+    assert float(limit.get("velocity")) == 2 * np.pi
+    assert joints["arm_left_2_joint"].find("dynamics").get("damping") == "0.5"
+    # $default fills only what is missing or zero: talos's efforts are set, so they stay.
+    src = {j.get("name"): j for j in etree.parse(str(arm)).getroot().findall("joint")}
+    assert limit.get("effort") == src["arm_left_2_joint"].find("limit").get("effort")
