@@ -53,9 +53,8 @@ def test_removing_a_fixed_joint_keeps_mass_com_and_composite_inertia(tmp_path: P
                                    pin.computeGeneralizedGravity(b, db, q), atol=1e-11)
     # The composite spatial inertia of the body the link merged into (Pinocchio lumps fixed
     # children into their joint's body, so both models hold the merged body there).
-    jid = a.getJointId("arm_left_7_joint")
-    np.testing.assert_allclose(a.inertias[jid].matrix(), b.inertias[b.getJointId("arm_left_7_joint")].matrix(),
-                               atol=1e-12)
+    ja, jb = a.getJointId("arm_left_7_joint"), b.getJointId("arm_left_7_joint")
+    np.testing.assert_allclose(a.inertias[ja].matrix(), b.inertias[jb].matrix(), atol=1e-12)
 
 
 @pytest.mark.parametrize(("link", "joint", "xyz"), [
