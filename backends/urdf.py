@@ -23,16 +23,18 @@ __all__ = ["emit", "read", "to_string"]
 def left_out(robot: Robot) -> list[str]:
     """What the robot holds that URDF cannot: motors, sensors, annotations, …"""
     counts = {
-        "motor": len(robot.motors), "sensor": len(robot.sensors), "pose": len(robot.poses),
-        "loop-closure joint": len(robot.cut_joints), "submechanism": len(robot.submechanisms),
-        "annotation category": len(robot.annotations),
-        "annotated link": sum(bool(lk.annotations) for lk in robot.links.values()),
-        "annotated joint": sum(bool(j.annotations) for j in robot.joints.values()),
-        "collision with bitmask or annotations": sum(
+        ("motor", "motors"): len(robot.motors), ("sensor", "sensors"): len(robot.sensors),
+        ("pose", "poses"): len(robot.poses),
+        ("loop-closure joint", "loop-closure joints"): len(robot.cut_joints),
+        ("submechanism", "submechanisms"): len(robot.submechanisms),
+        ("annotation category", "annotation categories"): len(robot.annotations),
+        ("annotated link", "annotated links"): sum(bool(lk.annotations) for lk in robot.links.values()),
+        ("annotated joint", "annotated joints"): sum(bool(j.annotations) for j in robot.joints.values()),
+        ("collision bitmask or annotation", "collision bitmasks or annotations"): sum(
             bool(c.annotations) or c.bitmask is not None
             for lk in robot.links.values() for c in lk.collisions),
     }
-    out = [f"{n} {what}{'s' * (n != 1)}" for what, n in counts.items() if n]
+    out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
     if robot.submechanisms_file:
         out.append("the submechanisms file")
     return out

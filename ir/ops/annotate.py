@@ -173,12 +173,13 @@ def _describe(c: Collision) -> dict[str, object]:
 
 @dataclass(frozen=True, kw_only=True)
 class AutoBitmask(Op):
-    """Compute collision bitmasks so that no two collisions collide that must not.
+    """Compute collision bitmasks so that no two links collide that must not (ir/bitmask.py).
 
     never: (a, b) pairs (links or collisions) that never collide; always: pairs that may.
+    The result: each collision's `bitmask`, and the robot annotation `self_collision`
+    listing the link pairs that may collide.
     """
 
-    SUPPORTED = False
     never: tuple[tuple[str, str], ...] = ()
     always: tuple[tuple[str, str], ...] = ()
 
@@ -187,6 +188,42 @@ class AutoBitmask(Op):
             _link_or_collision(names, a, effects, "")
             _link_or_collision(names, b, effects, "")
         return names
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        from itertools import combinations
+
+        from mpc.ir.bitmask import BITS, assign, never_colliding, touching
+        from mpc.ir.mesh_props import MeshError
+
+        owner = {c.name: n for n, lk in robot.links.items() for c in lk.collisions if c.name}
+
+        def pair(a: str, b: str) -> frozenset[str]:
+            return frozenset((owner.get(a, a) if a not in robot.links else a,
+                              owner.get(b, b) if b not in robot.links else b))
+
+        links = [n for n, lk in robot.links.items() if lk.collisions]
+        try:
+            apart = never_colliding(robot) | touching(robot)
+        except MeshError as e:
+            effects.error("E0602", f"auto_bitmask: {e}")
+            return robot
+        apart |= {pair(a, b) for a, b in self.never}
+        allowed = {frozenset(p) for p in combinations(links, 2)} - apart
+        allowed |= {pair(a, b) for a, b in self.always}
+        masks, lost = assign(links, allowed)
+        if lost:
+            effects.sink.warning(self.span, "W0304", f"auto_bitmask: {BITS} bits cannot let "
+                                 f"{len(lost)} allowed pairs collide (e.g. "
+                                 f"{' and '.join(sorted(next(iter(sorted(lost, key=sorted)))))}); "
+                                 "they will not collide")
+        new_links = dict(robot.links)
+        for name in links:
+            link = robot.links[name]
+            new_links[name] = replace(link, collisions=tuple(replace(c, bitmask=masks[name])
+                                                             for c in link.collisions))
+        matrix = {"may_collide": sorted(sorted(p) for p in allowed - lost)}
+        return replace(robot, links=new_links,
+                       annotations={**robot.annotations, "self_collision": matrix})
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -1,0 +1,104 @@
+"""Self-collision bitmasks: which links may collide, and 16-bit masks that say so.
+
+Two collisions collide when their bitmasks share a bit (MARS's and Phobos's rule). Links
+never collide with (Phobos's rules): their parent; ancestors above it while the joints
+in between have a zero translation (only rotation: they share the joint's centre); and
+links whose collision shapes touch or overlap at the zero configuration (tested with
+coal). `never` and `always` override pairs. Each bit is then a set of links that may all
+collide with each other; bits are added greedily until every allowed pair shares one,
+16 at most — a pair left over cannot collide (the safe side) and is reported.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+
+from mpc.ir.geometry import Geometry
+from mpc.ir.kinematics import link_in_root, pose_matrix
+from mpc.ir.robot import Robot
+from mpc.ir.tree import parent_joint
+
+BITS = 16
+
+
+def _coal_object(geometry: Geometry) -> object:
+    import coal
+
+    from mpc.ir.geometry import Box, Cylinder, Sphere
+    from mpc.ir.mesh_props import as_trimesh
+
+    if isinstance(geometry, Box):
+        return coal.Box(*geometry.size)
+    if isinstance(geometry, Cylinder):
+        return coal.Cylinder(geometry.radius, geometry.length)
+    if isinstance(geometry, Sphere):
+        return coal.Sphere(geometry.radius)
+    mesh = as_trimesh(geometry)
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(len(mesh.faces), len(mesh.vertices))
+    model.addVertices(np.asarray(mesh.vertices, dtype=float))
+    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+    model.endModel()
+    return model
+
+
+def touching(robot: Robot) -> set[frozenset[str]]:
+    """Pairs of links whose collision shapes touch or overlap at q = 0."""
+    import coal
+
+    shapes = []
+    for name, link in robot.links.items():
+        X_RL = link_in_root(robot, name)
+        for c in link.collisions:
+            X = X_RL @ pose_matrix(c.origin)
+            shapes.append((name, _coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
+    out: set[frozenset[str]] = set()
+    request = coal.CollisionRequest()
+    for (a, sa, ta), (b, sb, tb) in combinations(shapes, 2):
+        if a == b or frozenset((a, b)) in out:
+            continue
+        if coal.collide(sa, ta, sb, tb, request, coal.CollisionResult()):
+            out.add(frozenset((a, b)))
+    return out
+
+
+def never_colliding(robot: Robot) -> set[frozenset[str]]:
+    """Pairs of links that the kinematic rules keep apart (parents, rotation-only ancestors)."""
+    parents = parent_joint(robot)
+    out: set[frozenset[str]] = set()
+    for link in robot.links:
+        joint = parents.get(link)
+        while joint is not None:
+            out.add(frozenset((link, joint.parent)))
+            if joint.origin is not None and any(joint.origin.xyz):
+                break
+            joint = parents.get(joint.parent)
+    return out
+
+
+def assign(links: list[str], allowed: set[frozenset[str]]) -> tuple[dict[str, int], set[frozenset[str]]]:
+    """Bitmasks such that allowed pairs share a bit and no other pair does; the allowed
+    pairs that 16 bits could not cover."""
+    uncovered = set(allowed)
+    masks = dict.fromkeys(links, 0)
+    for bit in range(BITS):
+        if not uncovered:
+            break
+        a, b = sorted(min(uncovered, key=lambda p: tuple(sorted(p))))
+        clique = [a, b]
+        candidates = sorted(set(links) - {a, b})
+        # Grow the clique with links allowed against all its members, most new pairs first.
+        while True:
+            fits = [c for c in candidates if all(frozenset((c, m)) in allowed for m in clique)]
+            if not fits:
+                break
+            best = max(fits, key=lambda c: (sum(frozenset((c, m)) in uncovered for m in clique),
+                                            -links.index(c)))
+            clique.append(best)
+            candidates.remove(best)
+        for m in clique:
+            masks[m] |= 1 << bit
+        uncovered -= {frozenset(p) for p in combinations(clique, 2)}
+    return masks, uncovered
