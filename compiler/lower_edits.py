@@ -271,7 +271,9 @@ class EditLowering:
                 span=d.span, target=target, exclude=tuple(section.exclude) if not target else (),
                 remove=remove, shape=d.shape, oriented=d.oriented, replace=section.apply_primitives,
                 scale=self.lw.num(d, "scale", f"collision '{target}' scale") or 1.0, join=d.join,
-                bitmask=d.bitmask, annotations=d.entries,
+                bitmask=d.bitmask,
+                annotations={**d.entries, **({"ccfm": self.lw.num(d, "ccfm", f"collision '{target}' ccfm")}
+                                             if d.ccfm is not None else {})},
                 spans={"target": d.span, "exclude": section.value_span("$exclude")}))
         pairs = {k: tuple((a, b) for a, bs in getattr(section, k).items() for b in bs)
                  for k in ("no_collision_between", "collision_between")}

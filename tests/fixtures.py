@@ -74,3 +74,60 @@ def arm(folder: Path, urdf: str = ARM_URDF) -> Path:
     """Write the arm URDF and its mesh into `folder`; the URDF's path."""
     tetra_stl(folder / "meshes" / "tetra.stl")
     return write(folder / "arm.urdf", urdf)
+
+
+# A robot carrying every name the examples of the reference (model-definitions.md) use.
+REFERENCE_JOINTS = [
+    ("body_joint_1", "revolute", "root", "body_link_1"),
+    ("body_joint_b", "revolute", "body_link_1", "body_link_2"),
+    ("body_joint_2", "fixed", "body_link_2", "body_link_3"),
+    ("mount_r", "fixed", "root", "right_arm_mount_link"),
+    ("mount_l", "fixed", "root", "left_arm_mount_link"),
+    ("control", "fixed", "root", "control_frame"),
+    ("right_arm_joint", "revolute", "right_arm_mount_link", "right_arm_link"),
+    ("left_arm_shoulder_joint1", "revolute", "left_arm_mount_link", "left_shoulder_1"),
+    ("left_arm_shoulder_joint2", "revolute", "left_shoulder_1", "left_shoulder_2"),
+    ("left_exo_shoulder_1_joint", "revolute", "root", "exo_1"),
+    ("slider", "prismatic", "root", "slider_link"),
+    ("LLHip3", "revolute", "root", "ll_hip"), ("LLKnee", "revolute", "ll_hip", "ll_knee"),
+    ("LLAnklePitch", "revolute", "ll_knee", "ll_ankle"), ("LLAnkle_ft_joint", "fixed", "ll_ankle", "LLAnkle_FT"),
+    ("LRHip3", "revolute", "root", "lr_hip"), ("LRKnee", "revolute", "lr_hip", "lr_knee"),
+    ("LRAnklePitch", "revolute", "lr_knee", "lr_ankle"),
+    ("ALShoulder1", "revolute", "root", "al_1"), ("ALShoulder2", "revolute", "al_1", "al_2"),
+    ("ALElbow", "revolute", "al_2", "al_3"),
+    ("ARShoulder1", "revolute", "root", "ar_1"), ("ARShoulder2", "revolute", "ar_1", "ar_2"),
+    ("ARElbow", "revolute", "ar_2", "ar_3"),
+    ("BodyPitch", "revolute", "root", "body_p"), ("BodyRoll", "revolute", "body_p", "body_r"),
+    ("Body_B11", "revolute", "body_r", "b11"), ("Body_B12", "revolute", "b11", "b12"),
+    ("Body_Act1", "prismatic", "b12", "act1"), ("Body_B21", "revolute", "body_r", "b21"),
+    ("Body_B22", "revolute", "b21", "b22"), ("Body_Act2", "prismatic", "b22", "act2"),
+]
+REFERENCE_COLLISIONS = {"body_link_1": "body_joint_1_collision",
+                        "right_arm_mount_link": "right_arm_mount_link_collision",
+                        "left_arm_mount_link": "left_arm_mount_link_collision",
+                        "right_arm_link": "right_arm_link_collision"}
+
+
+def reference_robot(path: Path) -> Path:
+    """Write the reference robot URDF to `path`: small boxes, 0.1 m apart, axes along z
+    (the two shoulder joints' axes meet, as move_joint_axis_to_intersection needs)."""
+    links = ["root"] + [child for _, _, _, child in REFERENCE_JOINTS]
+    out = ['<?xml version="1.0"?>', '<robot name="mighty_bust">']
+    for i, name in enumerate(links):
+        collision = ""
+        if name in REFERENCE_COLLISIONS:
+            collision = (f'<collision name="{REFERENCE_COLLISIONS[name]}"><origin xyz="0 0 {0.01 * i}"/>'
+                         '<geometry><box size="0.02 0.02 0.02"/></geometry></collision>')
+        out.append(f'  <link name="{name}"><inertial><origin xyz="0 0 0.01"/><mass value="0.5"/>'
+                   '<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>'
+                   f'{collision}</link>')
+    for name, kind, parent, child in REFERENCE_JOINTS:
+        axis = "1 0 0" if name == "left_arm_shoulder_joint2" else "0 0 1"
+        xyz = "0 0 0.05" if name == "left_arm_shoulder_joint2" else "0.1 0 0"
+        limit = '<limit lower="-1" upper="1" effort="10" velocity="1"/>' if kind != "fixed" else ""
+        out.append(f'  <joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+                   f'<origin xyz="{xyz}"/><axis xyz="{axis}"/>{limit}</joint>')
+    out.append("</robot>")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(out) + "\n")
+    return path

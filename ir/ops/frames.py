@@ -130,12 +130,6 @@ class TransformFrame(TransformLink):
     """
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
-        from mpc.ir.kinematics import compose_poses, inverse_pose, pose_matrix
-
-        T = Pose(self.xyz, self.rpy)
-        T_inv = inverse_pose(T)
-        R_inv = pose_matrix(T_inv)[:3, :3]
-        joints = dict(robot.joints)
         parent = parent_joint(robot).get(self.link)
         if parent is not None and parent.type in ("revolute", "continuous"):
             import numpy as np
@@ -147,23 +141,35 @@ class TransformFrame(TransformLink):
                               f"{parent.type} joint '{parent.name}' off its line and change the motion; "
                               "translate the frame only along the axis", "link")
                 return robot
-        if parent is not None:
-            axis = parent.axis
-            if axis is not None or parent.type not in ("fixed", "floating"):
-                axis = tuple(float(x) for x in R_inv @ (axis or (1.0, 0.0, 0.0)))
-            joints[parent.name] = replace(parent, origin=compose_poses(parent.origin, T),
-                                          axis=axis)  # type: ignore[arg-type]
-        for name, j in robot.joints.items():
-            if j.parent == self.link:
-                joints[name] = replace(j, origin=compose_poses(T_inv, j.origin))
-        link = robot.links[self.link]
-        inertial = link.inertial
-        link = replace(
-            link,
-            inertial=inertial and replace(inertial, origin=compose_poses(T_inv, inertial.origin)),
-            visuals=tuple(replace(v, origin=compose_poses(T_inv, v.origin)) for v in link.visuals),
-            collisions=tuple(replace(c, origin=compose_poses(T_inv, c.origin)) for c in link.collisions))
-        return replace(robot, joints=joints, links={**robot.links, self.link: link})
+        return move_frame(robot, self.link, Pose(self.xyz, self.rpy))
+
+
+def move_frame(robot: Robot, link_name: str, T: Pose) -> Robot:
+    """X_PL' = X_PL · T with everything given in L re-expressed (X_L'V = T⁻¹ · X_LV), and the
+    axis of L's joint turned with the frame."""
+    from mpc.ir.kinematics import compose_poses, inverse_pose, pose_matrix
+
+    T_inv = inverse_pose(T)
+    R_inv = pose_matrix(T_inv)[:3, :3]
+    joints = dict(robot.joints)
+    parent = parent_joint(robot).get(link_name)
+    if parent is not None:
+        axis = parent.axis
+        if axis is not None or parent.type not in ("fixed", "floating"):
+            axis = tuple(float(x) for x in R_inv @ (axis or (1.0, 0.0, 0.0)))
+        joints[parent.name] = replace(parent, origin=compose_poses(parent.origin, T),
+                                      axis=axis)  # type: ignore[arg-type]
+    for name, j in robot.joints.items():
+        if j.parent == link_name:
+            joints[name] = replace(j, origin=compose_poses(T_inv, j.origin))
+    link = robot.links[link_name]
+    inertial = link.inertial
+    link = replace(
+        link,
+        inertial=inertial and replace(inertial, origin=compose_poses(T_inv, inertial.origin)),
+        visuals=tuple(replace(v, origin=compose_poses(T_inv, v.origin)) for v in link.visuals),
+        collisions=tuple(replace(c, origin=compose_poses(T_inv, c.origin)) for c in link.collisions))
+    return replace(robot, joints=joints, links={**robot.links, link_name: link})
 
 
 @dataclass(frozen=True, kw_only=True)

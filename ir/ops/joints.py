@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, replace
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
-from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Robot
+from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 
 MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
 
@@ -278,14 +278,42 @@ class AddCutJoint(Op):
 
 @dataclass(frozen=True, kw_only=True)
 class MoveJointAxisToIntersection(Op):
-    """Move `joint`'s frame to where the axes of joints `a` and `b` meet."""
+    """Move `joint`'s frame (its child link's frame) to where the axes of joints `a` and `b`
+    meet at q = 0 — for skew axes, the middle of their closest points. Only the frame
+    moves: the link's content stays where it is. This changes the kinematics on purpose
+    (aligning, say, an exoskeleton's shoulder axes with the human's)."""
 
-    WHAT = "move_joint_axis_to_intersection"
-
-    SUPPORTED = False
     joint: str
     a: str
     b: str
 
+    WHAT = "move_joint_axis_to_intersection"
+
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("joint", self.joint, "joint"), Ref("joint", self.a, "a"), Ref("joint", self.b, "b"))
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        import numpy as np
+
+        from mpc.ir.kinematics import link_in_root
+        from mpc.ir.ops.frames import move_frame
+
+        lines = []
+        for name in (self.a, self.b):
+            j = robot.joints[name]
+            X = link_in_root(robot, j.child)
+            lines.append((X[:3, 3], X[:3, :3] @ np.asarray(j.axis or (1.0, 0.0, 0.0), dtype=float)))
+        (p1, d1), (p2, d2) = lines
+        n = np.cross(d1, d2)
+        if np.linalg.norm(n) < 1e-9:
+            effects.error("E0321", f"the axes of '{self.a}' and '{self.b}' are parallel: they have no "
+                          "intersection to move the joint to", "a")
+            return robot
+        # Closest points p1 + t·d1 and p2 + s·d2 of the two lines.
+        t = np.dot(np.cross(p2 - p1, d2), n) / np.dot(n, n)
+        s = np.dot(np.cross(p2 - p1, d1), n) / np.dot(n, n)
+        point = ((p1 + t * d1) + (p2 + s * d2)) / 2
+        child = robot.joints[self.joint].child
+        X_RL = link_in_root(robot, child)
+        p_L = X_RL[:3, :3].T @ (point - X_RL[:3, 3])
+        return move_frame(robot, child, Pose(tuple(float(x) for x in p_L)))  # type: ignore[arg-type]
