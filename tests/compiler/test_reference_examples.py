@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from mpc.compiler import inherit, schema, source
+from mpc.ir.robot import Robot
 from tests.conftest import Diags
 
 FIXTURES = sorted((Path(__file__).parents[1] / "fixtures" / "reference").glob("*.yml"))
@@ -36,7 +37,7 @@ EDITING = ["frames", "joints", "collisions", "poses", "materials", "sensors", "s
            "submechanisms_file"]
 
 
-def _compile_reference(name: str, tmp_path: Path):  # noqa: ANN202
+def _compile_reference(name: str, tmp_path: Path) -> tuple[Robot, Diags]:
     from mpc.compiler.driver import Options, compile_model
     from tests.fixtures import reference_robot
 
@@ -60,7 +61,7 @@ def test_reference_example_compiles_with_its_effect(name: str, tmp_path: Path) -
     assert not sink.diagnostics, sink.summary()
 
 
-def _frames(robot) -> None:  # noqa: ANN001
+def _frames(robot: Robot) -> None:
     joints = {j.child: j for j in robot.joints.values()}
     assert joints["right_arm_mount_link"].origin.xyz == pytest.approx((1.1, 0, 0))
     assert joints["control_frame"].parent == "left_arm_mount_link"
@@ -69,7 +70,7 @@ def _frames(robot) -> None:  # noqa: ANN001
     assert robot.links["body_link_1"].annotations == {"noDataPackage": False, "reducedDataPackage": True}
 
 
-def _joints(robot) -> None:  # noqa: ANN001
+def _joints(robot: Robot) -> None:
     import math
 
     j1 = robot.joints["body_joint_1"]
@@ -87,7 +88,7 @@ def _joints(robot) -> None:  # noqa: ANN001
     assert moved == pytest.approx((0.1, 0.0, 0.05))
 
 
-def _collisions(robot) -> None:  # noqa: ANN001
+def _collisions(robot: Robot) -> None:
     assert robot.links["left_arm_mount_link"].collisions == ()
     [box] = robot.links["right_arm_link"].collisions
     assert box.bitmask == 1 and box.annotations["ccfm"] == 0.002
@@ -95,26 +96,26 @@ def _collisions(robot) -> None:  # noqa: ANN001
     assert "self_collision" in robot.annotations
 
 
-def _poses(robot) -> None:  # noqa: ANN001
+def _poses(robot: Robot) -> None:
     # values outside [-1, 1] would be clamped; these are all inside
     assert robot.poses["init"]["LLKnee"] == 0.64 and len(robot.poses["init"]) == 13
 
 
-def _materials(robot) -> None:  # noqa: ANN001
+def _materials(robot: Robot) -> None:
     assert robot.materials["shiny_blue_material"].rgba == (0.0, 0.0, 1.0, 1.0)
 
 
-def _sensors(robot) -> None:  # noqa: ANN001
+def _sensors(robot: Robot) -> None:
     assert robot.sensors["LLAnkle_ft"].link == "LLAnkle_FT"
     movable = {n for n, j in robot.joints.items() if j.type != "fixed"}
     assert set(robot.sensors["Joint_Position"].targets) == movable
 
 
-def _submechanisms(robot) -> None:  # noqa: ANN001
+def _submechanisms(robot: Robot) -> None:
     assert [s.name for s in robot.submechanisms] == ["rh5_torso"]
 
 
-def _submechanisms_file(robot) -> None:  # noqa: ANN001
+def _submechanisms_file(robot: Robot) -> None:
     assert robot.submechanisms_file.endswith("submechanisms.yml")
 
 
