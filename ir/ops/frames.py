@@ -73,11 +73,53 @@ class MakeRoot(Op):
 
     WHAT = "make_root"
 
-    SUPPORTED = False
     link: str
 
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("link", self.link, "link"),)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """Turn the joints from the root to `link` around (at q = 0).
+
+        For a joint j from P to C with origin O, the reversed joint goes from C to P with
+        origin A_C⁻¹ and axis −a (so q keeps its meaning and its limits); P's frame moves
+        to the old joint frame (A_P = O), and everything given in P — visuals, collisions,
+        inertial, the joints to its other children — is re-expressed: X_F V = O⁻¹ · X_P V.
+        """
+        from mpc.ir.kinematics import compose_poses, inverse_pose
+
+        parents = parent_joint(robot)
+        path, link = [], self.link
+        while link in parents:
+            path.append(parents[link])
+            link = parents[link].parent
+        if not path:
+            return robot
+        joints, links = dict(robot.joints), dict(robot.links)
+        moved: dict[str, Pose] = {self.link: Pose()}  # A_P: each path link's new frame in its old one
+        for joint in path:  # from `link` up to the old root
+            moved[joint.parent] = joint.origin or Pose()
+        for joint in path:
+            axis = joint.axis
+            if joint.type not in ("fixed", "floating"):
+                axis = tuple(-x for x in (joint.axis or (1.0, 0.0, 0.0)))  # type: ignore[assignment]
+            joints[joint.name] = replace(joint, parent=joint.child, child=joint.parent, axis=axis,
+                                         origin=inverse_pose(moved[joint.child]))
+        on_path = {j.name for j in path}
+        for name, A in moved.items():
+            if name == self.link:
+                continue
+            A_inv = inverse_pose(A)
+            lk = links[name]
+            inertial = lk.inertial
+            links[name] = replace(
+                lk, inertial=inertial and replace(inertial, origin=compose_poses(A_inv, inertial.origin)),
+                visuals=tuple(replace(v, origin=compose_poses(A_inv, v.origin)) for v in lk.visuals),
+                collisions=tuple(replace(c, origin=compose_poses(A_inv, c.origin)) for c in lk.collisions))
+            for jname, j in robot.joints.items():
+                if j.parent == name and jname not in on_path:
+                    joints[jname] = replace(j, origin=compose_poses(A_inv, j.origin))
+        return replace(robot, root=self.link, joints=joints, links=links)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         by_child = {c: (j, p) for j, (p, c) in names.joints.items()}

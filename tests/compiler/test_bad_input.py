@@ -68,12 +68,12 @@ def test_unknown_key_with_did_you_mean(tmp_path: Path, diags: Diags) -> None:
 
 def test_key_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
-    _compile(tmp_path, diags, definition("arm.urdf") + "  frames: {upper: {make_root: true}}\n"
-             "  collisions: {auto_bitmask: true}\n")
-    frames, bitmask = diags.take_error("E0202"), diags.take_error("E0202")
-    assert (frames.message, bitmask.message) == ("the make_root operation is not supported yet",
-                                                 "the auto_bitmask operation is not supported yet")
-    assert (_where(frames), _where(bitmask)) == ((12, 20), (13, 16))
+    _compile(tmp_path, diags, definition("arm.urdf") + "  collisions: {upper: {join: true}}\n"
+             "  test: {tests: [compare_link_masses]}\n")
+    test, join = diags.take_error("E0202"), diags.take_error("E0202")  # lowering reports first
+    assert (join.message, test.message) == ("joining collisions (join: true) is not supported yet",
+                                            "'test' is not supported yet")
+    assert (_where(join), _where(test)) == ((12, 16), (13, 3))
 
 
 def test_export_of_a_later_version(tmp_path: Path, diags: Diags) -> None:

@@ -227,3 +227,36 @@ def test_auto_bitmask(tmp_path: Path, model: str) -> None:
                 assert masks[a] & masks[b] == 0, (a, b)
     assert touching > 0
     assert len(may) > 10
+
+
+def test_make_root_keeps_the_multibody(tmp_path: Path) -> None:
+    """With the left foot as root, every link keeps its pose relative to every other link,
+    for any configuration: X_new(F) = X_old(L)⁻¹ · X_old(P) · A_P, A_P the frame move."""
+    from mpc.backends import urdf as urdf_backend
+    from mpc.compiler.diagnostics import Sink
+
+    out = _compile(tmp_path, TALOS, """
+          frames:
+            leg_left_6_link:
+              make_root: true
+        """)
+    old, new = pin.buildModelFromUrdf(str(TALOS)), pin.buildModelFromUrdf(str(out))
+    ir_new = urdf_backend.read(out, Sink())
+    assert ir_new is not None and ir_new.root == "leg_left_6_link"
+    assert abs(pin.computeTotalMass(load(TALOS)) - pin.computeTotalMass(load(out))) < 1e-9
+    ir_old = urdf_backend.read(TALOS, Sink())
+    path = {"leg_left_6_link", "leg_left_5_link", "leg_left_4_link", "leg_left_3_link",
+            "leg_left_2_link", "leg_left_1_link", "base_link"}
+    for q_old in random_configurations(old, 3, seed=4):
+        q_new = pin.neutral(new)
+        for jid in range(1, old.njoints):
+            nid = new.getJointId(old.names[jid])
+            q_new[new.idx_qs[nid]] = q_old[old.idx_qs[jid]]
+        fo, fn = _frames(old, q_old), _frames(new, q_new)
+        X_L = fo["leg_left_6_link"]
+        for name in ir_old.links:
+            A = np.eye(4)
+            if name in path and name != "leg_left_6_link":
+                child = next(j for j in ir_old.joints.values() if j.parent == name and j.child in path)
+                A = tf.pose_to_matrix(child.origin.xyz, child.origin.rpy)
+            np.testing.assert_allclose(fn[name], np.linalg.inv(X_L) @ fo[name] @ A, atol=1e-9, err_msg=name)
