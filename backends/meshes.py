@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import ConvexHull, Mesh, MeshOp, ReflectMesh
+from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, MeshOp, ReflectMesh
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
@@ -101,8 +101,11 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
     return _disambiguate(wanted)
 
 
+_SUFFIXES = {ReflectMesh: "_mirrored", ConvexHull: "_hull", JoinShapes: "_joined"}
+
+
 def _suffix(ops: tuple[MeshOp, ...]) -> str:
-    return "".join("_mirrored" if isinstance(op, ReflectMesh) else "_hull" for op in ops)
+    return "".join(_SUFFIXES[type(op)] for op in ops)
 
 
 def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
@@ -150,20 +153,13 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) ->
 
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
     """Apply `ops` to the mesh in `src` and write it to `dest`; why not, or None."""
-    import numpy as np
-    import trimesh
+    from mpc.ir.geometry import MeshSource
+    from mpc.ir.mesh_props import MeshError, as_trimesh
 
     try:
-        mesh = trimesh.load(src, force="mesh", process=False)
-    except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
-        return f"cannot read it ({type(e).__name__}: {e})"
-    for op in ops:
-        if isinstance(op, ReflectMesh):
-            T = np.eye(4)
-            T[op.axis, op.axis] = -1.0
-            mesh.apply_transform(T)  # trimesh reverses the winding for a reflection
-        elif isinstance(op, ConvexHull):
-            mesh = mesh.convex_hull
+        mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
+    except MeshError as e:
+        return str(e)
     data = mesh.export(file_type=dest.suffix[1:])
     dest.write_bytes(data if isinstance(data, bytes) else data.encode())
     return None

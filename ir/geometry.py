@@ -77,7 +77,15 @@ class ConvexHull:
     """Mesh op: replace the mesh by its convex hull."""
 
 
-MeshOp = ReflectMesh | ConvexHull
+@dataclass(frozen=True, slots=True)
+class JoinShapes:
+    """Mesh op: the mesh becomes the union of `parts`, each a shape with its pose (xyz, rpy)
+    in this mesh's frame. The source file then only names the result."""
+
+    parts: tuple[tuple[Geometry, Vec3, Vec3], ...]
+
+
+MeshOp = ReflectMesh | ConvexHull | JoinShapes
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -6,15 +6,17 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from mpc.ir.geometry import Box, ConvexHull, Cylinder, Geometry, Mesh, ReflectMesh, Sphere
+from mpc.ir import transforms as tf
+from mpc.ir.geometry import Box, ConvexHull, Cylinder, Geometry, JoinShapes, Mesh, ReflectMesh, Sphere
 
 
 class MeshError(Exception):
     """A mesh file cannot be read (the caller turns it into a diagnostic)."""
 
 
-def as_trimesh(geometry: Geometry) -> trimesh.Trimesh:
-    """The shape in its own frame, scaled, with its mesh ops applied."""
+def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
+    """The shape in its own frame with its mesh ops applied; scaled unless told not to
+    (a URDF keeps the scale on the element, so files are written unscaled)."""
     if isinstance(geometry, Box):
         return trimesh.creation.box(extents=geometry.size)
     if isinstance(geometry, Cylinder):
@@ -22,22 +24,32 @@ def as_trimesh(geometry: Geometry) -> trimesh.Trimesh:
     if isinstance(geometry, Sphere):
         return trimesh.creation.icosphere(subdivisions=3, radius=geometry.radius)
     assert isinstance(geometry, Mesh)
-    path = geometry.source.path
-    if path is None or not path.is_file():
-        raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
-    try:
-        mesh = trimesh.load(path, force="mesh", process=False)
-    except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
-        raise MeshError(f"cannot read mesh '{path}': {e}") from None
-    if geometry.scale is not None:
-        mesh.apply_scale(np.asarray(geometry.scale))
+    if geometry.ops and isinstance(geometry.ops[0], JoinShapes):
+        mesh = None  # the parts make the mesh; the file only names it
+    else:
+        path = geometry.source.path
+        if path is None or not path.is_file():
+            raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
+        try:
+            mesh = trimesh.load(path, force="mesh", process=False)
+        except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
+            raise MeshError(f"cannot read mesh '{path}': {e}") from None
     for op in geometry.ops:
         if isinstance(op, ReflectMesh):
             T = np.eye(4)
             T[op.axis, op.axis] = -1.0
-            mesh.apply_transform(T)
+            mesh.apply_transform(T)  # trimesh reverses the winding for a reflection
         elif isinstance(op, ConvexHull):
             mesh = mesh.convex_hull
+        elif isinstance(op, JoinShapes):
+            pieces = [] if mesh is None else [mesh]
+            for shape, xyz, rpy in op.parts:
+                piece = as_trimesh(shape)
+                piece.apply_transform(tf.pose_to_matrix(xyz, rpy))
+                pieces.append(piece)
+            mesh = trimesh.util.concatenate(pieces)
+    if scaled and geometry.scale is not None:
+        mesh.apply_scale(np.asarray(geometry.scale))
     return mesh
 
 

@@ -103,8 +103,6 @@ class EditCollisions(Op):
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.target:
             _link_or_collision(names, self.target, effects, "target")
-        if self.join:
-            effects.unsupported("joining collisions (join: true)", "target")
         if self.shape == "convex_decomposition":
             effects.unsupported("shape: convex_decomposition", "target")
         return names
@@ -128,6 +126,9 @@ class EditCollisions(Op):
                     edited = self._edit(c, name, effects)
                     if edited is not None:
                         kept.append(edited)
+            if self.join and len(kept) > 1:
+                joined = _join(name, kept, effects)
+                kept = [joined] if joined is not None else kept
             links[name] = replace(link, collisions=tuple(kept))
         return replace(robot, links=links)
 
@@ -158,6 +159,28 @@ class EditCollisions(Op):
             return None
         return replace(c, geometry=scaled(shape, self.scale),
                        origin=matrix_pose(pose_matrix(c.origin) @ X_GB))
+
+
+def _join(link: str, collisions: list[Collision], effects: Effects) -> Collision | None:
+    """One collision: the convex hull of all of them, in the frame of the first mesh."""
+    from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh
+    from mpc.ir.kinematics import compose_poses, inverse_pose
+
+    first = next((c for c in collisions if isinstance(c.geometry, Mesh)), None)
+    if first is None:
+        effects.error("E0322", f"join on link '{link}' needs at least one mesh collision to name the "
+                      "joined mesh", "target")
+        return None
+    assert isinstance(first.geometry, Mesh)
+    X_inv = inverse_pose(first.origin)
+    parts = []
+    for c in collisions:  # each part keeps its own scale (as_trimesh applies it)
+        X = compose_poses(X_inv, c.origin)
+        parts.append((c.geometry, X.xyz, X.rpy))
+    mesh = Mesh(source=first.geometry.source, span=first.geometry.span,
+                ops=(JoinShapes(tuple(parts)), ConvexHull()))
+    return replace(first, name=first.name or f"{link}_joined", geometry=mesh,
+                   annotations={k: v for c in collisions for k, v in c.annotations.items()})
 
 
 def _describe(c: Collision) -> dict[str, object]:

@@ -260,3 +260,46 @@ def test_make_root_keeps_the_multibody(tmp_path: Path) -> None:
                 child = next(j for j in ir_old.joints.values() if j.parent == name and j.child in path)
                 A = tf.pose_to_matrix(child.origin.xyz, child.origin.rpy)
             np.testing.assert_allclose(fn[name], np.linalg.inv(X_L) @ fo[name] @ A, atol=1e-9, err_msg=name)
+
+
+def _convex(mesh: trimesh.Trimesh) -> float:
+    """The largest distance of a vertex outside a face plane (≤ 0 for a convex mesh)."""
+    normals, origins = mesh.face_normals, mesh.triangles[:, 0]
+    return float(np.einsum("fk,fvk->fv", normals, mesh.vertices[None, :, :] - origins[:, None, :]).max())
+
+
+def test_join_and_convex_collisions_are_convex_hulls(tmp_path: Path) -> None:
+    """finger_edu's base link has four collision meshes: joined, they become one convex hull
+    that contains them all; a `shape: convex` collision becomes its mesh's hull."""
+    source = ERD / "finger_edu_description/robots/finger_edu.urdf"
+    out = _compile(tmp_path, source, """
+          collisions:
+            finger_base_link: {join: true}
+            finger_upper_link: {shape: convex}
+        """, name="finger")
+    root = etree.parse(str(out)).getroot()
+    links = {lk.get("name"): lk for lk in root.findall("link")}
+    [joined] = links["finger_base_link"].findall("collision")
+    [hull] = links["finger_upper_link"].findall("collision")
+    joined_file = joined.find("geometry/mesh").get("filename")
+    assert joined_file.endswith("_joined_hull.stl") and hull.find("geometry/mesh").get("filename").endswith(
+        "_hull.stl")
+    for c in (joined, hull):
+        mesh = trimesh.load(out.parent / c.find("geometry/mesh").get("filename"), force="mesh")
+        assert mesh.volume > 0 and _convex(mesh) < 1e-9
+    # The joined hull contains each part (scaled, placed), within the float32 precision of STL.
+    from mpc.backends import urdf as urdf_backend
+    from mpc.compiler.diagnostics import Sink
+    from mpc.ir.kinematics import pose_matrix
+    from mpc.ir.mesh_props import as_trimesh
+
+    src = urdf_backend.read(source, Sink())
+    parts = src.links["finger_base_link"].collisions
+    X_first = np.linalg.inv(pose_matrix(parts[0].origin))
+    joined_mesh = trimesh.load(out.parent / joined_file, force="mesh")
+    for part in parts:
+        piece = as_trimesh(part.geometry)
+        piece.apply_transform(X_first @ pose_matrix(part.origin))
+        normals, origins = joined_mesh.face_normals, joined_mesh.triangles[:, 0]
+        outside = np.einsum("fk,fvk->fv", normals, piece.vertices[None, :, :] - origins[:, None, :]).max()
+        assert outside < 1e-6
