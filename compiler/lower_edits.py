@@ -23,6 +23,7 @@ from mpc.ir.ops import (
     AddSubmechanism,
     AnnotateLinks,
     AutoBitmask,
+    CompleteSubmechanisms,
     EditCollisions,
     EditJoint,
     EditMaterial,
@@ -323,6 +324,9 @@ class EditLowering:
                     joints += [j for j in getattr(s, key, []) if j not in joints]
                 self.add(AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
                                          definition=s.model_dump(exclude_defaults=True)))
+        if m.submechanisms or m.exoskeletons:
+            span = m.key_span("submechanisms" if m.submechanisms else "exoskeletons")
+            self.add(CompleteSubmechanisms(span=span))
 
     def sensors(self) -> None:
         assert self.model.sensors is not None

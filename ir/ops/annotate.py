@@ -417,3 +417,46 @@ class AddAnnotations(Op):
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         merged = {**robot.annotations.get(self.category, {}), **self.content}
         return replace(robot, annotations={**robot.annotations, self.category: merged})
+
+
+@dataclass(frozen=True, kw_only=True)
+class CompleteSubmechanisms(Op):
+    """Cover every joint no submechanism names (Phobos does this when any is given): each
+    connected group of uncovered movable joints becomes a `serial` chain, each group of
+    uncovered fixed joints a `fixed` chain, in depth-first order, marked `auto_gen`."""
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        from mpc.ir.tree import depth_first
+
+        covered: set[str] = set()
+        for s in robot.submechanisms:
+            for key in ("jointnames_spanningtree", "jointnames", "jointnames_independent",
+                        "jointnames_active", "jointnames_dependent"):
+                covered |= set(s.definition.get(key, ()))  # type: ignore[arg-type]
+        order = [j.name for j, _ in depth_first(robot) if j is not None]
+        groups: list[tuple[bool, list[str]]] = []
+        group_of: dict[str, int] = {}
+        for name in order:
+            if name in covered:
+                continue
+            joint = robot.joints[name]
+            fixed = joint.type == "fixed"
+            above = next((j for j in robot.joints.values() if j.child == joint.parent), None)
+            if above is not None and above.name in group_of and groups[group_of[above.name]][0] == fixed:
+                index = group_of[above.name]
+            else:
+                groups.append((fixed, []))
+                index = len(groups) - 1
+            groups[index][1].append(name)
+            group_of[name] = index
+        made = []
+        for fixed, joints in groups:
+            kind = "fixed" if fixed else "serial"
+            name = f"{kind}_chain_{joints[0]}"
+            definition: dict[str, object] = {"name": name, "contextual_name": name, "type": kind,
+                                             "auto_gen": True, "jointnames": list(joints)}
+            if not fixed:
+                definition.update(jointnames_spanningtree=list(joints), jointnames_active=list(joints),
+                                  jointnames_independent=list(joints))
+            made.append(Submechanism(name=name, definition=definition))
+        return replace(robot, submechanisms=(*robot.submechanisms, *made))

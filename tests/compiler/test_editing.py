@@ -303,3 +303,36 @@ def test_join_and_convex_collisions_are_convex_hulls(tmp_path: Path) -> None:
         normals, origins = joined_mesh.face_normals, joined_mesh.triangles[:, 0]
         outside = np.einsum("fk,fvk->fv", normals, piece.vertices[None, :, :] - origins[:, None, :]).max()
         assert outside < 1e-6
+
+
+def test_uncovered_joints_get_serial_and_fixed_chains(tmp_path: Path) -> None:
+    """With a submechanism over the shoulder only, the elbow becomes a serial chain and the
+    fixed wrist joints a fixed chain; every joint is then covered exactly once."""
+    from mpc.compiler.driver import Options, compile_model
+
+    arm = ERD / "talos_data/robots/talos_left_arm.urdf"
+    spec = write(tmp_path / "s.yml", f"""
+        model:
+          robotname: arm
+          modelname: arm-sm
+          input_models: {{src: {{basefile: "{arm}"}}}}
+          assemble: {{model: src}}
+          submechanisms:
+            - name: shoulder
+              type: serial
+              jointnames_spanningtree: [arm_left_2_joint, arm_left_3_joint]
+        """)
+    result = compile_model(spec, Diags(), Options(out=tmp_path / "out"))
+    robot = result.robot
+    assert robot is not None
+    made = {s.name: s.definition for s in robot.submechanisms}
+    assert list(made) == ["shoulder", "serial_chain_arm_left_4_joint", "fixed_chain_wrist_left_ft_joint",
+                          "serial_chain_gripper_left_joint"]
+    assert made["serial_chain_arm_left_4_joint"]["jointnames"] == [
+        "arm_left_4_joint", "arm_left_5_joint", "arm_left_6_joint", "arm_left_7_joint"]
+    covered = [j for d in made.values() for j in d.get("jointnames", d.get("jointnames_spanningtree", []))]
+    assert sorted(covered) == sorted(robot.joints)
+    for d in made.values():
+        if d.get("auto_gen"):
+            kinds = {robot.joints[j].type == "fixed" for j in d["jointnames"]}
+            assert kinds == {d["type"] == "fixed"}
