@@ -112,7 +112,9 @@ def _sensors(robot: Robot) -> None:
 
 
 def _submechanisms(robot: Robot) -> None:
-    assert [s.name for s in robot.submechanisms] == ["rh5_torso"]
+    given, generated = robot.submechanisms[0], robot.submechanisms[1:]
+    assert given.name == "rh5_torso" and given.definition["jointnames_active"] == ["Body_Act1", "Body_Act2"]
+    assert generated and all(s.definition["auto_gen"] for s in generated)
 
 
 def _submechanisms_file(robot: Robot) -> None:
