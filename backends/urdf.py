@@ -33,6 +33,12 @@ def left_out(robot: Robot) -> list[str]:
         ("collision bitmask or annotation", "collision bitmasks or annotations"): sum(
             bool(c.annotations) or c.bitmask is not None
             for lk in robot.links.values() for c in lk.collisions),
+        ("annotated visual", "annotated visuals"): sum(
+            bool(v.annotations) for lk in robot.links.values() for v in lk.visuals),
+        ("material with more than a colour", "materials with more than a colour"): sum(
+            any(getattr(m, k) is not None for k in ("ambient", "specular", "emissive", "shininess",
+                                                     "transparency", "normal_texture"))
+            or bool(m.annotations) for m in robot.materials.values()),
     }
     out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
     if robot.submechanisms_file:

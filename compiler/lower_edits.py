@@ -64,6 +64,24 @@ class EditLowering:
     def add(self, op: Any) -> None:
         self.lw.ops.append(op)
 
+    def removal(self, d: Any, what: str) -> bool | tuple[str, ...]:
+        """`remove`: true, or names and regular expressions (checked here, E0305)."""
+        if isinstance(d.remove, bool):
+            return d.remove
+        from mpc.ir.naming import bad_pattern
+
+        kept = []
+        for i, pattern in enumerate(d.remove):
+            problem = bad_pattern(pattern)
+            if problem:
+                span = self.lw.item_span(d, "remove", i) if isinstance(
+                    d._doc.data_at((*d._path, "remove")), list) else d.value_span("remove")
+                self.sink.error(span, "E0305", f"'{pattern}' in {what} remove is not a regular "
+                                f"expression: {problem}")
+            else:
+                kept.append(pattern)
+        return tuple(kept)
+
     def run(self) -> None:
         m = self.model
         for name, d in m.materials.items():
@@ -95,6 +113,21 @@ class EditLowering:
 
     # -- materials and frames -------------------------------------------------------------
 
+    def refuse(self, d: Node, where: str, keys: tuple[str, ...]) -> None:
+        """Report keys that mean nothing in this place (instead of ignoring them)."""
+        for key in keys:
+            if key in d.model_fields_set:
+                self.sink.error(d.key_span(key), "E0313", f"'{key}' has no meaning in {where}")
+
+    def scoped(self, editing: Any, where: str, scope: str) -> None:
+        """Name editing of one kind of name: the keys of other kinds would do nothing."""
+        for key in editing.model_fields_set:
+            kind = key.split("_", 1)[0]
+            if "_" in key and kind in ("link", "joint", "collision", "visual", "submechanism") \
+                    and kind != scope:
+                self.sink.error(editing.key_span(key), "E0313", f"'{key}' has no meaning in {where}, "
+                                f"which renames {scope}s only")
+
     def material(self, name: str, d: Any) -> None:
         colours = {k: self.lw.vec(d, k, f"material '{name}' {k}") for k in
                    ("diffuse", "ambient", "specular", "emissive")}
@@ -118,14 +151,20 @@ class EditLowering:
         if roots:
             self.add(MakeRoot(span=roots[0][1].key_span("make_root"), link=roots[0][0]))
         if section.default is not None:
+            self.refuse(section.default, "frames $default", _NOT_IN_FRAME_DEFAULT)
             self.link_edits("", section.default, all_links=True)
         for name, d in entries.items():
+            if name not in new:
+                self.refuse(d, f"frame '{name}' (an existing link; give it a parent to add a new frame)",
+                            _NEW_FRAME_ONLY)
             self.link_edits(name, d, all_links=False, is_new=name in new)
         for name, d in entries.items():
             if d.name_editing is not None:
+                self.scoped(d.name_editing, f"frames.{name}.name_editing", "link")
                 self.add(EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
                                    kinds=("link",), only=(name,)))
         if section.name_editing is not None:
+            self.scoped(section.name_editing, "frames.$name_editing", "link")
             self.add(EditNames(span=section.name_editing.span, kinds=("link",),
                                rules=self.lw.name_rules(section.name_editing)))
 
@@ -142,7 +181,7 @@ class EditLowering:
         joint = (j.name if j is not None else d.jointname) or name
         self.add(AddFrame(span=d.span, link=name, parent=parent or "", joint=joint,  # type: ignore[arg-type]
                           type=(j.type if j is not None else d.type) or "fixed", xyz=xyz, rpy=rpy,
-                          axis=self.lw.vec(src, "axis", f"frame '{name}' axis") if j else None,
+                          axis=self.lw.vec(src, "axis", f"frame '{name}' axis"),
                           mass=self.lw.num(d, "mass", f"frame '{name}' mass"), annotations=d.entries,
                           spans={"parent": src.value_span("parent"), "link": d.span}))
 
@@ -162,9 +201,9 @@ class EditLowering:
         if d.estimate_missing_coms:
             self.add(EstimateMissingComs(span=d.key_span("estimate_missing_coms"), links=links,
                                          spans=spans))
-        if (d.entries or d.material) and not is_new:
+        if (d.entries and not is_new) or d.material:
             self.add(AnnotateLinks(span=d.span, links=links, material=d.material,
-                                   annotations=d.entries, spans=spans))
+                                   annotations={} if is_new else d.entries, spans=spans))
 
     # -- joints ----------------------------------------------------------------------------
 
@@ -183,10 +222,12 @@ class EditLowering:
             if d.cut_joint:
                 self.cut_joint(name, d)
         if section.default is not None:
+            self.refuse(section.default, "joints $default", _NOT_IN_JOINT_DEFAULT)
             listed = () if section.all else tuple(n for n, d in entries.items()
                                                   if not d.cut_joint and not d.remove)
             self.add(JointDefaults(span=section.key_span("$default"), joints=listed,
                                    values=self.values(section.default, "joints $default"),
+                                   annotations=section.default.entries,
                                    spans={"joints": section.key_span("$default")}))
         if section.backup is not None:
             self.add(JointDefaults(span=section.key_span("$backup"), backup=True,
@@ -199,9 +240,11 @@ class EditLowering:
                 self.add(RemoveJoint(span=d.key_span("remove"), joint=name, spans={"joint": d.span}))
         for name, d in entries.items():
             if d.name_editing is not None:
+                self.scoped(d.name_editing, f"joints.{name}.name_editing", "joint")
                 self.add(EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
                                    kinds=("joint",), only=(name,)))
         if section.name_editing is not None:
+            self.scoped(section.name_editing, "joints.$name_editing", "joint")
             self.add(EditNames(span=section.name_editing.span, kinds=("joint",),
                                rules=self.lw.name_rules(section.name_editing)))
 
@@ -249,7 +292,11 @@ class EditLowering:
         motor_name = f"{name}_motor"
         for m in given:
             if isinstance(m, MotorDef):
-                settings.update({k: v for k, v in m.model_dump(exclude_none=True).items() if k != "name"})
+                for key in ("p", "i", "d", "maxEffort", "maxSpeed"):
+                    if getattr(m, key) is not None:
+                        settings[key] = self.lw.num(m, key, f"motor of joint '{name}' {key}")
+                if m.type is not None:
+                    settings["type"] = m.type
                 settings.update(m.entries)
                 motor_name = m.name or motor_name
         key = "active" if d.active not in (None, False) else "motor"
@@ -262,12 +309,13 @@ class EditLowering:
         section = self.model.collisions
         assert section is not None
         if section.name_editing is not None:
+            self.scoped(section.name_editing, "collisions.$name_editing", "collision")
             self.add(EditNames(span=section.name_editing.span, kinds=("collision",),
                                rules=self.lw.name_rules(section.name_editing)))
         todo = [("", section.default)] if section.default is not None else []
         todo += list(section.entries.items())
         for target, d in todo:
-            remove = d.remove if isinstance(d.remove, bool) else tuple(d.remove)
+            remove = self.removal(d, f"collisions of '{target or '$default'}'")
             self.add(EditCollisions(
                 span=d.span, target=target, exclude=tuple(section.exclude) if not target else (),
                 remove=remove, shape=d.shape, oriented=d.oriented, replace=section.apply_primitives,
@@ -279,7 +327,10 @@ class EditLowering:
         pairs = {k: tuple((a, b) for a, bs in getattr(section, k).items() for b in bs)
                  for k in ("no_collision_between", "collision_between")}
         if section.auto_bitmask:
-            self.add(AutoBitmask(span=section.key_span("auto_bitmask"),
+            spans = {f"pair/{a}": section.key_span(k) for k in pairs for a, _ in pairs[k]}
+            spans.update({f"pair/{a}/{b}": self.lw.pair_span(section, k, a, b)
+                          for k in pairs for a, b in pairs[k]})
+            self.add(AutoBitmask(span=section.key_span("auto_bitmask"), spans=spans,
                                  never=pairs["no_collision_between"], always=pairs["collision_between"]))
         else:
             for key in pairs:
@@ -291,6 +342,7 @@ class EditLowering:
         section = self.model.visuals
         assert section is not None
         if section.name_editing is not None:
+            self.scoped(section.name_editing, "visuals.$name_editing", "visual")
             self.add(EditNames(span=section.name_editing.span, kinds=("visual",),
                                rules=self.lw.name_rules(section.name_editing)))
         todo = [("", section.default)] if section.default is not None else []
@@ -299,7 +351,7 @@ class EditLowering:
             self.add(EditVisuals(
                 span=d.span, targets=(target,) if target else (),
                 exclude=tuple(section.exclude) if not target else (),
-                remove=d.remove if isinstance(d.remove, bool) else tuple(d.remove), material=d.material,
+                remove=self.removal(d, f"visuals of '{target or '$default'}'"), material=d.material,
                 annotations=d.entries,
                 spans={"targets": d.span, "exclude": section.value_span("$exclude"),
                        "material": d.value_span("material")}))
@@ -314,15 +366,22 @@ class EditLowering:
                 self.sink.error(m.key_span("submechanisms_file"), "E0315", "give either "
                                 "'submechanisms_file' or 'submechanisms'/'exoskeletons', not both")
                 return
-            path = str((self.lw.base_dir / m.submechanisms_file).resolve())
-            self.add(SubmechanismsFile(span=m.value_span("submechanisms_file"), path=path))
+            path = (self.lw.folder_of(m, "submechanisms_file") / m.submechanisms_file).resolve()
+            if not path.is_file():
+                self.sink.error(m.value_span("submechanisms_file"), "E0601",
+                                f"submechanisms_file '{path}' does not exist")
+            self.add(SubmechanismsFile(span=m.value_span("submechanisms_file"), path=str(path)))
         for exo, items in lists:
             for s in items:
                 joints = []
                 for key in ("jointnames_independent", "jointnames_spanningtree", "jointnames_active",
                             "jointnames", "jointnames_dependent"):
                     joints += [j for j in getattr(s, key, []) if j not in joints]
+                links = [b for lc in getattr(s, "loop_constraints", [])
+                         for b in (lc.predecessor_body, lc.successor_body)]
+                links += [s.around] if getattr(s, "around", None) else []
                 self.add(AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
+                                         links=tuple(dict.fromkeys(links)),
                                          definition=s.model_dump(exclude_defaults=True)))
         if m.submechanisms or m.exoskeletons:
             span = m.key_span("submechanisms" if m.submechanisms else "exoskeletons")
@@ -331,6 +390,10 @@ class EditLowering:
     def sensors(self) -> None:
         assert self.model.sensors is not None
         for kind, d in sensor_entries(self.model.sensors):
+            if kind and d.type and d.type != kind:
+                self.sink.error(d.value_span("type"), "E0316", f"sensor '{d.name}' is listed under "
+                                f"{kind} but says type {d.type}")
+                continue
             kind = kind or d.type
             if kind is None:
                 self.sink.error(d.span, "E0316", f"sensor '{d.name}' has no 'type'")
@@ -348,3 +411,14 @@ class EditLowering:
                 position_offset=self.lw.vec(d, "position_offset", f"sensor '{d.name}' position_offset"),
                 orientation_offset=self.lw.vec(d, "orientation_offset", f"sensor '{d.name}' orientation"),
                 annotations=d.entries, spans=_spans(d, "link", "joint", "frame", "targets")))
+
+
+# Keys that belong to a new frame's joint, and mean nothing on an existing link.
+_NEW_FRAME_ONLY = ("parent", "jointname", "xyz", "rpy", "axis", "type", "mass", "joint")
+# Keys that act on one link, and mean nothing in frames' $default.
+_NOT_IN_FRAME_DEFAULT = ("transform_link", "transform_frame", "reparent_to", "make_root", "name_editing",
+                         *_NEW_FRAME_ONLY)
+# Keys that act on one joint, and mean nothing in joints' $default.
+_NOT_IN_JOINT_DEFAULT = ("type", "axis", "remove", "cut_joint", "parent", "child", "constraint_axes",
+                         "move_joint_axis_to_intersection", "mimic", "movement_depends_on", "active",
+                         "motor", "name_editing")

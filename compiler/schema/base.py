@@ -163,6 +163,7 @@ class Screen:
 
     def __init__(self, doc: Document, sink: Sink) -> None:
         self.doc, self.sink = doc, sink
+        self.shortened: set[Path_] = set()  # lists that lost items here (their errors are reported)
 
     def __call__(self, data: Any, tp: Any, path: Path_) -> Any:
         origin = typing.get_origin(tp)
@@ -188,6 +189,8 @@ class Screen:
         if origin is list and isinstance(data, list):
             (item,) = typing.get_args(tp) or (Any,)
             out = [self(x, item, (*path, i)) for i, x in enumerate(data)]
+            if _DROP in out:
+                self.shortened.add(path)
             return [x for x in out if x is not _DROP]
         if origin is dict and isinstance(data, dict):
             value_tp = typing.get_args(tp)[1] if typing.get_args(tp) else Any
@@ -321,11 +324,17 @@ def _union_message(errs: list[dict[str, Any]], loc: tuple) -> str:
     return f"'{_key(loc)}' must be {' or '.join(wanted) or 'of another form'}, got {describe(value)}"
 
 
-def report(e: ValidationError, doc: Document, data: Any, sink: Sink, what: str) -> None:
-    """Map pydantic's errors onto spans; errors of one union value become one diagnostic."""
+def report(e: ValidationError, doc: Document, data: Any, sink: Sink, what: str,
+           shortened: set[Path_] = frozenset()) -> None:  # type: ignore[assignment]
+    """Map pydantic's errors onto spans; errors of one union value become one diagnostic.
+
+    shortened: lists from which screening removed items; "too short" there only repeats it.
+    """
     groups: dict[tuple, list[dict[str, Any]]] = {}
     for err in e.errors():
         loc = _clean_loc(tuple(err["loc"]), data, err["type"] == "missing")
+        if err["type"] == "too_short" and loc in shortened:
+            continue
         groups.setdefault(loc, []).append(err)
     for loc, errs in groups.items():
         missing = [x for x in errs if x["type"] == "missing" and len(errs) == 1]
@@ -356,11 +365,12 @@ def validate_as(cls: type[Node], doc: Document, sink: Sink, what: str) -> Node |
         sink.error(doc.value_span(()), "E0203", f"{what} is a mapping, not {describe(doc.data)}")
         return None
     errors = sink.error_count
-    data = Screen(doc, sink)(doc.data, cls, ())
+    screen = Screen(doc, sink)
+    data = screen(doc.data, cls, ())
     try:
         ast = cls.model_validate(data)
     except ValidationError as e:
-        report(e, doc, data, sink, what)
+        report(e, doc, data, sink, what, screen.shortened)
         return None
     if sink.error_count > errors:
         return None

@@ -45,7 +45,7 @@ class ModelSection(Node):
     inherit_smurf_properties: bool = True
     input_models: Annotated[dict[str, InputModel], Field(min_length=1)]
     assemble: Assemble
-    export_config: list[ExportEntry] | None = None
+    export_config: Annotated[list[ExportEntry], Field(min_length=1)] | None = None
     append_export_config: list[ExportEntry] = []
     reduce_meshes: Expr | None = None
     apply_scale: bool = False

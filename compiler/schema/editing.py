@@ -73,6 +73,7 @@ class FrameDef(OpenNode):
     jointname: str | None = None
     xyz: Vec3 | None = None
     rpy: Vec3 | None = None
+    axis: Vec3 | None = None
     type: JointTypeName | None = None
     mass: Expr | None = None
 

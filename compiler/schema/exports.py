@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field
+from pydantic import BeforeValidator, Field
 
 from mpc.compiler.schema.base import Expr, Node, OneOrMore
 
@@ -42,7 +42,9 @@ class UrdfExport(_Kinematic):
 class SdfExport(_Kinematic):
     SECTION: ClassVar[str] = "an sdf export"
     type: Literal["sdf"]
-    version: Literal["1.6", "1.7", "1.9"] = "1.9"
+    # 1.9 unquoted is a number in YAML; it means the version all the same.
+    version: Annotated[Literal["1.6", "1.7", "1.9"], BeforeValidator(
+        lambda v: str(v) if isinstance(v, float) else v)] = "1.9"
 
 
 class MjcfExport(_Kinematic):

@@ -208,8 +208,8 @@ class AutoBitmask(Op):
 
     def effect(self, names: Names, effects: Effects) -> Names:
         for a, b in (*self.never, *self.always):
-            _link_or_collision(names, a, effects, "")
-            _link_or_collision(names, b, effects, "")
+            _link_or_collision(names, a, effects, f"pair/{a}")
+            _link_or_collision(names, b, effects, f"pair/{a}/{b}")
         return names
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -375,6 +375,7 @@ class AddSubmechanism(Op):
     """A submechanism or exoskeleton (HyRoDyn) over joints of the robot.
 
     joints: every joint the definition names (spanning tree, active, independent, …).
+    links: every link it names (loop-constraint bodies, an exoskeleton's `around`).
     definition: the definition as written, for the submechanisms file.
     """
 
@@ -384,10 +385,12 @@ class AddSubmechanism(Op):
     name: str
     exoskeleton: bool = False
     joints: tuple[str, ...] = ()
+    links: tuple[str, ...] = ()
     definition: Annotations = field(default_factory=dict)
 
     def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("joint", j, "joints") for j in self.joints)
+        return (*(Ref("joint", j, "joints") for j in self.joints),
+                *(Ref("link", n, "links") for n in self.links))
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("submechanism", [self.name])

@@ -90,6 +90,7 @@ class JointDefaults(Op):
 
     joints: the joints it applies to (all when empty: `$all`).
     backup: only for movable joints without any limit (`$backup`).
+    annotations: set where the joint has no annotation of that key.
     """
 
     WHAT = "joints $default"
@@ -97,6 +98,7 @@ class JointDefaults(Op):
     values: JointValues
     joints: tuple[str, ...] = ()
     backup: bool = False
+    annotations: Annotations = field(default_factory=dict)
 
     def reads(self) -> tuple[Ref, ...]:
         return tuple(Ref("joint", n, "joints") for n in self.joints)
@@ -107,7 +109,8 @@ class JointDefaults(Op):
             joint = joints[name]
             if joint.type not in MOVABLE or (self.backup and joint.limit is not None):
                 continue
-            joints[name] = set_values(joint, self.values, fill_only=True)
+            joint = set_values(joint, self.values, fill_only=True)
+            joints[name] = replace(joint, annotations={**self.annotations, **joint.annotations})
         return replace(robot, joints=joints)
 
 
