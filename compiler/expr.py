@@ -8,14 +8,13 @@ from __future__ import annotations
 
 import math
 import operator
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache, lru_cache
-from pathlib import Path
+from functools import cache
 from typing import TYPE_CHECKING
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.compiler.source import source_line
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
@@ -161,7 +160,7 @@ class _Where:
         """Find `text` in the source: the whole scalar, or (last) the last item of a flow list."""
         if "\n" in text or span.end_line > span.line:
             return cls(span, None)  # block and folded scalars: offsets are not columns
-        line = _source_line(span.file, span.line)
+        line = source_line(span.file, span.line)
         if line is None:
             return cls(span, None if last else span.col)  # unreadable: assume unquoted
         if last:
@@ -176,21 +175,6 @@ class _Where:
         if self.col is None:
             return self.span
         return Span(self.span.file, self.span.line, self.col + start, self.span.line, self.col + end)
-
-
-def _source_line(file: str, line: int) -> str | None:
-    try:
-        stat = os.stat(file)
-        lines = _source_lines(file, (stat.st_mtime_ns, stat.st_size))
-    except (OSError, UnicodeDecodeError):
-        return None
-    return lines[line - 1] if 0 < line <= len(lines) else None
-
-
-@lru_cache(maxsize=16)
-def _source_lines(file: str, stamp: tuple[int, int]) -> tuple[str, ...]:
-    """The lines of `file`; `stamp` (mtime, size) is part of the key so that edits are seen."""
-    return tuple(Path(file).read_text(encoding="utf-8").split("\n"))
 
 
 def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None:

@@ -8,28 +8,19 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from functools import lru_cache
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
+from mpc.compiler.source import source_line
 from mpc.ir.span import Span
 
 MAX_SHOWN = 50
 
 
-@lru_cache(maxsize=64)
-def _lines(file: str) -> tuple[str, ...]:
-    try:
-        with open(file, encoding="utf-8", errors="replace") as f:
-            return tuple(f.read().splitlines())
-    except OSError:
-        return ()
-
-
 def _excerpt(span: Span) -> list[str]:
-    lines = _lines(span.file)
-    if not 1 <= span.line <= len(lines):
+    line = source_line(span.file, span.line)
+    if line is None:
         return []
-    text = lines[span.line - 1].expandtabs(1)
+    text = line.expandtabs(1)
     width = len(str(span.line))
     end = span.end_col if span.end_line == span.line and span.end_col > span.col else span.col + 1
     end = min(max(end, span.col + 1), max(len(text) + 1, span.col + 1))

@@ -7,8 +7,10 @@ unsupported tags are diagnostics. Merge keys (`<<`) work.
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -184,3 +186,21 @@ def loads(text: str, file: str, sink: Sink) -> Document | None:
     doc = Document(file, None)
     doc.data = _Builder(doc, sink).build(node, ())
     return doc
+
+
+def source_line(file: str, line: int) -> str | None:
+    """Line `line` (1-based) of `file` as it is now, or None; for diagnostics and columns.
+
+    Files are read once per (modification time, size), so an edited file is read again.
+    """
+    try:
+        stat = os.stat(file)
+        lines = _source_lines(file, (stat.st_mtime_ns, stat.st_size))
+    except (OSError, UnicodeDecodeError):
+        return None
+    return lines[line - 1] if 0 < line <= len(lines) else None
+
+
+@lru_cache(maxsize=16)
+def _source_lines(file: str, stamp: tuple[int, int]) -> tuple[str, ...]:
+    return tuple(Path(file).read_text(encoding="utf-8").split("\n"))
