@@ -4,9 +4,8 @@ A mesh value is a source file plus a chain of mesh ops. Each distinct value goes
 `meshes/<format>/<basename>` (extension in lower case; `_mirrored` added for a
 reflected mesh, as Phobos names them). Two different values with the same name are
 told apart by a content hash in their names; a value used twice is written once.
-A mesh without ops is copied byte for byte; one with ops is computed with trimesh.
-Converting between formats is not done here yet: a mesh without ops whose format
-differs from the export's is a diagnostic.
+A mesh without ops in the export's format is copied byte for byte; one with ops, or in
+another format, is computed with trimesh (DAE through pycollada, with its unit).
 """
 
 from __future__ import annotations
@@ -57,14 +56,19 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:10]
 
 
+# Extensions of the formats the language names; `mars_obj` is OBJ content (Phobos's intended
+# axis change was never written), `bobj` is Phobos's binary OBJ, which trimesh cannot write.
+EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply"}
+
+
 def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[MeshKey, str] | None:
     """Map each mesh value to its path in the output (relative, `meshes/<fmt>/<name>`).
 
-    Reports meshes that cannot be found or would need a conversion; None if any.
+    A mesh in another format than the export's, or with ops, is computed with trimesh at
+    `copy`; an unchanged one is copied. Reports meshes that cannot be found; None if any.
     """
     ok = True
     wanted: dict[MeshKey, str] = {}
-    conversions: dict[str, MeshUse] = {}
     for use in mesh_uses(robot):
         src = use.mesh.source
         span = use.mesh.span or export_span
@@ -83,19 +87,14 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
             ok = False
             continue
         fmt = src.format if mesh_format == KEEP_FORMAT else mesh_format
-        if use.mesh.ops:
-            fmt = fmt if fmt in WRITABLE else "stl"
-        elif fmt != src.format:
-            conversions.setdefault(src.format, use)
-            continue
+        if fmt not in EXTENSIONS or (mesh_format == KEEP_FORMAT and use.mesh.ops and fmt not in WRITABLE):
+            if mesh_format != KEEP_FORMAT:
+                sink.error(export_span, "E0501", f"writing '{fmt}' meshes is not supported yet",
+                           hint="stl, obj, dae and mars_obj are")
+                return None
+            fmt = "stl"  # a computed mesh whose own format trimesh cannot write
         stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
-        wanted[k] = f"meshes/{fmt}/{stem}.{fmt}"
-    for fmt, use in sorted(conversions.items()):
-        sink.error(export_span, "E0501", f"converting '{fmt}' meshes to '{mesh_format}' is not "
-                   f"supported yet (first: '{use.mesh.source.uri}' of link '{use.link}')",
-                   notes=((use.mesh.span, "the mesh is used here"),),
-                   hint="use `mesh_format: input_type` to keep each mesh's own format")
-        ok = False
+        wanted[k] = f"meshes/{fmt}/{stem}.{EXTENSIONS[fmt]}"
     if not ok:
         return None
     return _disambiguate(wanted)
@@ -141,7 +140,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) ->
         dest.parent.mkdir(parents=True, exist_ok=True)
         if dest.exists():
             continue
-        if not ops:
+        if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
+                and not dest.name.endswith(".mars.obj"):
             shutil.copyfile(src, dest)
             continue
         problem = _materialise(src, ops, dest)
@@ -160,6 +160,6 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
         mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
     except MeshError as e:
         return str(e)
-    data = mesh.export(file_type=dest.suffix[1:])
+    data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     dest.write_bytes(data if isinstance(data, bytes) else data.encode())
     return None

@@ -3,6 +3,8 @@ primitives, centres of mass from collision volumes. Imported only by those ops."
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import trimesh
 
@@ -32,6 +34,8 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
             raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
         try:
             mesh = trimesh.load(path, force="mesh", process=False)
+            if path.suffix.lower() == ".dae":
+                mesh.apply_scale(_collada_unit(path))
         except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
             raise MeshError(f"cannot read mesh '{path}': {e}") from None
     for op in geometry.ops:
@@ -107,3 +111,12 @@ def scaled(shape: Geometry, factor: float) -> Geometry:
         return Cylinder(radius=factor * shape.radius, length=factor * shape.length)
     assert isinstance(shape, Sphere)
     return Sphere(radius=factor * shape.radius)
+
+
+def _collada_unit(path: Path) -> float:
+    """Metres per unit of a COLLADA file (its <unit meter=…>), 1 when it has none."""
+    import re
+
+    head = path.read_bytes()[:4096].decode("utf-8", errors="replace")
+    m = re.search(r"<unit\b[^>]*\bmeter=\"([0-9.eE+-]+)\"", head)
+    return float(m.group(1)) if m else 1.0

@@ -61,7 +61,27 @@ class UrdfExport:
     type: Literal["urdf"] = "urdf"
 
 
-Export = UrdfExport
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SdfExport:
+    """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format` (as for URDF)."""
+
+    mesh_format: str
+    span: Span
+    version: Literal["1.6", "1.7", "1.9"] = "1.9"
+    type: Literal["sdf"] = "sdf"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MjcfExport:
+    """A `type: mjcf` entry: MuJoCo's format; meshes in `mesh_format` (stl or obj: MuJoCo
+    reads no DAE)."""
+
+    mesh_format: str
+    span: Span
+    type: Literal["mjcf"] = "mjcf"
+
+
+Export = UrdfExport | SdfExport | MjcfExport
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -238,13 +238,25 @@ def test_unknown_package(tmp_path: Path, diags: Diags) -> None:
                                 "cannot be found: package 'nowhere' was not found")
 
 
-def test_mesh_that_would_need_a_conversion(tmp_path: Path, diags: Diags) -> None:
+def test_mesh_format_that_cannot_be_written(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
-    _compile(tmp_path, diags, definition("arm.urdf", "obj"))
+    _compile(tmp_path, diags, definition("arm.urdf", "bobj"))
     d = diags.take_error("E0501")
-    assert d.message == ("converting 'stl' meshes to 'obj' is not supported yet "
-                         "(first: 'meshes/tetra.stl' of link 'base')")
+    assert d.message == "writing 'bobj' meshes is not supported yet"
     assert _where(d) == (10, 7)
+
+
+def test_meshes_are_converted(tmp_path: Path) -> None:
+    import trimesh
+
+    arm(tmp_path)
+    spec = write(tmp_path / "model.yml", definition("arm.urdf", "obj"))
+    out = compile_file(spec, tmp_path / "out", Diags()).out
+    assert out is not None
+    converted = trimesh.load(out / "meshes/obj/tetra.obj", force="mesh")
+    original = trimesh.load(tmp_path / "meshes/tetra.stl", force="mesh")
+    assert len(converted.faces) == 4
+    assert abs(converted.volume - original.volume) < 1e-9
 
 
 # -- nothing already built is lost -----------------------------------------------------------
