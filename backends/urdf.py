@@ -74,4 +74,4 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     def mesh_name(mesh: Mesh) -> str:
         return "../" + files[meshes.key(mesh)]
 
-    write_path(out / "urdf" / f"{robot.name}.urdf", to_string(robot, mesh_name))
+    write_path(out / "urdf" / f"{export.filename or robot.name}.urdf", to_string(robot, mesh_name))

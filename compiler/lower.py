@@ -9,6 +9,7 @@ reported through `later` (an error for `compile`, a warning for `check`).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +22,7 @@ from mpc.compiler.schema.assembly import AssembleChild, AttachJoint, NameEditing
 from mpc.compiler.schema.base import Node
 from mpc.ir.naming import SCOPES, NameRule, bad_pattern, edit_name
 from mpc.ir.ops import ROOT, Attach, EditNames, LoadModel, Mirror, Op, RemoveBeyond, SetRobotName, TakeLeaf
-from mpc.ir.program import Input, Program, RepoRef, UrdfExport
+from mpc.ir.program import Export, Input, Program, RepoRef, UrdfExport
 from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
@@ -229,24 +230,31 @@ class _Lowering:
 
     # -- the rest --------------------------------------------------------------------------
 
-    def exports(self) -> tuple[UrdfExport, ...]:
+    def exports(self) -> tuple[Export, ...]:
         if self.model.export_config is None:
             return (UrdfExport(mesh_format="input_type", span=self.model.span),)
-        out = []
+        out: list[Export] = []
+        written: dict[str, Export] = {}
         for entry in self.model.export_config:
-            if entry.type != "urdf":
+            if entry.type not in BUILT_EXPORTS:
                 self.not_yet(entry.value_span("type"), f"export type '{entry.type}'")
                 continue
-            for key, default in _URDF_DEFAULTS.items():
+            for key, default in _KINEMATIC_LATER.items():
                 if getattr(entry, key) != default:
-                    self.not_yet(entry.key_span(key), f"urdf export option '{key}'")
-            if out:
-                self.sink.error(entry.span, "E0503", "a second urdf export would overwrite "
-                                f"urdf/{self.model.robotname}.urdf (Phobos silently did); "
-                                "filename_suffix, which tells them apart, is not supported yet",
-                                notes=((out[0].span, "the first urdf export"),))
+                    self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
+            filename = (entry.filename or self.model.robotname) + entry.filename_suffix
+            target = f"{entry.type}/{filename}"
+            if target in written:
+                self.sink.error(entry.span, "E0503", f"two {entry.type} exports would write {target} "
+                                "(Phobos silently let the last one win); give one a filename_suffix",
+                                notes=((written[target].span, "the other export"),))
                 continue
-            out.append(UrdfExport(mesh_format=entry.mesh_format, span=entry.span))
+            export = BUILT_EXPORTS[entry.type](mesh_format=entry.mesh_format, span=entry.span,
+                                               filename=filename if filename != self.model.robotname else "")
+            if entry.type == "sdf":
+                export = replace(export, version=entry.version)
+            written[target] = export
+            out.append(export)
         return tuple(out)
 
     def program(self) -> Program:
@@ -270,11 +278,13 @@ class _Lowering:
                        inputs=inputs, ops=tuple(self.ops), exports=exports, span=self.model.span)
 
 
-_URDF_DEFAULTS: dict[str, Any] = {
+# Export types `mpc compile` writes; the others are reported as not supported yet.
+BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport}
+# Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
+_KINEMATIC_LATER: dict[str, Any] = {
     "additional_meshes": None, "link_in_smurf": False, "include_cut_joints": False,
-    "filename_suffix": "", "filename": None, "ros_pathes": False, "copy_with_other_pathes": False,
-    "enforce_zero": False, "add_floating_base": False, "correct_inertials": False,
-    "float_fmt_dict": None,
+    "ros_pathes": False, "copy_with_other_pathes": False, "enforce_zero": False,
+    "add_floating_base": False, "correct_inertials": False, "float_fmt_dict": None,
 }
 
 

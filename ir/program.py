@@ -53,11 +53,14 @@ class UrdfExport:
 
     mesh_format: the format of the meshes it references (`input_type` keeps each
     mesh's own format).
+    filename: the file's name without extension ("" for the robot's name), with
+    `filename_suffix` appended.
     span: the export_config entry.
     """
 
     mesh_format: str
     span: Span
+    filename: str = ""
     type: Literal["urdf"] = "urdf"
 
 
@@ -67,6 +70,7 @@ class SdfExport:
 
     mesh_format: str
     span: Span
+    filename: str = ""
     version: Literal["1.6", "1.7", "1.9"] = "1.9"
     type: Literal["sdf"] = "sdf"
 
@@ -78,6 +82,7 @@ class MjcfExport:
 
     mesh_format: str
     span: Span
+    filename: str = ""
     type: Literal["mjcf"] = "mjcf"
 
 

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Install everything mpc and its tests need on a fresh Debian machine:
-# Debian's check_urdf (liburdfdom-tools), then mpc itself with its dev extra
-# (pytest, hypothesis, Pinocchio, example-robot-data, ruff), editable.
+# Debian's check_urdf (liburdfdom-tools) and sdformat 12 tools (`ign sdf`), then mpc
+# itself with its dev extra (pytest, hypothesis, Pinocchio, MuJoCo, example-robot-data,
+# ruff), editable.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
-if ! command -v check_urdf >/dev/null; then
+if ! command -v check_urdf >/dev/null || ! command -v ign >/dev/null; then
   $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq liburdfdom-tools >/dev/null
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq liburdfdom-tools ignition-tools \
+    libsdformat12-12 sdformat-sdf libsdformat-dev >/dev/null
 fi
 python3 -m pip install -q --disable-pip-version-check -e '.[dev]'
