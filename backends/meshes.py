@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import filecmp
 import hashlib
+import os
 import shutil
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -24,6 +25,7 @@ from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 KEEP_FORMAT = "input_type"
+ENGINE = "1"  # changes when the way meshes are computed changes, so old cache entries go unused
 WRITABLE = ("stl", "obj", "dae", "ply")  # formats trimesh writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
@@ -133,26 +135,64 @@ def _digest(k: MeshKey) -> str:
 
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) -> bool:
-    """Write each planned mesh into `out`: a copy, or the result of its ops."""
+    """Write each planned mesh into `out`: a copy of the file, or the result of its ops.
+
+    Results are kept in a content-addressed cache (compiler/cache.py: `meshes/`), keyed by
+    the source's bytes, the ops and the format, and computed in parallel (a process pool)
+    when several are missing; a later build with the same inputs only copies them.
+    """
     ok = True
+    todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
+    plan_: list[tuple[Path, Path, str]] = []
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
         dest = out / rel
-        dest.parent.mkdir(parents=True, exist_ok=True)
         if dest.exists():
             continue
         if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
                 and not dest.name.endswith(".mars.obj"):
-            shutil.copyfile(src, dest)
+            plan_.append((src, dest, rel))
             continue
-        problem = _materialise(src, ops, dest)
-        if problem:
-            sink.error(export_span, "E0603", f"cannot compute mesh '{rel}' from '{src}': {problem}")
+        cached = _cached_path(src, ops, dest.suffix)
+        if not cached.is_file():
+            todo[cached] = (src, ops, cached)
+        plan_.append((cached, dest, rel))
+    problems = _compute(list(todo.values()))
+    for source, dest, rel in plan_:
+        if source in problems:
+            sink.error(export_span, "E0603", f"cannot compute mesh '{rel}' from "
+                       f"'{todo[source][0]}': {problems[source]}")
             ok = False
+            continue
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, dest)
     return ok
 
 
+def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
+    from mpc.compiler.cache import cache_dir
+
+    h = hashlib.sha256(src.read_bytes())
+    h.update(f"{ENGINE}|{ops!r}|{suffix}".encode())
+    digest = h.hexdigest()
+    return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
+
+
+def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, str]:
+    """Materialise each job into its cache path; {cache path: problem} for those that failed."""
+    if len(jobs) < 4:
+        results = [_materialise(*job) for job in jobs]
+    else:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        workers = min(len(jobs), os.cpu_count() or 1)
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+            results = list(pool.map(_materialise, *zip(*jobs, strict=True)))
+    return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
+
+
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
-    """Apply `ops` to the mesh in `src` and write it to `dest`; why not, or None."""
+    """Apply `ops` to the mesh in `src` and write it to `dest` atomically; why not, or None."""
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
@@ -161,5 +201,8 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
     except MeshError as e:
         return str(e)
     data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
-    dest.write_bytes(data if isinstance(data, bytes) else data.encode())
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
+    partial.write_bytes(data if isinstance(data, bytes) else data.encode())
+    os.replace(partial, dest)
     return None

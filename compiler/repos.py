@@ -15,20 +15,14 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from mpc.compiler.cache import cache_dir
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.program import RepoRef
 from mpc.ir.span import Span
 
 
-def cache_root() -> Path:
-    if os.environ.get("MPC_CACHE_DIR"):
-        return Path(os.environ["MPC_CACHE_DIR"]) / "repos"
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "mpc" / "repos"
-
-
 def _slot(url: str) -> Path:
-    return cache_root() / hashlib.sha256(url.encode()).hexdigest()[:16]
+    return cache_dir("repos") / hashlib.sha256(url.encode()).hexdigest()[:16]
 
 
 def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path | None:

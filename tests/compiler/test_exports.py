@@ -44,3 +44,31 @@ def test_two_exports_of_one_file_are_refused(tmp_path: Path, diags: Diags) -> No
     assert d.message == ("two urdf exports would write urdf/arm (Phobos silently let the last one win); "
                          "give one a filename_suffix")
     assert (d.span.line, d.span.col, d.notes[0][0].line) == (9, 7, 8)
+
+
+def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """talos with STL and OBJ exports: the OBJ meshes are computed once, then only copied."""
+    from tests.conftest import ERD
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    spec = write(tmp_path / "t.yml", f"""
+        model:
+          robotname: talos
+          modelname: talos-two-formats
+          input_models: {{talos: {{basefile: "{ERD / 'talos_data/robots/talos_full_v2.urdf'}"}}}}
+          assemble: {{model: talos}}
+          export_config:
+            - {{type: urdf, mesh_format: stl}}
+            - {{type: urdf, mesh_format: obj, filename_suffix: _obj}}
+        """)
+    first = compile_file(spec, tmp_path / "a", Diags()).out
+    assert first is not None
+    cache = {p: p.stat().st_mtime_ns for p in (tmp_path / "cache/meshes").rglob("*") if p.is_file()}
+    assert len(cache) == 48  # every OBJ, computed once; the STL files are copied
+    second = compile_file(spec, tmp_path / "b", Diags()).out
+    assert second is not None
+    again = {p: p.stat().st_mtime_ns for p in (tmp_path / "cache/meshes").rglob("*") if p.is_file()}
+    assert again == cache  # nothing was computed again
+    files = sorted(p.relative_to(first) for p in first.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(second) for p in second.rglob("*") if p.is_file())
+    assert all((first / f).read_bytes() == (second / f).read_bytes() for f in files)
