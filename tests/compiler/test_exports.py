@@ -47,7 +47,8 @@ def test_two_exports_of_one_file_are_refused(tmp_path: Path, diags: Diags) -> No
     assert (d.span.line, d.span.col, d.notes[0][0].line) == (9, 7, 8)
 
 
-def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
     """talos with STL and OBJ exports: the OBJ meshes are computed once, then only copied."""
     from tests.conftest import ERD
 
