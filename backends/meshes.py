@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, MeshOp, ReflectMesh
+from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, MeshOp, ReduceMesh, ReflectMesh, ScaleMesh
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
@@ -102,7 +102,8 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
     return _disambiguate(wanted)
 
 
-_SUFFIXES = {ReflectMesh: "_mirrored", ConvexHull: "_hull", JoinShapes: "_joined"}
+_SUFFIXES = {ReflectMesh: "_mirrored", ConvexHull: "_hull", JoinShapes: "_joined", ReduceMesh: "_reduced",
+             ScaleMesh: "_scaled"}
 
 
 def _suffix(ops: tuple[MeshOp, ...]) -> str:

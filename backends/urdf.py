@@ -14,6 +14,7 @@ from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.geometry import Mesh
+from mpc.ir.numbers import zero_small
 from mpc.ir.program import UrdfExport
 from mpc.ir.robot import Robot
 
@@ -70,8 +71,15 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span):
         return
+    for fmt in export.additional_meshes:  # written beside, referenced by nothing
+        extra = meshes.plan(robot, fmt, sink, export.span)
+        if extra is None or not meshes.copy(extra, out, sink, export.span):
+            return
+    if export.enforce_zero:
+        robot = zero_small(robot)
+    prefix = f"package://{export.ros_package}/" if export.ros_package else "../"
 
     def mesh_name(mesh: Mesh) -> str:
-        return "../" + files[meshes.key(mesh)]
+        return prefix + files[meshes.key(mesh)]
 
     write_path(out / "urdf" / f"{export.filename or robot.name}.urdf", to_string(robot, mesh_name))

@@ -85,7 +85,22 @@ class JoinShapes:
     parts: tuple[tuple[Geometry, Vec3, Vec3], ...]
 
 
-MeshOp = ReflectMesh | ConvexHull | JoinShapes
+@dataclass(frozen=True, slots=True)
+class ReduceMesh:
+    """Mesh op: quadric decimation to `faces` faces, or to `ratio` of them (one is given)."""
+
+    faces: int | None = None
+    ratio: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class ScaleMesh:
+    """Mesh op: scale the vertices (`apply_scale` bakes an element's scale into its file)."""
+
+    scale: Vec3
+
+
+MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -9,7 +9,18 @@ import numpy as np
 import trimesh
 
 from mpc.ir import transforms as tf
-from mpc.ir.geometry import Box, ConvexHull, Cylinder, Geometry, JoinShapes, Mesh, ReflectMesh, Sphere
+from mpc.ir.geometry import (
+    Box,
+    ConvexHull,
+    Cylinder,
+    Geometry,
+    JoinShapes,
+    Mesh,
+    ReduceMesh,
+    ReflectMesh,
+    ScaleMesh,
+    Sphere,
+)
 
 
 class MeshError(Exception):
@@ -45,6 +56,12 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
             mesh.apply_transform(T)  # trimesh reverses the winding for a reflection
         elif isinstance(op, ConvexHull):
             mesh = mesh.convex_hull
+        elif isinstance(op, ReduceMesh):
+            target = op.faces if op.faces is not None else int(len(mesh.faces) * (op.ratio or 1.0))
+            if 4 <= target < len(mesh.faces):
+                mesh = mesh.simplify_quadric_decimation(face_count=target)
+        elif isinstance(op, ScaleMesh):
+            mesh.apply_scale(np.asarray(op.scale))
         elif isinstance(op, JoinShapes):
             pieces = [] if mesh is None else [mesh]
             for shape, xyz, rpy in op.parts:

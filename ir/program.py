@@ -55,12 +55,18 @@ class UrdfExport:
     mesh's own format).
     filename: the file's name without extension ("" for the robot's name), with
     `filename_suffix` appended.
+    additional_meshes: further formats the meshes are written in (not referenced).
+    ros_package: when given, meshes are referenced as `package://<ros_package>/meshes/…`.
+    enforce_zero: numbers closer to zero than 1e-12 are written as 0.
     span: the export_config entry.
     """
 
     mesh_format: str
     span: Span
     filename: str = ""
+    additional_meshes: tuple[str, ...] = ()
+    ros_package: str | None = None
+    enforce_zero: bool = False
     type: Literal["urdf"] = "urdf"
 
 

@@ -133,6 +133,7 @@ from mpc.ir.ops.joints import (  # noqa: E402
     ReplaceJointTypes,
     SetMotor,
 )
+from mpc.ir.ops.meshes import ApplyScale, ReduceMeshes  # noqa: E402
 from mpc.ir.ops.robot import SetRobotName  # noqa: E402
 
 __all__ = [
@@ -145,6 +146,7 @@ __all__ = [
     "AddSensor",
     "AddSubmechanism",
     "AnnotateLinks",
+    "ApplyScale",
     "Attach",
     "AutoBitmask",
     "CompleteSubmechanisms",
@@ -162,6 +164,7 @@ __all__ = [
     "MoveJointAxisToIntersection",
     "Names",
     "Op",
+    "ReduceMeshes",
     "Ref",
     "RemoveBeyond",
     "RemoveJoint",

@@ -74,3 +74,37 @@ def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path,
     files = sorted(p.relative_to(first) for p in first.rglob("*") if p.is_file())
     assert files == sorted(p.relative_to(second) for p in second.rglob("*") if p.is_file())
     assert all((first / f).read_bytes() == (second / f).read_bytes() for f in files)
+
+
+def test_urdf_options_and_mesh_ops(tmp_path: Path) -> None:
+    """additional_meshes, ros_pathes, enforce_zero; reduce_meshes keeps at most the faces asked;
+    apply_scale bakes the scale into the file."""
+    import trimesh
+
+    from tests.conftest import ERD
+
+    source = ERD / "talos_data/robots/talos_left_arm.urdf"
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: arm
+          modelname: arm-pkg
+          input_models: {{arm: {{basefile: "{source}"}}}}
+          assemble: {{model: arm}}
+          reduce_meshes: 300
+          apply_scale: true
+          frames:
+            arm_left_2_link: {{transform_frame: {{xyz: [0, 0, 1e-17]}}}}
+          export_config:
+            - {{type: urdf, mesh_format: stl, additional_meshes: obj, ros_pathes: true, enforce_zero: true}}
+        """)
+    out = compile_file(spec, tmp_path / "out", Diags()).out
+    assert out is not None
+    root = etree.parse(str(out / "urdf/arm.urdf")).getroot()
+    filenames = [m.get("filename") for m in root.iter("mesh")]
+    assert filenames and all(f.startswith("package://arm-pkg/meshes/stl/") for f in filenames)
+    assert all(m.get("scale") is None for m in root.iter("mesh"))
+    assert sorted(p.stem for p in (out / "meshes/obj").iterdir()) == sorted(
+        p.stem for p in (out / "meshes/stl").iterdir())
+    for stl in (out / "meshes/stl").iterdir():
+        assert len(trimesh.load(stl, force="mesh").faces) <= 300
+    assert "1e-17" not in (out / "urdf/arm.urdf").read_text()
