@@ -7,6 +7,7 @@ from types import ModuleType
 
 _MODULES = {
     "urdf": "mpc.backends.urdf",
+    "mjcf": "mpc.backends.mjcf",
 }
 
 

@@ -201,6 +201,8 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
         mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
     except MeshError as e:
         return str(e)
+    if len(mesh.faces) == 0:  # e.g. pycollada failed on a texture and trimesh gave an empty scene
+        return "it has no triangles after reading"
     data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     dest.parent.mkdir(parents=True, exist_ok=True)
     partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")

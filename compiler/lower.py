@@ -34,7 +34,7 @@ from mpc.ir.ops import (
     SetRobotName,
     TakeLeaf,
 )
-from mpc.ir.program import Export, Input, Program, RepoRef, UrdfExport
+from mpc.ir.program import Export, Input, MjcfExport, Program, RepoRef, UrdfExport
 from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
@@ -282,7 +282,10 @@ class _Lowering:
                                 "(Phobos silently let the last one win); give one a filename_suffix",
                                 notes=((written[target].span, "the other export"),))
                 continue
-            export = BUILT_EXPORTS[entry.type](mesh_format=entry.mesh_format, span=entry.span,
+            mesh_format = entry.mesh_format
+            if entry.type == "mjcf" and mesh_format == "input_type":
+                mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
+            export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                                filename=filename if filename != self.model.robotname else "")
             if entry.type == "sdf":
                 export = replace(export, version=entry.version)
@@ -319,7 +322,7 @@ class _Lowering:
 
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.
-BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport}
+BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
     "link_in_smurf": False, "include_cut_joints": False, "copy_with_other_pathes": False,

@@ -108,3 +108,29 @@ def test_urdf_options_and_mesh_ops(tmp_path: Path) -> None:
     for stl in (out / "meshes/stl").iterdir():
         assert len(trimesh.load(stl, force="mesh").faces) <= 300
     assert "1e-17" not in (out / "urdf/arm.urdf").read_text()
+
+
+def test_mjcf_export_from_the_command_line(tmp_path: Path) -> None:
+    """A definition with an mjcf export: MuJoCo loads it; its mass is Pinocchio's."""
+    import mujoco
+    import pinocchio as pin
+
+    from tests.backends.pin_compare import load
+    from tests.conftest import ERD
+
+    source = ERD / "solo_description/robots/solo12.urdf"
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: solo
+          modelname: solo-sim
+          input_models: {{solo: {{basefile: "{source}"}}}}
+          assemble: {{model: solo}}
+          export_config:
+            - {{type: urdf}}
+            - {{type: mjcf}}
+        """)
+    out = compile_file(spec, tmp_path / "out", Diags()).out
+    assert out is not None
+    model = mujoco.MjModel.from_xml_path(str(out / "mjcf/solo.xml"))
+    assert abs(mujoco.mj_getTotalmass(model) - pin.computeTotalMass(load(source))) < 1e-9
+    assert (out / "meshes/obj").is_dir()  # MuJoCo reads no DAE: mjcf meshes default to OBJ

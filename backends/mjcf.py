@@ -1,0 +1,402 @@
+"""ir.Robot → canonical MJCF (MuJoCo's format): `<out>/mjcf/<robot>.xml`, meshes (stl or obj)
+in `<out>/meshes/<fmt>/`. It does not read MJCF, nor fix inertias, nor write what MJCF cannot
+hold (fragments, sensors, velocity limits, …): one W0500 names those.
+
+The root link is a body fixed to the world (no joint), as in Pinocchio with a fixed base;
+a free-floating robot needs a `floating` joint in the IR. A root link named `world` is
+MuJoCo's world body itself. Bodies nest depth-first, children by joint name; a body sits at
+its joint's origin, the joint at the body's origin, the axis as in URDF. revolute → hinge with
+range, continuous → hinge, prismatic → slide, fixed → no joint (a welded body), floating →
+freejoint (its body hoisted to the world; deeper down: three slides and a ball), planar → two
+slides and a hinge. Mimic → `<equality><joint>` with joint1 = offset + multiplier·joint2 (polycoef);
+cut joints → `<connect>` at their origin (`<weld>` for fixed ones); motors → `<motor>`.
+
+Inertia: `diaginertia` in the principal frame (`quat`), diagonalised here, so that MuJoCo
+checks exactly the numbers written (eigenvalues within 1e-12 of the largest are round-off,
+written as 0); `fullinertia` would refuse a zero inertia (a massless link) even on a welded
+body. `check` reports (E0504) what MuJoCo would refuse or change. `<compiler>` pins every
+setting that could change an inertia silently: angle radian (URDF's unit); autolimits (a range
+limits its joint); inertiafromgeom false (else a link without inertial gets its geoms' mass);
+balanceinertia false (else A + B < C is averaged away); boundmass and boundinertia 0 (no
+floor; 0 still clamps negatives, hence `check`); fusestatic false (else welded bodies merge
+and the root joins the world, its mass lost); discardvisual false (keep visual geoms).
+Meshes get inertia="shell": MuJoCo computes every mesh's inertia, though none is used here,
+and refuses a mesh of too small a volume (open or flat visual meshes).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from mpc.backends import meshes
+from mpc.backends.xml import fmt_float, fmt_floats, write_path
+from mpc.compiler.diagnostics import Sink
+from mpc.ir import transforms as tf
+from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
+from mpc.ir.program import MjcfExport
+from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
+from mpc.ir.span import Span
+from mpc.ir.tree import child_joints, depth_first
+
+__all__ = ["check", "emit", "left_out", "to_string"]
+
+Quat = tuple[float, float, float, float]
+Pairs = list[tuple[str, str | None]]
+MJMINVAL = 1e-15  # MuJoCo's mjMINVAL: the least mass and inertia of a moving body
+IND = "  "
+COMPILER: Pairs = [("angle", "radian"), ("autolimits", "true"), ("inertiafromgeom", "false"),
+            ("balanceinertia", "false"), ("boundmass", "0"), ("boundinertia", "0"),
+            ("fusestatic", "false"), ("discardvisual", "false")]
+
+
+def _attrs(pairs: Pairs) -> str:
+    return "".join(f' {k}="{escape(v, {chr(34): "&quot;"})}"' for k, v in pairs if v is not None)
+
+
+def _quat_rpy(rpy: tuple[float, float, float]) -> Quat:
+    """(w, x, y, z) of URDF's fixed-axis rpy, R = Rz·Ry·Rx; w ≥ 0."""
+    cr, sr = math.cos(rpy[0] / 2), math.sin(rpy[0] / 2)
+    cp, sp = math.cos(rpy[1] / 2), math.sin(rpy[1] / 2)
+    cy, sy = math.cos(rpy[2] / 2), math.sin(rpy[2] / 2)
+    q = (cy * cp * cr + sy * sp * sr, cy * cp * sr - sy * sp * cr,
+         cy * sp * cr + sy * cp * sr, sy * cp * cr - cy * sp * sr)
+    return q if q[0] >= 0 else (-q[0], -q[1], -q[2], -q[3])
+
+
+def _quat_matrix(R: np.ndarray) -> Quat:
+    """(w, x, y, z) of a rotation matrix; w ≥ 0."""
+    x, y, z, w = (float(c) for c in Rotation.from_matrix(R).as_quat())
+    return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)
+
+
+def _pose_pairs(pose: Pose | None) -> Pairs:
+    """pos and quat of a pose, each left out when it is the identity (MJCF's default)."""
+    if pose is None:
+        return []
+    q = _quat_rpy(pose.rpy)
+    return [("pos", fmt_floats(pose.xyz) if any(pose.xyz) else None),
+            ("quat", fmt_floats(q) if q != (1.0, 0.0, 0.0, 0.0) else None)]
+
+
+def principal(inertial: Inertial) -> tuple[tuple[float, float, float], Quat]:
+    """The principal moments and the principal frame (in the link frame) of an inertial."""
+    i = inertial.inertia
+    rpy = inertial.origin.rpy if inertial.origin is not None else (0.0, 0.0, 0.0)
+    if i.ixy == 0 and i.ixz == 0 and i.iyz == 0:
+        return (i.ixx, i.iyy, i.izz), _quat_rpy(rpy)
+    I_c = np.array([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]])
+    w, V = np.linalg.eigh(I_c)
+    if np.linalg.det(V) < 0:
+        V[:, 2] = -V[:, 2]
+    big = float(np.max(np.abs(w)))
+    d = tuple(0.0 if abs(x) <= 1e-12 * big else float(x) for x in w)
+    return d, _quat_matrix(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
+
+
+def _mass_ok(inertial: Inertial | None) -> bool:
+    return inertial is not None and inertial.mass >= MJMINVAL and min(principal(inertial)[0]) >= MJMINVAL
+
+
+def check(robot: Robot, sink: Sink, span: Span) -> bool:
+    """Report (E0504) each link whose mass properties MuJoCo would refuse or change, by its
+    rules: mass and principal moments not negative (MuJoCo clamps them to 0), moments
+    satisfying A + B ≥ C (on every body), and a moving body's mass and moments at least
+    mjMINVAL unless a body welded below it has both. The MJCF is written anyway."""
+    children, ok = child_joints(robot), True
+    moving = {j.child for j in robot.joints.values() if j.type != "fixed"}
+
+    def welded_mass(link: str) -> bool:
+        return any(j.type == "fixed" and (_mass_ok(robot.links[j.child].inertial) or welded_mass(j.child))
+                   for j in children.get(link, []))
+
+    for _, link in depth_first(robot):
+        inertial = robot.links[link].inertial
+        if link == robot.root == "world":
+            continue
+        problems = []
+        if inertial is not None:
+            d, _ = principal(inertial)
+            a, b, c = sorted(d)
+            if inertial.mass < 0:
+                problems.append(f"its mass {fmt_float(inertial.mass)} is negative")
+            if a < 0:
+                problems.append(f"its inertia is not positive semi-definite (principal moment "
+                                f"{fmt_float(a)})")
+            elif a + b < c:
+                problems.append(f"its principal moments violate A + B ≥ C ({fmt_float(a)} + "
+                                f"{fmt_float(b)} < {fmt_float(c)})")
+        if link in moving and not _mass_ok(inertial) and not welded_mass(link):
+            problems.append(f"it moves but its mass or a principal moment is below mjMINVAL "
+                            f"({MJMINVAL:g}) and no link welded to it carries mass")
+        if problems:
+            sink.error(robot.links[link].span or span, "E0504", f"link '{link}' has mass properties "
+                       f"MuJoCo refuses or changes: {'; '.join(problems)}", hint="fix its inertial")
+            ok = False
+    return ok
+
+
+def _limits(joint: Joint) -> tuple[float, float] | None:
+    """(lower, upper) as URDF means them (a missing one is 0), or None without any."""
+    lim = joint.limit
+    if joint.type not in ("revolute", "prismatic") or lim is None:
+        return None
+    if lim.lower is None and lim.upper is None:
+        return None
+    return (lim.lower or 0.0, lim.upper or 0.0)
+
+
+def _one_dof(joint: Joint | None) -> bool:
+    return joint is not None and joint.type in ("revolute", "continuous", "prismatic")
+
+
+def left_out(robot: Robot) -> list[str]:
+    """What the robot holds that this MJCF does not: fragments, sensors, velocity limits, …"""
+    links, joints = list(robot.links.values()), list(robot.joints.values())
+    shapes: list[Visual | Collision] = [s for lk in links for s in (*lk.visuals, *lk.collisions)]
+    named = Counter(s.name for s in shapes if s.name is not None)
+    materials = [*robot.materials.values(), *(v.inline_material for lk in links for v in lk.visuals
+                                               if v.inline_material is not None)]
+    inner = [f for el in (*links, *joints, *shapes) for f in el.extras] + [
+        f for lk in links if lk.inertial is not None for f in lk.inertial.extras]
+    counts = {
+        ("sensor", "sensors"): len(robot.sensors), ("pose", "poses"): len(robot.poses),
+        ("submechanism", "submechanisms"): len(robot.submechanisms),
+        ("annotation category", "annotation categories"): len(robot.annotations),
+        ("annotated link or joint", "annotated links and joints"):
+            sum(bool(e.annotations) for e in (*links, *joints)),
+        ("annotated visual or collision", "annotated visuals and collisions"):
+            sum(bool(s.annotations) for s in shapes),
+        ("joint velocity limit", "joint velocity limits"):
+            sum(j.limit is not None and j.limit.velocity is not None for j in joints),
+        ("joint calibration", "joint calibrations"): sum(j.calibration is not None for j in joints),
+        ("safety controller", "safety controllers"): sum(j.safety_controller is not None for j in joints),
+        ("empty position range (lower ≥ upper)", "empty position ranges (lower ≥ upper)"):
+            sum((r := _limits(j)) is not None and r[0] >= r[1] for j in joints),
+        ("material texture or property beyond colour", "material textures or properties beyond colour"):
+            sum(m.texture is not None or m.normal_texture is not None or bool(m.annotations) or any(
+                getattr(m, k) is not None for k in ("ambient", "specular", "emissive", "shininess",
+                                                    "transparency")) for m in materials),
+        ("name of a visual or collision used twice", "names of visuals or collisions used twice"):
+            sum(n for n in named.values() if n > 1),
+        ("attribute URDF does not define", "attributes URDF does not define"):
+            sum(len(e.extra_attrs) for e in (*links, *joints, *shapes)),
+        ("mimic of or by a joint without one degree of freedom",
+         "mimics of or by joints without one degree of freedom"): sum(
+            j.mimic is not None and not (_one_dof(j) and _one_dof(robot.joints.get(j.mimic.joint)))
+            for j in joints),
+        ("motor setting", "motor settings"): sum(len(m.settings) for m in robot.motors.values()),
+        ("cut joint constraint axis", "cut joint constraint axes"):
+            sum(len(c.constraint_axes) for c in robot.cut_joints.values()),
+        ("non-fixed cut joint's rotation (a connect is a ball joint)",
+         "non-fixed cut joints' rotations (a connect is a ball joint)"):
+            sum(c.type != "fixed" for c in robot.cut_joints.values()),
+    }
+    out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
+    tags = Counter(f.tag for f in (*robot.fragments, *inner))
+    out += [f"{n} <{tag}> element{'s' * (n != 1)}" for tag, n in sorted(tags.items())]
+    root = robot.links[robot.root]
+    if robot.root == "world" and root.inertial is not None and root.inertial.mass != 0:
+        out.append("the mass of the root link 'world' (MuJoCo's world body has none)")
+    if robot.submechanisms_file:
+        out.append("the submechanisms file")
+    return out
+
+
+class _Writer:
+    def __init__(self, robot: Robot, mesh_name: Callable[[Mesh], str]) -> None:
+        self.robot, self.mesh_name = robot, mesh_name
+        self.out: list[str] = []
+        self.children = child_joints(robot)
+        self.assets: dict[tuple[str, str | None], str] = {}  # (file, scale) → asset name
+        shapes = [s for lk in robot.links.values() for s in (*lk.visuals, *lk.collisions)]
+        counts = Counter(s.name for s in shapes)
+        self.unique_names = {n for n, c in counts.items() if c == 1 and n is not None}
+        # A free joint must be at the top level: its body is hoisted to the world (the root
+        # body sits at the identity, so the joint origin stays right).
+        self.hoisted = {j.name for j in self.children.get(robot.root, [])
+                        if j.type == "floating" and robot.root != "world"}
+
+    def leaf(self, depth: int, tag: str, pairs: Pairs) -> None:
+        self.out.append(f"{IND * depth}<{tag}{_attrs(pairs)}/>")
+
+    def asset(self, mesh: Mesh) -> str:
+        key = (self.mesh_name(mesh), fmt_floats(mesh.scale) if mesh.scale is not None else None)
+        if key not in self.assets:
+            stem = key[0].rsplit("/", 1)[-1].rsplit(".", 1)[0]
+            name, n, taken = stem, 1, set(self.assets.values())
+            while name in taken:
+                name, n = f"{stem}_{n}", n + 1
+            self.assets[key] = name
+        return self.assets[key]
+
+    def _emit_geom(self, depth: int, shape: Visual | Collision) -> None:
+        g = shape.geometry
+        pairs: Pairs = [("name", shape.name if shape.name in self.unique_names else None)]
+        match g:
+            case Box():
+                pairs += [("type", "box"), ("size", fmt_floats([s / 2 for s in g.size]))]
+            case Cylinder():
+                pairs += [("type", "cylinder"), ("size", fmt_floats([g.radius, g.length / 2]))]
+            case Sphere():
+                pairs += [("type", "sphere"), ("size", fmt_float(g.radius))]
+            case Mesh():
+                pairs += [("type", "mesh"), ("mesh", self.asset(g))]
+        pairs += _pose_pairs(shape.origin)
+        if isinstance(shape, Visual):
+            m = shape.inline_material or self.robot.materials.get(shape.material or "")
+            rgba = fmt_floats(m.rgba) if m is not None and m.rgba is not None else None
+            pairs += [("contype", "0"), ("conaffinity", "0"), ("group", "1"), ("rgba", rgba)]
+        else:
+            bits = str(shape.bitmask) if shape.bitmask is not None else None
+            pairs += [("contype", bits), ("conaffinity", bits), ("group", "3")]
+        self.leaf(depth, "geom", pairs)
+
+    def _emit_inertial(self, depth: int, inertial: Inertial) -> None:
+        d, q = principal(inertial)
+        xyz = inertial.origin.xyz if inertial.origin is not None else (0.0, 0.0, 0.0)
+        self.leaf(depth, "inertial", [("pos", fmt_floats(xyz)),
+                                      ("quat", fmt_floats(q) if q != (1.0, 0.0, 0.0, 0.0) else None),
+                                      ("mass", fmt_float(inertial.mass)), ("diaginertia", fmt_floats(d))])
+
+    def _emit_joint(self, depth: int, joint: Joint, top: bool) -> None:
+        axis = joint.axis or (1.0, 0.0, 0.0)
+        dyn = joint.dynamics
+        common: Pairs = [
+            ("damping", fmt_float(dyn.damping) if dyn and dyn.damping else None),
+            ("frictionloss", fmt_float(dyn.friction) if dyn and dyn.friction else None)]
+        effort = joint.limit.effort if joint.limit is not None else None
+        if effort:
+            common.append(("actuatorfrcrange", fmt_floats([-abs(effort), abs(effort)])))
+        if joint.type in ("revolute", "continuous", "prismatic"):
+            r = _limits(joint)
+            rng: Pairs = [("limited", "true"), ("range", fmt_floats(r))] if r and r[0] < r[1] else []
+            kind = "slide" if joint.type == "prismatic" else "hinge"
+            self.leaf(depth, "joint", [("name", joint.name), ("type", kind), ("axis", fmt_floats(axis)),
+                                       *rng, *common])
+        elif joint.type == "floating" and top:
+            self.leaf(depth, "freejoint", [("name", joint.name)])
+        elif joint.type in ("floating", "planar"):
+            n = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+            e1 = np.eye(3)[int(np.argmin(np.abs(n)))]
+            e1 = (e1 - (e1 @ n) * n) / np.linalg.norm(e1 - (e1 @ n) * n)
+            dirs = (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0))) \
+                if joint.type == "floating" else (("x", tuple(e1)), ("y", tuple(np.cross(n, e1))))
+            for suffix, d in dirs:
+                self.leaf(depth, "joint", [("name", f"{joint.name}_{suffix}"), ("type", "slide"),
+                                           ("axis", fmt_floats([float(c) for c in d])), *common])
+            last = ("ball", None) if joint.type == "floating" else ("hinge", fmt_floats(axis))
+            self.leaf(depth, "joint", [("name", f"{joint.name}_rot"), ("type", last[0]),
+                                       ("axis", last[1]), *common])
+
+    def _emit_body(self, depth: int, joint: Joint | None, link: Link, top: bool) -> None:
+        """The link's body at `joint`'s origin: inertial, joint, geoms, then child bodies."""
+        pose = _pose_pairs(joint.origin if joint is not None else None)
+        self.out.append(f"{IND * depth}<body{_attrs([('name', link.name), *pose])}>")
+        d = depth + 1
+        if link.inertial is not None:
+            self._emit_inertial(d, link.inertial)
+        if joint is not None:
+            self._emit_joint(d, joint, top)
+        self._emit_content(d, link)
+        self.out.append(f"{IND * depth}</body>")
+
+    def _emit_content(self, depth: int, link: Link, top: bool = False) -> None:
+        """Geoms, then child bodies; `top`: the children are bodies of the world."""
+        for shape in (*link.visuals, *link.collisions):
+            self._emit_geom(depth, shape)
+        for j in self.children.get(link.name, []):
+            if j.name not in self.hoisted:
+                self._emit_body(depth, j, self.robot.links[j.child], top)
+
+    def _emit_worldbody(self) -> None:
+        root = self.robot.links[self.robot.root]
+        self.out.append(f"{IND}<worldbody>")
+        if root.name == "world":  # the URDF convention for the fixed frame: MuJoCo's world body
+            self._emit_content(2, root, top=True)
+        else:
+            self._emit_body(2, None, root, top=False)
+            for name in sorted(self.hoisted):
+                joint = self.robot.joints[name]
+                self._emit_body(2, joint, self.robot.links[joint.child], top=True)
+        self.out.append(f"{IND}</worldbody>")
+
+    def _emit_equality(self, depth: int = 2) -> None:
+        movable = {n for n, j in self.robot.joints.items() if _one_dof(j)}
+        for name in sorted(movable):
+            m = self.robot.joints[name].mimic
+            if m is not None and m.joint in movable:
+                poly = [m.offset or 0.0, 1.0 if m.multiplier is None else m.multiplier, 0.0, 0.0, 0.0]
+                self.leaf(depth, "joint", [("joint1", name), ("joint2", m.joint),
+                                           ("polycoef", fmt_floats(poly))])
+        for name in sorted(self.robot.cut_joints):
+            c = self.robot.cut_joints[name]
+            if c.type == "fixed":
+                relpose = fmt_floats([*c.origin.xyz, *_quat_rpy(c.origin.rpy)])
+                self.leaf(depth, "weld", [("name", name), ("body1", c.parent), ("body2", c.child),
+                                          ("relpose", relpose)])
+            else:
+                self.leaf(depth, "connect", [("name", name), ("body1", c.parent), ("body2", c.child),
+                                             ("anchor", fmt_floats(c.origin.xyz))])
+
+    def _emit_actuators(self, depth: int = 2) -> None:
+        for name in sorted(self.robot.motors):
+            motor = self.robot.motors[name]
+            joint = self.robot.joints.get(motor.joint)
+            effort = joint.limit.effort if joint is not None and joint.limit is not None else None
+            rng = fmt_floats([-abs(effort), abs(effort)]) if effort else None
+            self.leaf(depth, "motor", [("name", name), ("joint", motor.joint), ("ctrlrange", rng)])
+
+    def document(self) -> str:
+        """Worldbody first: it names the mesh assets, which come before it in the file."""
+        parts = []
+        for emit_part in (self._emit_worldbody, self._emit_equality, self._emit_actuators):
+            self.out = []
+            emit_part()
+            parts.append(self.out)
+        body, equality, actuator = parts
+        self.out = [f'<mujoco{_attrs([("model", self.robot.name)])}>']
+        self.leaf(1, "compiler", COMPILER)
+        assets = [(name, file, scale) for (file, scale), name in self.assets.items()]
+        self.out += [f"{IND}<asset>"] * bool(assets)
+        for name, file, scale in assets:
+            self.leaf(2, "mesh", [("name", name), ("file", file), ("scale", scale), ("inertia", "shell")])
+        self.out += [f"{IND}</asset>"] * bool(assets) + body
+        for tag, lines in (("equality", equality), ("actuator", actuator)):
+            self.out += [f"{IND}<{tag}>", *lines, f"{IND}</{tag}>"] if lines else []
+        return "\n".join([*self.out, "</mujoco>"]) + "\n"
+
+
+def to_string(robot: Robot, mesh_name: Callable[[Mesh], str], sink: Sink | None = None) -> str:
+    """The canonical MJCF text of `robot`; `mesh_name` gives each mesh's file relative to it.
+    With a sink, also reports what MuJoCo would refuse (E0504) and what is left out (W0500)."""
+    if sink is not None:
+        _diagnose(robot, sink, robot.span or Span.of_file(robot.name))
+    return _Writer(robot, mesh_name).document()
+
+
+def _diagnose(robot: Robot, sink: Sink, span: Span) -> None:
+    check(robot, sink, span)
+    missing = left_out(robot)
+    if missing:
+        sink.warning(span, "W0500", "the MJCF leaves out what it cannot hold: " + ", ".join(missing))
+
+
+def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
+    """Write `out/mjcf/<filename or robot.name>.xml`, meshes under `out/meshes/<stl|obj>/`."""
+    if export.mesh_format not in ("stl", "obj"):
+        sink.error(export.span, "E0501", f"MuJoCo reads no '{export.mesh_format}' meshes",
+                   hint="use mesh_format stl or obj for an mjcf export")
+        return
+    _diagnose(robot, sink, export.span)
+    files = meshes.plan(robot, export.mesh_format, sink, export.span)
+    if files is None or not meshes.copy(files, out, sink, export.span):
+        return
+    text = to_string(robot, lambda mesh: "../" + files[meshes.key(mesh)])
+    write_path(out / "mjcf" / f"{export.filename or robot.name}.xml", text)
