@@ -8,6 +8,7 @@ from types import ModuleType
 _MODULES = {
     "urdf": "mpc.backends.urdf",
     "mjcf": "mpc.backends.mjcf",
+    "sdf": "mpc.backends.sdf",
 }
 
 

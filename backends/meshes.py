@@ -19,7 +19,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, MeshOp, ReduceMesh, ReflectMesh, ScaleMesh
+from mpc.ir.geometry import (
+    ConvexHull,
+    ConvexPart,
+    JoinShapes,
+    Mesh,
+    MeshOp,
+    ReduceMesh,
+    ReflectMesh,
+    ScaleMesh,
+)
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
@@ -106,8 +115,12 @@ _SUFFIXES = {ReflectMesh: "_mirrored", ConvexHull: "_hull", JoinShapes: "_joined
              ScaleMesh: "_scaled"}
 
 
+def _op_suffix(op: MeshOp) -> str:
+    return f"_part{op.index}" if isinstance(op, ConvexPart) else _SUFFIXES[type(op)]
+
+
 def _suffix(ops: tuple[MeshOp, ...]) -> str:
-    return "".join(_SUFFIXES[type(op)] for op in ops)
+    return "".join(_op_suffix(op) for op in ops)
 
 
 def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
@@ -135,12 +148,14 @@ def _digest(k: MeshKey) -> str:
     return h.hexdigest()[:10]
 
 
-def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) -> bool:
+def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
+         robot: Robot | None = None) -> bool:
     """Write each planned mesh into `out`: a copy of the file, or the result of its ops.
 
     Results are kept in a content-addressed cache (compiler/cache.py: `meshes/`), keyed by
     the source's bytes, the ops and the format, and computed in parallel (a process pool)
     when several are missing; a later build with the same inputs only copies them.
+    robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
@@ -158,10 +173,14 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span) ->
             todo[cached] = (src, ops, cached)
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
+    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None and problems else {}
     for source, dest, rel in plan_:
         if source in problems:
-            sink.error(export_span, "E0603", f"cannot compute mesh '{rel}' from "
-                       f"'{todo[source][0]}': {problems[source]}")
+            src, ops, _ = todo[source]
+            use = users.get((src, ops))
+            where = f" of a {use.element} of link '{use.link}'" if use else ""
+            sink.error(use.mesh.span if use and use.mesh.span else export_span, "E0603",
+                       f"cannot compute mesh '{rel}'{where} from '{src}': {problems[source]}")
             ok = False
             continue
         dest.parent.mkdir(parents=True, exist_ok=True)

@@ -396,7 +396,7 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
         return
     _diagnose(robot, sink, export.span)
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None or not meshes.copy(files, out, sink, export.span):
+    if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
     text = to_string(robot, lambda mesh: "../" + files[meshes.key(mesh)])
     write_path(out / "mjcf" / f"{export.filename or robot.name}.xml", text)

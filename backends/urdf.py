@@ -69,11 +69,11 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
         sink.warning(export.span, "W0500", "the URDF leaves out what URDF cannot hold: "
                      + ", ".join(missing) + "; no export that holds them (SMURF) is implemented yet")
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None or not meshes.copy(files, out, sink, export.span):
+    if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
     for fmt in export.additional_meshes:  # written beside, referenced by nothing
         extra = meshes.plan(robot, fmt, sink, export.span)
-        if extra is None or not meshes.copy(extra, out, sink, export.span):
+        if extra is None or not meshes.copy(extra, out, sink, export.span, robot):
             return
     if export.enforce_zero:
         robot = zero_small(robot)

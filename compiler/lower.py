@@ -34,7 +34,7 @@ from mpc.ir.ops import (
     SetRobotName,
     TakeLeaf,
 )
-from mpc.ir.program import Export, Input, MjcfExport, Program, RepoRef, UrdfExport
+from mpc.ir.program import Export, Input, MjcfExport, Program, RepoRef, SdfExport, UrdfExport
 from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
@@ -322,7 +322,7 @@ class _Lowering:
 
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.
-BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "mjcf": MjcfExport}
+BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
     "link_in_smurf": False, "include_cut_joints": False, "copy_with_other_pathes": False,

@@ -100,7 +100,16 @@ class ScaleMesh:
     scale: Vec3
 
 
-MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh
+@dataclass(frozen=True, slots=True)
+class ConvexPart:
+    """Mesh op: part `index` of the convex decomposition (coacd) of the mesh so far, scaled
+    by `scale` (the element's scale moves here: the element that uses the part has none)."""
+
+    index: int
+    scale: Vec3 | None = None
+
+
+MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh | ConvexPart
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -12,6 +12,7 @@ from mpc.ir import transforms as tf
 from mpc.ir.geometry import (
     Box,
     ConvexHull,
+    ConvexPart,
     Cylinder,
     Geometry,
     JoinShapes,
@@ -49,7 +50,12 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
                 mesh.apply_scale(_collada_unit(path))
         except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
             raise MeshError(f"cannot read mesh '{path}': {e}") from None
-    for op in geometry.ops:
+    for n, op in enumerate(geometry.ops):
+        if isinstance(op, ConvexPart):
+            from mpc.ir.decompose import parts
+
+            mesh = parts(Mesh(source=geometry.source, scale=op.scale, ops=geometry.ops[:n]))[op.index]
+            continue
         if isinstance(op, ReflectMesh):
             T = np.eye(4)
             T[op.axis, op.axis] = -1.0

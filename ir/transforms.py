@@ -30,17 +30,16 @@ def rpy_to_matrix(rpy: Vec3) -> np.ndarray:
 
 
 def matrix_to_rpy(R: np.ndarray) -> Vec3:
-    """Fixed-axis roll, pitch, yaw of a rotation matrix (pitch in [-pi/2, pi/2])."""
-    sp = -float(R[2, 0])
-    if abs(sp) >= 1.0 - 1e-12:
-        # Gimbal lock: only roll ± yaw is defined; put it all into yaw.
-        pitch = math.copysign(math.pi / 2, sp)
-        yaw = math.atan2(-float(R[0, 1]), float(R[1, 1]))
-        return (0.0, pitch, yaw)
-    roll = math.atan2(float(R[2, 1]), float(R[2, 2]))
-    pitch = math.asin(max(-1.0, min(1.0, sp)))
+    """Fixed-axis roll, pitch, yaw of a rotation matrix (pitch in [-pi/2, pi/2]).
+
+    Pitch comes from atan2 (not asin) and roll from what yaw and pitch leave of R, so the
+    angles reproduce R to rounding also near pitch ±π/2 (an asin with a gimbal-lock band
+    moved frames there by up to 1e-6 rad).
+    """
     yaw = math.atan2(float(R[1, 0]), float(R[0, 0]))
-    return (roll, pitch, yaw)
+    pitch = math.atan2(-float(R[2, 0]), math.hypot(float(R[0, 0]), float(R[1, 0])))
+    M = rpy_to_matrix((0.0, pitch, yaw)).T @ R
+    return (math.atan2(float(M[2, 1]), float(M[1, 1])), pitch, yaw)
 
 
 def pose_to_matrix(xyz: Vec3, rpy: Vec3) -> np.ndarray:

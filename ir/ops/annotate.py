@@ -103,8 +103,6 @@ class EditCollisions(Op):
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.target:
             _link_or_collision(names, self.target, effects, "target")
-        if self.shape == "convex_decomposition":
-            effects.unsupported("shape: convex_decomposition", "target")
         return names
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -124,7 +122,9 @@ class EditCollisions(Op):
                     kept.append(c)
                 elif not _matches(c.name, self.remove) and self.shape != "remove":
                     edited = self._edit(c, name, effects)
-                    if edited is not None:
+                    if edited is not None and self.shape == "convex_decomposition":
+                        kept.extend(_decomposed(edited, name, effects))
+                    elif edited is not None:
                         kept.append(edited)
             if self.join and len(kept) > 1:
                 joined = _join(name, kept, effects)
@@ -159,6 +159,26 @@ class EditCollisions(Op):
             return None
         return replace(c, geometry=scaled(shape, self.scale),
                        origin=matrix_pose(pose_matrix(c.origin) @ X_GB))
+
+
+def _decomposed(c: Collision, link: str, effects: Effects) -> list[Collision]:
+    """One collision per convex part of a mesh (coacd); primitives are convex already."""
+    from mpc.ir.decompose import parts
+    from mpc.ir.geometry import ConvexPart, Mesh
+    from mpc.ir.mesh_props import MeshError
+
+    if not isinstance(c.geometry, Mesh):
+        return [c]
+    try:
+        count = len(parts(c.geometry))
+    except MeshError as e:
+        effects.error("E0602", f"convex decomposition of a collision of link '{link}': {e}", "target")
+        return [c]
+    base = c.name or f"{link}_collision"
+    scale = c.geometry.scale
+    return [replace(c, name=f"{base}_{i}", geometry=replace(c.geometry, scale=None,
+                                                            ops=(*c.geometry.ops, ConvexPart(i, scale))))
+            for i in range(count)]
 
 
 def _join(link: str, collisions: list[Collision], effects: Effects) -> Collision | None:

@@ -336,3 +336,30 @@ def test_uncovered_joints_get_serial_and_fixed_chains(tmp_path: Path) -> None:
         if d.get("auto_gen"):
             kinds = {robot.joints[j].type == "fixed" for j in d["jointnames"]}
             assert kinds == {d["type"] == "fixed"}
+
+
+def test_convex_decomposition_makes_one_convex_collision_per_part(tmp_path: Path) -> None:
+    ring = trimesh.creation.annulus(r_min=0.05, r_max=0.1, height=0.04, sections=12)
+    ring.export(tmp_path / "ring.stl")
+    urdf = write(tmp_path / "ringy.urdf", """
+        <robot name="ringy">
+          <link name="base">
+            <collision name="ring"><geometry><mesh filename="ring.stl"/></geometry></collision>
+          </link>
+        </robot>
+        """)
+    out = _compile(tmp_path, urdf, """
+          collisions:
+            base: {shape: convex_decomposition}
+        """, name="ringy")
+    collisions = etree.parse(str(out)).getroot().findall("link/collision")
+    assert len(collisions) >= 3  # a ring is far from convex
+    assert [c.get("name") for c in collisions] == [f"ring_{i}" for i in range(len(collisions))]
+    total = 0.0
+    for c in collisions:
+        part = trimesh.load(out.parent / c.find("geometry/mesh").get("filename"), force="mesh")
+        assert _convex(part) < 1e-6 and part.volume > 0
+        assert np.all(part.bounds[0] >= ring.bounds[0] - 0.01)
+        assert np.all(part.bounds[1] <= ring.bounds[1] + 0.01)
+        total += part.volume
+    assert total == pytest.approx(ring.volume, rel=0.25)

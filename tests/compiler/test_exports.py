@@ -134,3 +134,14 @@ def test_mjcf_export_from_the_command_line(tmp_path: Path) -> None:
     model = mujoco.MjModel.from_xml_path(str(out / "mjcf/solo.xml"))
     assert abs(mujoco.mj_getTotalmass(model) - pin.computeTotalMass(load(source))) < 1e-9
     assert (out / "meshes/obj").is_dir()  # MuJoCo reads no DAE: mjcf meshes default to OBJ
+
+
+def test_a_mesh_that_cannot_be_read_names_link_element_and_file(tmp_path: Path, diags: Diags) -> None:
+    arm(tmp_path)
+    (tmp_path / "meshes/tetra.stl").write_bytes(b"solid broken\n this is no STL\n")
+    spec = write(tmp_path / "m.yml", HEAD + "    - {type: urdf, mesh_format: obj}\n")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    d = diags.take_error("E0603")
+    assert d.message.startswith(f"cannot compute mesh 'meshes/obj/tetra.obj' of a visual of link 'base' "
+                                f"from '{tmp_path}/meshes/tetra.stl': ")
+    assert (d.span.file, d.span.line) == (str(tmp_path / "arm.urdf"), 10)

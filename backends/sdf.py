@@ -1,0 +1,329 @@
+"""ir.Robot → canonical SDFormat (1.6, 1.7 or 1.9): one `<model>`, plus Gazebo's model.config.
+
+Links and joints come depth-first as in the URDF writer, numbers use `fmt_float`, and
+the same robot always gives the same bytes. Every link pose is in the model frame (at
+q = 0); each joint frame is its child link's frame, so joints carry no pose and their
+axis is written in the joint frame, exactly as the IR holds it. What SDF cannot hold
+or mpc does not translate (mimic, floating and planar joints, fragments, extras,
+motors, sensors, cut joints, …) is left out and named in one W0500 warning.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+from mpc.backends import meshes
+from mpc.backends.sdf_reader import read
+from mpc.backends.xml import fmt_float, fmt_floats, write_path
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.kinematics import link_in_root, matrix_pose
+from mpc.ir.program import SdfExport
+from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
+from mpc.ir.span import Span
+from mpc.ir.tree import depth_first
+
+__all__ = ["emit", "read", "sdf_names", "to_string"]
+
+MeshNamer = Callable[[Mesh], str]
+IND = "  "
+WORLD = "world"  # SDF's name for the world frame, reserved as a link name
+UNBOUNDED = 1e16  # the position limit SDF uses for "no limit" (its default, and sdformat's)
+_SKIPPED = ("floating", "planar")  # URDF joint types SDF has no joint for
+# A link without <inertial> weighs 1 kg in SDF; in URDF it is massless.
+_MASSLESS = Inertial(mass=0.0, inertia=Inertia(ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.0, iyz=0.0, izz=0.0))
+
+
+def _attr(value: str) -> str:
+    return escape(value, {'"': "&quot;"})
+
+
+def _is_empty(link: Link) -> bool:
+    return link.inertial is None and not link.visuals and not link.collisions
+
+
+def sdf_names(robot: Robot) -> tuple[dict[str, str], dict[str, str]]:
+    """The names links and joints get in SDF: (links, joints), each old → new.
+
+    SDF links, joints and frames share one namespace and `world` names the world frame:
+    an empty root link `world` becomes the world frame itself (its joints attach the model
+    to the world), another link `world` becomes `world_link`, and a joint named like a
+    link gets `_joint` appended, as sdformat's own URDF parser does.
+    """
+    links = {name: name for name in robot.links}
+    if WORLD in links and not (robot.root == WORLD and _is_empty(robot.links[WORLD])):
+        links[WORLD] = _unique(WORLD, "_link", set(robot.links) | set(robot.joints))
+    taken = set(links.values()) | set(robot.joints)
+    joints = {}
+    for name in robot.joints:
+        joints[name] = name if name not in links.values() else _unique(name, "_joint", taken)
+        taken.add(joints[name])
+    return links, joints
+
+
+def _unique(name: str, suffix: str, taken: set[str]) -> str:
+    new = name + suffix
+    while new in taken:
+        new += suffix
+    return new
+
+
+def left_out(robot: Robot) -> list[str]:
+    """What the robot holds that this writer does not write to SDF, for one W0500."""
+    joints = sorted(robot.joints.values(), key=lambda j: j.name)
+    out = [f"{j.type} joint '{j.name}' (SDF has none: link '{j.child}' is written free)"
+           for j in joints if j.type in _SKIPPED]
+    if mimics := [j.name for j in joints if j.mimic is not None]:
+        out.append("the mimic of joint" + "s" * (len(mimics) > 1) + " " + ", ".join(f"'{m}'" for m in mimics))
+    counts: Counter[tuple[str, str]] = Counter({
+        ("", "motor"): len(robot.motors), ("", "sensor"): len(robot.sensors),
+        ("", "named pose"): len(robot.poses), ("", "loop-closure joint"): len(robot.cut_joints),
+        ("", "submechanism"): len(robot.submechanisms), ("", "annotation category"): len(robot.annotations),
+        ("", "joint calibration"): sum(j.calibration is not None for j in joints),
+        ("", "joint safety controller"): sum(j.safety_controller is not None for j in joints)})
+    counts.update(("", f"<{f.tag}> fragment") for f in robot.fragments)
+    elements: list[tuple[str, Link | Joint | Visual | Collision]] = [("joint", j) for j in joints]
+    for lk in robot.links.values():
+        elements += [("link", lk)] + [("visual", v) for v in lk.visuals]
+        elements += [("collision", c) for c in lk.collisions]
+        counts.update((f"<{f.tag}> in ", "inertial") for f in (lk.inertial.extras if lk.inertial else ()))
+        counts["", "collision bitmask"] += sum(c.bitmask is not None for c in lk.collisions)
+    for kind, el in elements:
+        counts.update((f"<{f.tag}> in ", kind) for f in el.extras)
+        counts["annotations of ", kind] += bool(el.annotations)
+        attrs = list(el.extra_attrs)
+        if isinstance(el, Visual | Collision):
+            counts.update((f"attribute '{a}' of the geometry in ", kind)
+                          for a, _ in (*el.geometry_attrs, *el.geometry.extra_attrs))
+        elif isinstance(el, Joint):
+            attrs += [a for part in (el.limit, el.dynamics) if part is not None for a in part.extra_attrs]
+        counts.update((f"attribute '{name}' of ", kind) for name, _ in attrs)
+    for m in _used_materials(robot):
+        counts["", "material texture"] += m.texture is not None or m.normal_texture is not None
+        counts["", "material shininess"] += m.shininess is not None
+        counts["annotations of ", "material"] += bool(m.annotations)
+    out += [f"{pre}{n} {noun}{'s' * (n != 1)}" for (pre, noun), n in counts.items() if n]
+    if robot.submechanisms_file:
+        out.append("the submechanisms file")
+    return out
+
+
+def _used_materials(robot: Robot) -> list[Material]:
+    found = {}
+    for lk in robot.links.values():
+        for v in lk.visuals:
+            m = _material(robot, v)
+            if m is not None:
+                found[id(m)] = m
+    return list(found.values())
+
+
+def _material(robot: Robot, visual: Visual) -> Material | None:
+    if visual.inline_material is not None:
+        return visual.inline_material
+    return robot.materials.get(visual.material) if visual.material is not None else None
+
+
+def warn(robot: Robot, span: Span, sink: Sink, version: str = "1.9") -> None:
+    """Report, in one W0500 each, what the SDF leaves out and which names it changes."""
+    missing = left_out(robot)
+    if missing:
+        sink.warning(span, "W0500", f"the SDF leaves out what SDFormat {version} cannot hold or mpc "
+                     "does not translate: " + "; ".join(missing))
+    links, joints = sdf_names(robot)
+    renamed = [f"{kind} '{a}' → '{b}'" for kind, table in (("link", links), ("joint", joints))
+               for a, b in table.items() if a != b]
+    if renamed:
+        sink.warning(span, "W0501", "the SDF renames what SDFormat forbids (links, joints and "
+                     "frames share one namespace; 'world' is reserved): " + ", ".join(renamed))
+
+
+class _Writer:
+    def __init__(self, robot: Robot, mesh_name: MeshNamer) -> None:
+        self.robot, self.mesh_name = robot, mesh_name
+        self.links, self.joints = sdf_names(robot)
+        self.out: list[str] = []
+
+    def line(self, depth: int, text: str) -> None:
+        self.out.append(IND * depth + text)
+
+    def comments(self, depth: int, comments: tuple[str, ...]) -> None:
+        for c in comments:
+            self.line(depth, f"<!--{c}-->")
+
+    def leaf(self, depth: int, tag: str, value: str) -> None:
+        self.line(depth, f"<{tag}>{escape(value)}</{tag}>")
+
+    def pose(self, depth: int, pose: Pose | None, always: bool = False) -> None:
+        if pose is None or (not always and pose.xyz == (0, 0, 0) and pose.rpy == (0, 0, 0)):
+            return
+        self.leaf(depth, "pose", fmt_floats(pose.xyz + pose.rpy))
+
+    def _emit_link(self, depth: int, link: Link) -> None:
+        self.comments(depth, link.comments)
+        self.line(depth, f'<link name="{_attr(self.links[link.name])}">')
+        d = depth + 1
+        self.comments(d, link.inner_comments)
+        self.pose(d, matrix_pose(link_in_root(self.robot, link.name)), always=True)
+        self._emit_inertial(d, link.inertial or _MASSLESS)
+        for kind, items in (("visual", link.visuals), ("collision", link.collisions)):
+            used: set[str] = set()
+            for i, item in enumerate(items):
+                name = item.name or (f"{link.name}_{kind}" + (f"_{i}" if i else ""))
+                name = _unique(name, f"_{i}", used) if name in used else name
+                used.add(name)
+                self._emit_shape(d, kind, name, item)
+        self.line(depth, "</link>")
+
+    def _emit_inertial(self, depth: int, inertial: Inertial) -> None:
+        self.line(depth, "<inertial>")
+        d = depth + 1
+        self.pose(d, inertial.origin)
+        self.leaf(d, "mass", fmt_float(inertial.mass))
+        self.line(d, "<inertia>")
+        for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
+            self.leaf(d + 1, k, fmt_float(getattr(inertial.inertia, k)))
+        self.line(d, "</inertia>")
+        self.line(depth, "</inertial>")
+
+    def _emit_shape(self, depth: int, kind: str, name: str, item: Visual | Collision) -> None:
+        self.line(depth, f'<{kind} name="{_attr(name)}">')
+        d = depth + 1
+        self.pose(d, item.origin)
+        self._emit_geometry(d, item.geometry)
+        material = _material(self.robot, item) if isinstance(item, Visual) else None
+        if material is not None:
+            if material.transparency is not None:
+                self.leaf(d, "transparency", fmt_float(material.transparency))
+            self._emit_material(d, material)
+        self.line(depth, f"</{kind}>")
+
+    def _emit_geometry(self, depth: int, geometry: Geometry) -> None:
+        self.line(depth, "<geometry>")
+        d = depth + 1
+        match geometry:
+            case Box():
+                self.line(d, "<box>")
+                self.leaf(d + 1, "size", fmt_floats(geometry.size))
+                self.line(d, "</box>")
+            case Cylinder():
+                self.line(d, "<cylinder>")
+                self.leaf(d + 1, "radius", fmt_float(geometry.radius))
+                self.leaf(d + 1, "length", fmt_float(geometry.length))
+                self.line(d, "</cylinder>")
+            case Sphere():
+                self.line(d, "<sphere>")
+                self.leaf(d + 1, "radius", fmt_float(geometry.radius))
+                self.line(d, "</sphere>")
+            case Mesh():
+                self.line(d, "<mesh>")
+                self.leaf(d + 1, "uri", self.mesh_name(geometry))
+                if geometry.scale is not None:
+                    self.leaf(d + 1, "scale", fmt_floats(geometry.scale))
+                self.line(d, "</mesh>")
+        self.line(depth, "</geometry>")
+
+    def _emit_material(self, depth: int, material: Material) -> None:
+        colours = [("ambient", material.ambient), ("diffuse", material.rgba),
+                   ("specular", material.specular), ("emissive", material.emissive)]
+        colours = [(tag, c) for tag, c in colours if c is not None]
+        if not colours:
+            return
+        self.line(depth, "<material>")
+        for tag, colour in colours:
+            # SDF colours are "r g b a"; an rgb colour is opaque.
+            self.leaf(depth + 1, tag, fmt_floats(tuple(colour) + (1.0,) * (4 - len(colour))))
+        self.line(depth, "</material>")
+
+    def _emit_joint(self, depth: int, joint: Joint) -> None:
+        self.comments(depth, joint.comments)
+        jtype = "revolute" if joint.type == "continuous" else joint.type
+        self.line(depth, f'<joint name="{_attr(self.joints[joint.name])}" type="{jtype}">')
+        d = depth + 1
+        self.comments(d, joint.inner_comments)
+        self.leaf(d, "parent", self.links[joint.parent])
+        self.leaf(d, "child", self.links[joint.child])
+        if joint.type != "fixed":
+            self._emit_axis(d, joint)
+        self.line(depth, "</joint>")
+
+    def _emit_axis(self, depth: int, joint: Joint) -> None:
+        self.line(depth, "<axis>")
+        d = depth + 1
+        # No expressed_in: the axis is in the joint frame, which is the child link's frame
+        # here, as in URDF. SDF's default axis is 0 0 1, URDF's 1 0 0.
+        self.leaf(d, "xyz", fmt_floats(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0)))
+        dyn = joint.dynamics
+        if dyn is not None and (dyn.damping is not None or dyn.friction is not None):
+            self.line(d, "<dynamics>")
+            for k in ("damping", "friction"):
+                if getattr(dyn, k) is not None:
+                    self.leaf(d + 1, k, fmt_float(getattr(dyn, k)))
+            self.line(d, "</dynamics>")
+        lim = joint.limit
+        if joint.type == "continuous":
+            lower, upper = -UNBOUNDED, UNBOUNDED
+        else:  # URDF's lower and upper default to 0
+            lower = lim.lower if lim is not None and lim.lower is not None else 0.0
+            upper = lim.upper if lim is not None and lim.upper is not None else 0.0
+        self.line(d, "<limit>")
+        self.leaf(d + 1, "lower", fmt_float(lower))
+        self.leaf(d + 1, "upper", fmt_float(upper))
+        for k in ("effort", "velocity"):
+            if lim is not None and getattr(lim, k) is not None:
+                self.leaf(d + 1, k, fmt_float(getattr(lim, k)))
+        self.line(d, "</limit>")
+        self.line(depth, "</axis>")
+
+
+def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
+              sink: Sink | None = None) -> str:
+    """The canonical SDF text of `robot`; `mesh_name` gives each mesh's uri.
+
+    With a sink, what the SDF leaves out or renames is reported there (W0500).
+    """
+    if sink is not None:
+        warn(robot, robot.span or Span.of_file(robot.name), sink, version)
+    w = _Writer(robot, mesh_name)
+    w.line(0, '<?xml version="1.0" encoding="utf-8"?>')
+    w.comments(0, robot.header_comments)
+    w.line(0, f'<sdf version="{version}">')
+    w.line(1, f'<model name="{_attr(robot.name)}">')
+    for joint, link in depth_first(robot):
+        if joint is not None and joint.type not in _SKIPPED:
+            w._emit_joint(2, joint)
+        if w.links[link] != WORLD:
+            w._emit_link(2, robot.links[link])
+    w.comments(2, robot.trailing_comments)
+    w.line(1, "</model>")
+    w.line(0, "</sdf>")
+    return "\n".join(w.out) + "\n"
+
+
+def model_config(robot: Robot, version: str = "1.9") -> str:
+    """Gazebo's model.config for the model: name, version, the SDF file, a description."""
+    name = escape(robot.name)
+    return (f'<?xml version="1.0" encoding="utf-8"?>\n<model>\n{IND}<name>{name}</name>\n'
+            f'{IND}<version>1.0</version>\n{IND}<sdf version="{version}">{name}.sdf</sdf>\n'
+            f"{IND}<description>The robot '{name}', written by mpc.</description>\n</model>\n")
+
+
+def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
+    """Write `out/sdf/<filename or robot.name>.sdf` and `out/sdf/model.config`, meshes under
+    `out/meshes/`."""
+    warn(robot, export.span, sink, export.version)
+    files = meshes.plan(robot, export.mesh_format, sink, export.span)
+    if files is None or not meshes.copy(files, out, sink, export.span, robot):
+        return
+
+    def mesh_name(mesh: Mesh) -> str:
+        # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
+        # file's folder; model:// would need the meshes inside the model folder (out/sdf).
+        return "../" + files[meshes.key(mesh)]
+
+    text = to_string(robot, mesh_name, export.version)
+    write_path(out / "sdf" / f"{export.filename or robot.name}.sdf", text)
+    write_path(out / "sdf" / "model.config", model_config(robot, export.version))

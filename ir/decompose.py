@@ -1,0 +1,52 @@
+"""Convex decomposition (coacd) of a shape into convex parts, cached on disk.
+
+`EditCollisions` needs the number of parts to make one collision per part, and the
+emission needs each part's mesh: both read the same cache entry, keyed by the shape's
+content (its file's bytes, its ops and scale) and the decomposition's settings, so a
+mesh is decomposed once, however often it is used or built.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import trimesh
+
+from mpc.compiler.cache import cache_dir
+from mpc.ir.geometry import Mesh
+from mpc.ir.mesh_props import as_trimesh
+
+THRESHOLD = 0.05  # coacd's concavity threshold: smaller is finer (and slower)
+MAX_PARTS = 16  # a bound on the parts (collisions) one mesh becomes
+
+
+def _key(mesh: Mesh) -> str:
+    h = hashlib.sha256(mesh.source.path.read_bytes() if mesh.source.path else b"")
+    h.update(f"coacd-{THRESHOLD}-{MAX_PARTS}|{mesh.ops!r}|{mesh.scale!r}".encode())
+    return h.hexdigest()
+
+
+def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
+    """The convex parts of `mesh` (scaled, with its ops), computed once."""
+    path = cache_dir("decompositions") / f"{_key(mesh)}.npz"
+    if path.is_file():
+        data = np.load(path)
+        return [trimesh.Trimesh(data[f"v{i}"], data[f"f{i}"], process=False)
+                for i in range(int(data["n"]))]
+    import coacd
+
+    coacd.set_log_level("error")
+    shape = as_trimesh(mesh)
+    shape.merge_vertices()  # STL files repeat each vertex per face; coacd wants a connected surface
+    result = coacd.run_coacd(coacd.Mesh(shape.vertices, shape.faces), threshold=THRESHOLD, seed=0,
+                             max_convex_hull=MAX_PARTS)
+    out = [trimesh.Trimesh(np.asarray(v), np.asarray(f), process=False) for v, f in result]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = {"n": np.array(len(out))}
+    for i, m in enumerate(out):
+        arrays[f"v{i}"], arrays[f"f{i}"] = m.vertices, m.faces
+    partial = path.with_suffix(".part.npz")
+    np.savez(partial, **arrays)
+    partial.replace(path)
+    return out
