@@ -57,22 +57,23 @@ class InputLoader:
         from mpc.compiler import driver
 
         if inp.kind == "basefile":
-            from mpc.backends import urdf
-
             if inp.path is None:  # its package was not found; reported when lowering
                 return None
-            return urdf.read(inp.path, self.sink, self.options.resolver)
+            return self._read(inp.path)
         if inp.kind == "derived_base":
             assert inp.path is not None
             if self._cycle(inp):
                 return None
             return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
         path = self._repo_file(inp, fetch=True)
-        if path is None:
-            return None
-        from mpc.backends import urdf
+        return None if path is None else self._read(path)
 
-        return urdf.read(path, self.sink, self.options.resolver)
+    def _read(self, path: Path) -> Robot | None:
+        """A model file, by its extension: URDF or SDF."""
+        from mpc.backends import BACKENDS
+
+        reader = BACKENDS["sdf" if path.suffix.lower() == ".sdf" else "urdf"]()
+        return reader.read(path, self.sink, self.options.resolver)
 
     def _repo_file(self, inp: Input, fetch: bool) -> Path | None:
         from mpc.compiler.repos import checkout

@@ -145,3 +145,30 @@ def test_a_mesh_that_cannot_be_read_names_link_element_and_file(tmp_path: Path, 
     assert d.message.startswith(f"cannot compute mesh 'meshes/obj/tetra.obj' of a visual of link 'base' "
                                 f"from '{tmp_path}/meshes/tetra.stl': ")
     assert (d.span.file, d.span.line) == (str(tmp_path / "arm.urdf"), 10)
+
+
+def test_an_sdf_export_is_an_input_again(tmp_path: Path) -> None:
+    """solo12 → SDF → a definition with the SDF as basefile → URDF: the same robot."""
+    from tests.backends.pin_compare import assert_same_physics
+    from tests.conftest import ERD
+
+    source = ERD / "solo_description/robots/solo12.urdf"
+    first = write(tmp_path / "a.yml", f"""
+        model:
+          robotname: solo
+          modelname: solo-sdf
+          input_models: {{solo: {{basefile: "{source}"}}}}
+          assemble: {{model: solo}}
+          export_config: [{{type: sdf}}]
+        """)
+    assert compile_file(first, tmp_path / "a", Diags()).out is not None
+    second = write(tmp_path / "b.yml", f"""
+        model:
+          robotname: solo
+          modelname: solo-again
+          input_models: {{solo: {{basefile: "{tmp_path / 'a/sdf/solo.sdf'}"}}}}
+          assemble: {{model: solo}}
+        """)
+    out = compile_file(second, tmp_path / "b", Diags()).out
+    assert out is not None
+    assert_same_physics(source, out / "urdf/solo.urdf")
