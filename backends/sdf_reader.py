@@ -22,7 +22,7 @@ import numpy as np
 from lxml import etree
 
 from mpc.backends.packages import PackageResolver
-from mpc.backends.xml import XmlError, XmlSource, parse_floats
+from mpc.backends.xml import XmlSource, load, parse_floats
 from mpc.compiler.diagnostics import Sink
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
@@ -42,7 +42,6 @@ from mpc.ir.robot import (
     Robot,
     Visual,
 )
-from mpc.ir.span import Span
 
 VERSIONS = ("1.5", "1.6", "1.7", "1.8", "1.9")
 TREE_TYPES = ("revolute", "continuous", "prismatic", "fixed")  # the SDF joint types URDF has
@@ -55,16 +54,8 @@ _SHAPES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radiu
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Robot | None:
     """Read the SDF at `path`; None when it has errors (all of them reported)."""
-    file = str(path)
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        sink.error(Span.of_file(file), "E0601", f"cannot read SDF '{file}': {e.strerror}")
-        return None
-    try:
-        src = XmlSource.parse(data, file)
-    except XmlError as e:
-        sink.error(Span(file, e.line, e.col), "E0401", f"malformed XML in '{file}': {e.message}")
+    src = load(path, sink, "SDF")
+    if src is None:
         return None
     errors_before = sink.error_count
     robot = _Reader(src, sink, resolver or PackageResolver(), path.parent.resolve()).robot()

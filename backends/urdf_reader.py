@@ -13,7 +13,7 @@ from pathlib import Path
 from lxml import etree
 
 from mpc.backends.packages import PackageResolver
-from mpc.backends.xml import XmlError, XmlSource, parse_floats
+from mpc.backends.xml import XmlSource, load, parse_floats
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
@@ -34,7 +34,6 @@ from mpc.ir.robot import (
     SafetyController,
     Visual,
 )
-from mpc.ir.span import Span
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -49,16 +48,8 @@ _MODELLED = frozenset({
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
          display: str | None = None) -> Robot | None:
     """Read the URDF at `path`; None when it has errors (all of them reported)."""
-    file = display or str(path)
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        sink.error(Span.of_file(file), "E0601", f"cannot read URDF '{file}': {e.strerror}")
-        return None
-    try:
-        src = XmlSource.parse(data, file)
-    except XmlError as e:
-        sink.error(Span(file, e.line, e.col), "E0401", f"malformed XML in '{file}': {e.message}")
+    src = load(path, sink, "URDF", display)
+    if src is None:
         return None
     errors_before = sink.error_count
     robot = _Reader(src, sink, resolver or PackageResolver(), path.parent.resolve()).robot()

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from lxml import etree
 
+from mpc.compiler.diagnostics import Sink
 from mpc.ir.span import Span
 
 _PARSER = etree.XMLParser(
@@ -88,6 +89,21 @@ class XmlSource:
         line, col = self._pos(offset)
         tag_end = offset + 1 + len(str(etree.QName(el).localname))
         return Span(self.file, line, col, line, col + (tag_end - offset))
+
+
+def load(path: Path, sink: Sink, kind: str, file: str | None = None) -> XmlSource | None:
+    """Read and parse the `kind` file (URDF, SDF) at `path`; None after a located diagnostic."""
+    file = file or str(path)
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        sink.error(Span.of_file(file), "E0601", f"cannot read {kind} '{file}': {e.strerror}")
+        return None
+    try:
+        return XmlSource.parse(data, file)
+    except XmlError as e:
+        sink.error(Span(file, e.line, e.col), "E0401", f"malformed XML in '{file}': {e.message}")
+        return None
 
 
 def fmt_float(x: float) -> str:
