@@ -35,7 +35,7 @@ from mpc.ir.tree import depth_first
 
 KEEP_FORMAT = "input_type"
 ENGINE = "1"  # changes when the way meshes are computed changes, so old cache entries go unused
-WRITABLE = ("stl", "obj", "dae", "ply")  # formats trimesh writes, for meshes with ops
+WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
 
@@ -68,8 +68,8 @@ def _digest(path: Path) -> str:
 
 
 # Extensions of the formats the language names; `mars_obj` is OBJ content (Phobos's intended
-# axis change was never written), `bobj` is Phobos's binary OBJ, which trimesh cannot write.
-EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply"}
+# axis change was never written), `bobj` is MARS's binary OBJ (backends/bobj.py).
+EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply", "bobj": "bobj"}
 
 
 def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[MeshKey, str] | None:
@@ -101,7 +101,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
         if fmt not in EXTENSIONS or (mesh_format == KEEP_FORMAT and use.mesh.ops and fmt not in WRITABLE):
             if mesh_format != KEEP_FORMAT:
                 sink.error(export_span, "E0501", f"writing '{fmt}' meshes is not supported yet",
-                           hint="stl, obj, dae and mars_obj are")
+                           hint="stl, obj, dae, bobj and mars_obj are")
                 return None
             fmt = "stl"  # a computed mesh whose own format trimesh cannot write
         stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
@@ -222,7 +222,12 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
         return str(e)
     if len(mesh.faces) == 0:  # e.g. pycollada failed on a texture and trimesh gave an empty scene
         return "it has no triangles after reading"
-    data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
+    if dest.suffix == ".bobj":
+        from mpc.backends import bobj
+
+        data: bytes | str = bobj.dumps(mesh)
+    else:
+        data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     dest.parent.mkdir(parents=True, exist_ok=True)
     partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
     partial.write_bytes(data if isinstance(data, bytes) else data.encode())

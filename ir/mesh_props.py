@@ -45,7 +45,12 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
         if path is None or not path.is_file():
             raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
         try:
-            mesh = trimesh.load(path, force="mesh", process=False)
+            if path.suffix.lower() == ".bobj":
+                from mpc.backends import bobj
+
+                mesh = bobj.loads(path.read_bytes())
+            else:
+                mesh = trimesh.load(path, force="mesh", process=False)
             if path.suffix.lower() == ".dae":
                 mesh.apply_scale(_collada_unit(path))
         except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"

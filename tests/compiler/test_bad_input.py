@@ -239,11 +239,31 @@ def test_unknown_package(tmp_path: Path, diags: Diags) -> None:
 
 
 def test_mesh_format_that_cannot_be_written(tmp_path: Path, diags: Diags) -> None:
+    """The language only names formats mpc writes; an IR file can name any."""
+    from mpc.compiler.driver import Options, load_program
+    from mpc.ir.text import dump
+
     arm(tmp_path)
-    _compile(tmp_path, diags, definition("arm.urdf", "bobj"))
+    spec = write(tmp_path / "model.yml", definition("arm.urdf", "stl"))
+    program = load_program(spec, Diags(), Options())
+    assert program is not None
+    ir = tmp_path / "model.ir"
+    ir.write_text(dump(program).replace('mesh_format="stl"', 'mesh_format="x3d"'))
+    assert compile_file(ir, tmp_path / "out", diags).out is None
     d = diags.take_error("E0501")
-    assert d.message == "writing 'bobj' meshes is not supported yet"
+    assert d.message == "writing 'x3d' meshes is not supported yet"
     assert _where(d) == (10, 7)
+
+
+def test_bobj_meshes_read_back(tmp_path: Path) -> None:
+    from mpc.backends import bobj
+
+    arm(tmp_path)
+    spec = write(tmp_path / "model.yml", definition("arm.urdf", "bobj"))
+    out = compile_file(spec, tmp_path / "out", Diags()).out
+    assert out is not None
+    mesh = bobj.loads((out / "meshes/bobj/tetra.bobj").read_bytes())
+    assert len(mesh.faces) == 4 and abs(mesh.volume - 0.1**3 / 6) < 1e-9
 
 
 def test_meshes_are_converted(tmp_path: Path) -> None:
