@@ -19,6 +19,7 @@ from mpc.backends import meshes
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
+from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import link_in_root, matrix_pose
 from mpc.ir.program import SdfExport
@@ -71,8 +72,11 @@ def _unique(name: str, suffix: str, taken: set[str]) -> str:
     return new
 
 
-def left_out(robot: Robot) -> list[str]:
-    """What the robot holds that this writer does not write to SDF, for one W0500."""
+def left_out(robot: Robot, cut_joints: bool = False) -> list[str]:
+    """What the robot holds that this writer does not write to SDF, for one W0500.
+
+    cut_joints: whether the loop-closure joints are written (`include_cut_joints`).
+    """
     joints = sorted(robot.joints.values(), key=lambda j: j.name)
     out = [f"{j.type} joint '{j.name}' (SDF has none: link '{j.child}' is written free)"
            for j in joints if j.type in _SKIPPED]
@@ -80,7 +84,8 @@ def left_out(robot: Robot) -> list[str]:
         out.append("the mimic of joint" + "s" * (len(mimics) > 1) + " " + ", ".join(f"'{m}'" for m in mimics))
     counts: Counter[tuple[str, str]] = Counter({
         ("", "motor"): len(robot.motors), ("", "sensor"): len(robot.sensors),
-        ("", "named pose"): len(robot.poses), ("", "loop-closure joint"): len(robot.cut_joints),
+        ("", "named pose"): len(robot.poses),
+        ("", "loop-closure joint"): 0 if cut_joints else len(robot.cut_joints),
         ("", "submechanism"): len(robot.submechanisms), ("", "annotation category"): len(robot.annotations),
         ("", "joint calibration"): sum(j.calibration is not None for j in joints),
         ("", "joint safety controller"): sum(j.safety_controller is not None for j in joints)})
@@ -127,9 +132,9 @@ def _material(robot: Robot, visual: Visual) -> Material | None:
     return robot.materials.get(visual.material) if visual.material is not None else None
 
 
-def warn(robot: Robot, span: Span, sink: Sink, version: str = "1.9") -> None:
+def warn(robot: Robot, span: Span, sink: Sink, version: str = "1.9", cut_joints: bool = False) -> None:
     """Report, in one W0500 each, what the SDF leaves out and which names it changes."""
-    missing = left_out(robot)
+    missing = left_out(robot, cut_joints)
     if missing:
         sink.warning(span, "W0500", f"the SDF leaves out what SDFormat {version} cannot hold or mpc "
                      "does not translate: " + "; ".join(missing))
@@ -250,6 +255,20 @@ class _Writer:
             self._emit_axis(d, joint)
         self.line(depth, "</joint>")
 
+    def _emit_cut_joint(self, depth: int, cut: CutJoint) -> None:
+        """A loop closure, in the child's frame (where the tree puts it at q = 0). A fixed or
+        ball closure needs no axis; another type takes its one constraint axis."""
+        kind = cut.type if cut.type in ("fixed", "ball", "revolute", "prismatic") else "fixed"
+        self.line(depth, f'<joint name="{_attr(cut.name)}" type="{kind}">')
+        self.leaf(depth + 1, "parent", self.links.get(cut.parent, cut.parent))
+        self.leaf(depth + 1, "child", self.links.get(cut.child, cut.child))
+        if kind in ("revolute", "prismatic"):
+            axis = cut.constraint_axes[0][1] if cut.constraint_axes else (0.0, 0.0, 1.0)
+            self.line(depth + 1, "<axis>")
+            self.leaf(depth + 2, "xyz", fmt_floats(axis))
+            self.line(depth + 1, "</axis>")
+        self.line(depth, "</joint>")
+
     def _emit_axis(self, depth: int, joint: Joint) -> None:
         self.line(depth, "<axis>")
         d = depth + 1
@@ -280,13 +299,14 @@ class _Writer:
 
 
 def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
-              sink: Sink | None = None) -> str:
+              sink: Sink | None = None, cut_joints: bool = False) -> str:
     """The canonical SDF text of `robot`; `mesh_name` gives each mesh's uri.
 
     With a sink, what the SDF leaves out or renames is reported there (W0500).
+    cut_joints: also write the loop-closure joints (SDF allows loops).
     """
     if sink is not None:
-        warn(robot, robot.span or Span.of_file(robot.name), sink, version)
+        warn(robot, robot.span or Span.of_file(robot.name), sink, version, cut_joints)
     w = _Writer(robot, mesh_name)
     w.line(0, '<?xml version="1.0" encoding="utf-8"?>')
     w.comments(0, robot.header_comments)
@@ -297,6 +317,9 @@ def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
             w._emit_joint(2, joint)
         if w.links[link] != WORLD:
             w._emit_link(2, robot.links[link])
+    if cut_joints:
+        for name in sorted(robot.cut_joints):
+            w._emit_cut_joint(2, robot.cut_joints[name])
     w.comments(2, robot.trailing_comments)
     w.line(1, "</model>")
     w.line(0, "</sdf>")
@@ -314,7 +337,7 @@ def model_config(robot: Robot, version: str = "1.9") -> str:
 def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     """Write `out/sdf/<filename or robot.name>.sdf` and `out/sdf/model.config`, meshes under
     `out/meshes/`."""
-    warn(robot, export.span, sink, export.version)
+    warn(robot, export.span, sink, export.version, export.include_cut_joints)
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
@@ -324,6 +347,6 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
         # file's folder; model:// would need the meshes inside the model folder (out/sdf).
         return "../" + files[meshes.key(mesh)]
 
-    text = to_string(robot, mesh_name, export.version)
+    text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints)
     write_path(out / "sdf" / f"{export.filename or robot.name}.sdf", text)
     write_path(out / "sdf" / "model.config", model_config(robot, export.version))

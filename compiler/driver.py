@@ -157,7 +157,17 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".mpc-tmp", dir=out.parent))
     try:
         for export in program.exports:
-            BACKENDS[export.type]().emit(robot, export, staging, sink)
+            model = robot
+            if export.add_floating_base:
+                from mpc.ir.floating import with_floating_base
+
+                floating = with_floating_base(robot)
+                if floating is None:
+                    sink.error(export.span, "E0505", "add_floating_base needs the names 'world' and "
+                               "'floating_base', which the robot uses already")
+                    continue
+                model = floating
+            BACKENDS[export.type]().emit(model, export, staging, sink)
         if sink.has_errors():
             return False
         _replace(staging, out)

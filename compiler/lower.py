@@ -286,9 +286,15 @@ class _Lowering:
             if entry.type == "mjcf" and mesh_format == "input_type":
                 mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
             export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
+                                               add_floating_base=entry.add_floating_base,
                                                filename=filename if filename != self.model.robotname else "")
             if entry.type == "sdf":
-                export = replace(export, version=entry.version)
+                export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
+            elif entry.include_cut_joints:
+                self.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
+                                f"no meaning in a {entry.type} export: "
+                                + ("URDF cannot hold loops" if entry.type == "urdf"
+                                   else "MJCF always closes loops with equality constraints"))
             if entry.type == "urdf":
                 extra = entry.additional_meshes
                 package = (self.model.ros_pkg_name or self.model.modelname) if entry.ros_pathes else None
@@ -325,8 +331,8 @@ class _Lowering:
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
-    "link_in_smurf": False, "include_cut_joints": False, "copy_with_other_pathes": False,
-    "add_floating_base": False, "correct_inertials": False, "float_fmt_dict": None,
+    "link_in_smurf": False, "copy_with_other_pathes": False, "correct_inertials": False,
+    "float_fmt_dict": None,
 }
 
 

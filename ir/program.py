@@ -55,6 +55,7 @@ class UrdfExport:
     mesh's own format).
     filename: the file's name without extension ("" for the robot's name), with
     `filename_suffix` appended.
+    add_floating_base: hang the robot from a `world` link by a floating joint (ir/floating.py).
     additional_meshes: further formats the meshes are written in (not referenced).
     ros_package: when given, meshes are referenced as `package://<ros_package>/meshes/…`.
     enforce_zero: numbers closer to zero than 1e-12 are written as 0.
@@ -64,6 +65,7 @@ class UrdfExport:
     mesh_format: str
     span: Span
     filename: str = ""
+    add_floating_base: bool = False
     additional_meshes: tuple[str, ...] = ()
     ros_package: str | None = None
     enforce_zero: bool = False
@@ -77,6 +79,8 @@ class SdfExport:
     mesh_format: str
     span: Span
     filename: str = ""
+    add_floating_base: bool = False
+    include_cut_joints: bool = False
     version: Literal["1.6", "1.7", "1.9"] = "1.9"
     type: Literal["sdf"] = "sdf"
 
@@ -89,6 +93,7 @@ class MjcfExport:
     mesh_format: str
     span: Span
     filename: str = ""
+    add_floating_base: bool = False
     type: Literal["mjcf"] = "mjcf"
 
 

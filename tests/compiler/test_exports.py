@@ -172,3 +172,60 @@ def test_an_sdf_export_is_an_input_again(tmp_path: Path) -> None:
     out = compile_file(second, tmp_path / "b", Diags()).out
     assert out is not None
     assert_same_physics(source, out / "urdf/solo.urdf")
+
+
+def test_add_floating_base(tmp_path: Path) -> None:
+    """URDF: Pinocchio makes the floating joint a free flyer, so a fixed-base load of the
+    export is the free-flyer model of the source; MJCF: a freejoint."""
+    import mujoco
+    import numpy as np
+    import pinocchio as pin
+
+    from tests.backends.pin_compare import load
+    from tests.conftest import ERD
+
+    source = ERD / "solo_description/robots/solo12.urdf"
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: solo
+          modelname: solo-free
+          input_models: {{solo: {{basefile: "{source}"}}}}
+          assemble: {{model: solo}}
+          export_config:
+            - {{type: urdf, add_floating_base: true}}
+            - {{type: mjcf, add_floating_base: true}}
+        """)
+    out = compile_file(spec, tmp_path / "out", Diags()).out
+    assert out is not None
+    free, ours = load(source), pin.buildModelFromUrdf(str(out / "urdf/solo.urdf"))
+    assert (ours.nq, ours.nv) == (free.nq, free.nv)
+    assert abs(pin.computeTotalMass(ours) - pin.computeTotalMass(free)) < 1e-12
+    q = pin.neutral(free)
+    np.testing.assert_allclose(pin.computeGeneralizedGravity(ours, ours.createData(), q),
+                               pin.computeGeneralizedGravity(free, free.createData(), q), atol=1e-12)
+    model = mujoco.MjModel.from_xml_path(str(out / "mjcf/solo.xml"))
+    assert model.nq == free.nq and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+
+
+def test_sdf_loop_closures_with_include_cut_joints(tmp_path: Path) -> None:
+    import shutil
+    import subprocess
+
+    from mpc.backends import sdf
+    from mpc.compiler.diagnostics import Sink
+
+    arm(tmp_path)
+    spec = write(tmp_path / "m.yml", HEAD.replace("  export_config:\n", """  joints:
+    loop: {cut_joint: true, parent: base, child: lower, type: ball}
+  export_config:
+""") + "    - {type: sdf, mesh_format: stl, include_cut_joints: true}\n")
+    sink = Diags()
+    out = compile_file(spec, tmp_path / "out", sink).out
+    assert out is not None
+    sink.diagnostics.clear()  # W0500: the URDF-only data left out
+    checked = subprocess.run([shutil.which("ign") or "ign", "sdf", "-k", str(out / "sdf/arm.sdf")],
+                             capture_output=True, text=True)
+    assert "Valid." in checked.stdout, checked.stdout + checked.stderr
+    robot = sdf.read(out / "sdf/arm.sdf", Sink())
+    assert robot is not None and list(robot.cut_joints) == ["loop"]
+    assert robot.cut_joints["loop"].type == "ball"
