@@ -19,7 +19,7 @@ from mpc.backends import meshes
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.extras import CutJoint
+from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import link_in_root, matrix_pose
 from mpc.ir.program import SdfExport
@@ -34,6 +34,8 @@ IND = "  "
 WORLD = "world"  # SDF's name for the world frame, reserved as a link name
 UNBOUNDED = 1e16  # the position limit SDF uses for "no limit" (its default, and sdformat's)
 _SKIPPED = ("floating", "planar")  # URDF joint types SDF has no joint for
+# The IR's single-link sensors SDF has, by their SDF type (Joint6DOF goes into its joint).
+LINK_SENSORS = {"IMU": "imu", "CameraSensor": "camera", "RotatingRaySensor": "gpu_lidar", "GPS": "navsat"}
 # A link without <inertial> weighs 1 kg in SDF; in URDF it is massless.
 _MASSLESS = Inertial(mass=0.0, inertia=Inertia(ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.0, iyz=0.0, izz=0.0))
 
@@ -83,7 +85,9 @@ def left_out(robot: Robot, cut_joints: bool = False) -> list[str]:
     if mimics := [j.name for j in joints if j.mimic is not None]:
         out.append("the mimic of joint" + "s" * (len(mimics) > 1) + " " + ", ".join(f"'{m}'" for m in mimics))
     counts: Counter[tuple[str, str]] = Counter({
-        ("", "motor"): len(robot.motors), ("", "sensor"): len(robot.sensors),
+        ("", "motor"): len(robot.motors),
+        ("", "sensor SDF has no type for"): sum(x.type not in (*LINK_SENSORS, "Joint6DOF") or (not x.link
+                                               and not x.joint) for x in robot.sensors.values()),
         ("", "named pose"): len(robot.poses),
         ("", "loop-closure joint"): 0 if cut_joints else len(robot.cut_joints),
         ("", "submechanism"): len(robot.submechanisms), ("", "annotation category"): len(robot.annotations),
@@ -181,7 +185,22 @@ class _Writer:
                 name = _unique(name, f"_{i}", used) if name in used else name
                 used.add(name)
                 self._emit_shape(d, kind, name, item)
+        for sensor in sorted(self.robot.sensors.values(), key=lambda x: x.name):
+            if sensor.link == link.name and sensor.type in LINK_SENSORS:
+                self._emit_sensor(d, sensor, LINK_SENSORS[sensor.type])
         self.line(depth, "</link>")
+
+    def _emit_sensor(self, depth: int, sensor: Sensor, kind: str) -> None:
+        """A sensor as SDF has it: its type and pose; type-specific settings are left to
+        SDF's defaults (the IR keeps them as annotations, for SMURF)."""
+        self.line(depth, f'<sensor name="{_attr(sensor.name)}" type="{kind}">')
+        xyz = sensor.position_offset or (0.0, 0.0, 0.0)
+        rpy = sensor.orientation_offset if sensor.orientation_offset and len(sensor.orientation_offset) == 3 \
+            else (0.0, 0.0, 0.0)
+        self.pose(depth + 1, Pose(tuple(xyz), tuple(rpy)))  # type: ignore[arg-type]
+        if kind == "camera":
+            self.line(depth + 1, "<camera/>")
+        self.line(depth, "</sensor>")
 
     def _emit_inertial(self, depth: int, inertial: Inertial) -> None:
         self.line(depth, "<inertial>")
@@ -253,6 +272,9 @@ class _Writer:
         self.leaf(d, "child", self.links[joint.child])
         if joint.type != "fixed":
             self._emit_axis(d, joint)
+        for sensor in sorted(self.robot.sensors.values(), key=lambda x: x.name):
+            if sensor.type == "Joint6DOF" and (sensor.joint == joint.name or sensor.link == joint.child):
+                self.line(d, f'<sensor name="{_attr(sensor.name)}" type="force_torque"/>')
         self.line(depth, "</joint>")
 
     def _emit_cut_joint(self, depth: int, cut: CutJoint) -> None:

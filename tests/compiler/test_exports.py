@@ -229,3 +229,33 @@ def test_sdf_loop_closures_with_include_cut_joints(tmp_path: Path) -> None:
     robot = sdf.read(out / "sdf/arm.sdf", Sink())
     assert robot is not None and list(robot.cut_joints) == ["loop"]
     assert robot.cut_joints["loop"].type == "ball"
+
+
+def test_sdf_sensors(tmp_path: Path) -> None:
+    """IMU, camera, lidar and GPS go into their links, a 6-DOF force-torque sensor into the
+    joint above its link; sensors over several joints have no SDF type (W0500 says so)."""
+    import shutil
+    import subprocess
+
+    arm(tmp_path)
+    spec = write(tmp_path / "m.yml", HEAD.replace("  export_config:\n", """  sensors:
+    - {type: IMU, name: imu, link: upper, position_offset: [0, 0, 0.1]}
+    - {type: CameraSensor, name: cam, link: lower}
+    - {type: RotatingRaySensor, name: lidar, link: base}
+    - {type: Joint6DOF, name: ft, link: lower}
+    - {type: JointPosition, name: encoders, targets: All}
+  export_config:
+""") + "    - {type: sdf, mesh_format: stl}\n")
+    sink = Diags()
+    out = compile_file(spec, tmp_path / "out", sink).out
+    assert out is not None
+    warning = next(d for d in sink.diagnostics if d.code == "W0500")
+    assert "1 sensor SDF has no type for" in warning.message
+    sink.diagnostics.clear()
+    root = etree.parse(str(out / "sdf/arm.sdf")).getroot()
+    sensors = {s.get("name"): (s.getparent().get("name"), s.get("type")) for s in root.iter("sensor")}
+    assert sensors == {"imu": ("upper", "imu"), "cam": ("lower", "camera"), "lidar": ("base", "gpu_lidar"),
+                       "ft": ("elbow", "force_torque")}
+    checked = subprocess.run([shutil.which("ign") or "ign", "sdf", "-k", str(out / "sdf/arm.sdf")],
+                             capture_output=True, text=True)
+    assert "Valid." in checked.stdout, checked.stdout + checked.stderr
