@@ -9,6 +9,8 @@ _MODULES = {
     "urdf": "mpc.backends.urdf",
     "mjcf": "mpc.backends.mjcf",
     "sdf": "mpc.backends.sdf",
+    "pdf": "mpc.backends.pdf",
+    "joint_limits": "mpc.backends.joint_limits",
 }
 
 

@@ -34,7 +34,17 @@ from mpc.ir.ops import (
     SetRobotName,
     TakeLeaf,
 )
-from mpc.ir.program import Export, Input, MjcfExport, Program, RepoRef, SdfExport, UrdfExport
+from mpc.ir.program import (
+    Export,
+    Input,
+    JointLimitsExport,
+    MjcfExport,
+    PdfExport,
+    Program,
+    RepoRef,
+    SdfExport,
+    UrdfExport,
+)
 from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
@@ -266,6 +276,11 @@ class _Lowering:
         out: list[Export] = []
         written: dict[str, Export] = {}
         for entry in self.model.export_config:
+            if entry.type in ("pdf", "joint_limits"):
+                export = self.simple_export(entry)
+                if export is not None:
+                    out.append(export)
+                continue
             if entry.type not in BUILT_EXPORTS:
                 self.not_yet(entry.value_span("type"), f"export type '{entry.type}'")
                 continue
@@ -304,6 +319,19 @@ class _Lowering:
             written[target] = export
             out.append(export)
         return tuple(out)
+
+    def simple_export(self, entry: Any) -> Export | None:
+        """The pdf and joint_limits entries (no meshes, no kinematic options)."""
+        if entry.type == "pdf":
+            return PdfExport(span=entry.span)
+        joints = tuple(entry.joints)
+        from mpc.backends.joint_limits import SELECTIONS
+
+        if len(joints) == 1 and joints[0].isupper() and joints[0] not in SELECTIONS:
+            what = "submodel joint lists" if joints[0] != "ABSTRACT" else "ABSTRACT (the abstract model)"
+            self.not_yet(entry.value_span("joints"), f"joints: {joints[0]} — {what}")
+            return None
+        return JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name)
 
     def program(self) -> Program:
         """The program, also after errors (values that failed are None), so that the names

@@ -97,7 +97,29 @@ class MjcfExport:
     type: Literal["mjcf"] = "mjcf"
 
 
-Export = UrdfExport | SdfExport | MjcfExport
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PdfExport:
+    """A `type: pdf` entry: the kinematic tree as a graph (Graphviz source and PDF)."""
+
+    span: Span
+    filename: str = ""
+    add_floating_base: bool = False
+    type: Literal["pdf"] = "pdf"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class JointLimitsExport:
+    """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED or names),
+    written to `file_name`."""
+
+    span: Span
+    joints: tuple[str, ...] = ("ALL",)
+    file_name: str = "joint_limits.yml"
+    add_floating_base: bool = False
+    type: Literal["joint_limits"] = "joint_limits"
+
+
+Export = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -1,0 +1,68 @@
+"""ir.Robot → a ROCK joint-limits file (YAML), for the joints an export selects.
+
+Format (Phobos's): `{limits: {names: [...], elements: [{max: {position, speed, effort},
+min: {position}}]}}`. Fixed joints are never listed; a missing limit is written as 0.
+Selections: ALL (every movable joint), ACTIVE and INDEPENDENT (the submechanisms'
+`jointnames_active` / `jointnames_independent`), ACTUATED (joints with a motor), or a
+list of joint names. Written as JSON-compatible YAML with sorted keys, so it diffs
+cleanly.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from mpc.backends.xml import write_path
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.program import JointLimitsExport
+from mpc.ir.robot import Robot
+from mpc.ir.tree import depth_first
+
+SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED")
+
+
+def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:
+    """The joints the export lists, in the tree's canonical order."""
+    movable = [j.name for j, _ in depth_first(robot) if j is not None and j.type != "fixed"]
+    if export.joints == ("ALL",):
+        return movable
+    if export.joints in (("ACTIVE",), ("INDEPENDENT",)):
+        key = f"jointnames_{export.joints[0].lower()}"
+        chosen = {str(j) for sm in robot.submechanisms for j in sm.definition.get(key, ())}  # type: ignore[union-attr]
+        if not robot.submechanisms:
+            sink.warning(export.span, "W0503", f"joints: {export.joints[0]} needs submechanisms; this "
+                         "model has none, so every movable joint is listed (as Phobos does)")
+            return movable
+        return [j for j in movable if j in chosen]
+    if export.joints == ("ACTUATED",):
+        driven = {m.joint for m in robot.motors.values()}
+        return [j for j in movable if j in driven]
+    listed = []
+    for name in export.joints:
+        joint = robot.joints.get(name)
+        if joint is None or joint.type == "fixed":
+            sink.error(export.span, "E0310", f"joint_limits lists '{name}', which is not a movable "
+                       "joint of the model")
+        else:
+            listed.append(name)
+    return listed
+
+
+def to_yaml(robot: Robot, names: list[str]) -> str:
+    elements = []
+    for name in names:
+        joint = robot.joints[name]
+        lim = joint.limit
+        lower = (lim.lower if lim and lim.lower is not None else 0.0) if joint.type != "continuous" else 0.0
+        upper = (lim.upper if lim and lim.upper is not None else 0.0) if joint.type != "continuous" else 0.0
+        elements.append({"max": {"position": upper, "speed": lim.velocity if lim and lim.velocity else 0.0,
+                                 "effort": lim.effort if lim and lim.effort else 0.0},
+                         "min": {"position": lower}})
+    return json.dumps({"limits": {"names": names, "elements": elements}}, indent=2, sort_keys=True) + "\n"
+
+
+def emit(robot: Robot, export: JointLimitsExport, out: Path, sink: Sink) -> None:
+    """Write `<file_name>` in the export's root folder."""
+    names = select(robot, export, sink)
+    write_path(out / export.file_name, to_yaml(robot, names))

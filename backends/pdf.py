@@ -1,0 +1,81 @@
+"""ir.Robot → the kinematic tree as a graph: `<name>.pdf.gv` (Graphviz) and `<name>.pdf`.
+
+Links are boxes; joints are ellipses labelled with their type, axis and origin (and their
+mimic); joints of a submechanism are filled with that submechanism's colour. The PDF is
+rendered by Graphviz's `dot`; without it the .gv file is still written and a warning
+says how to get the PDF.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+from mpc.backends.xml import fmt_floats, write_path
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.program import PdfExport
+from mpc.ir.robot import Joint, Robot
+from mpc.ir.tree import depth_first
+
+# Fill colours for submechanisms, in order (Graphviz's X11 names, light enough for text).
+PALETTE = ("lightblue", "palegreen", "lightsalmon", "khaki", "plum", "lightcyan", "peachpuff",
+           "lightpink", "wheat", "honeydew", "lavender", "mistyrose")
+
+
+def _quote(text: str) -> str:
+    """A DOT string; line breaks become DOT's centred `\\n`."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def _joint_label(joint: Joint) -> str:
+    lines = [joint.name, joint.type]
+    if joint.type not in ("fixed", "floating"):
+        lines.append("axis " + fmt_floats(joint.axis or (1.0, 0.0, 0.0)))
+    if joint.origin is not None:
+        lines.append("xyz " + fmt_floats(joint.origin.xyz))
+        lines.append("rpy " + fmt_floats(joint.origin.rpy))
+    if joint.mimic is not None:
+        lines.append(f"mimics {joint.mimic.joint}")
+    return "\n".join(lines)
+
+
+def to_gv(robot: Robot) -> str:
+    """The Graphviz source of the kinematic tree, in the canonical order."""
+    colour: dict[str, str] = {}
+    for i, sm in enumerate(robot.submechanisms):
+        for key in ("jointnames_spanningtree", "jointnames"):
+            for joint in sm.definition.get(key, ()):  # type: ignore[union-attr]
+                colour.setdefault(str(joint), PALETTE[i % len(PALETTE)])
+    out = [f"digraph {_quote(robot.name)} {{", '  rankdir="TB";', '  node [fontsize=10];']
+    for joint, link in depth_first(robot):
+        out.append(f"  {_quote('link:' + link)} [shape=box, label={_quote(link)}];")
+        if joint is None:
+            continue
+        style = f', style=filled, fillcolor="{colour[joint.name]}"' if joint.name in colour else ""
+        out.append(f"  {_quote('joint:' + joint.name)} [shape=ellipse, label={_quote(_joint_label(joint))}"
+                   f"{style}];")
+        out.append(f"  {_quote('link:' + joint.parent)} -> {_quote('joint:' + joint.name)};")
+        out.append(f"  {_quote('joint:' + joint.name)} -> {_quote('link:' + link)};")
+    for name in sorted(robot.cut_joints):
+        cut = robot.cut_joints[name]
+        out.append(f"  {_quote('link:' + cut.parent)} -> {_quote('link:' + cut.child)} "
+                   f'[style=dashed, label={_quote(name + " (loop)")}];')
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
+    """Write `<name>.pdf.gv` and, with `dot`, `<name>.pdf` in the export's root folder."""
+    name = export.filename or robot.name
+    gv = out / f"{name}.pdf.gv"
+    write_path(gv, to_gv(robot))
+    dot = shutil.which("dot")
+    if dot is None:
+        sink.warning(export.span, "W0502", f"'dot' (Graphviz) is not installed: wrote {gv.name} but "
+                     "not the PDF", hint=f"apt-get install graphviz, then: dot -Tpdf {gv.name} -o {name}.pdf")
+        return
+    done = subprocess.run([dot, "-Tpdf", str(gv), "-o", str(out / f"{name}.pdf")],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        sink.error(export.span, "E0506", f"Graphviz could not render {gv.name}: {done.stderr.strip()}")
