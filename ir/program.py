@@ -119,7 +119,24 @@ class JointLimitsExport:
     type: Literal["joint_limits"] = "joint_limits"
 
 
-Export = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RosPackageExport:
+    """The ROS 2 package files (`package.xml`, `CMakeLists.txt`, `config/init_positions_*.yml`),
+    added after the other exports when one of them writes `package://` paths.
+
+    package: the package's name. version, description, license: the model's, when given.
+    """
+
+    span: Span
+    package: str
+    version: str = "0.0.0"
+    description: str = ""
+    license: str = ""
+    add_floating_base: bool = False
+    type: Literal["ros_package"] = "ros_package"
+
+
+Export = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | RosPackageExport
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -88,6 +88,7 @@ def test_urdf_options_and_mesh_ops(tmp_path: Path) -> None:
         model:
           robotname: arm
           modelname: arm-pkg
+          ros_pkg_name: arm_pkg
           input_models: {{arm: {{basefile: "{source}"}}}}
           assemble: {{model: arm}}
           reduce_meshes: 300
@@ -101,7 +102,7 @@ def test_urdf_options_and_mesh_ops(tmp_path: Path) -> None:
     assert out is not None
     root = etree.parse(str(out / "urdf/arm.urdf")).getroot()
     filenames = [m.get("filename") for m in root.iter("mesh")]
-    assert filenames and all(f.startswith("package://arm-pkg/meshes/stl/") for f in filenames)
+    assert filenames and all(f.startswith("package://arm_pkg/meshes/stl/") for f in filenames)
     assert all(m.get("scale") is None for m in root.iter("mesh"))
     assert sorted(p.stem for p in (out / "meshes/obj").iterdir()) == sorted(
         p.stem for p in (out / "meshes/stl").iterdir())
