@@ -6,7 +6,8 @@ so that a hand-edited file kept through deployment's `keep_files` is the way to 
 in. `CMakeLists.txt` installs every folder the other exports wrote into
 `share/<package>`. Each named pose becomes `config/init_positions_<pose>.yml`
 (`initial_positions: {joint: value}`, the form ros2_control's simulators read).
-Runs after the other exports, since it lists what they wrote.
+Runs after the other exports and the post_processing commands, since it lists what they
+wrote; a file a command wrote is kept.
 """
 
 from __future__ import annotations
@@ -62,8 +63,16 @@ def init_positions(positions: dict[str, float]) -> str:
 
 def emit(robot: Robot, export: RosPackageExport, out: Path, sink: Sink) -> None:
     """Write the package files into the export's root folder."""
-    for pose, positions in sorted(robot.poses.items()):
-        write_path(out / "config" / f"init_positions_{pose}.yml", init_positions(dict(positions)))
+    files = {f"config/init_positions_{pose}.yml": init_positions(dict(positions))
+             for pose, positions in sorted(robot.poses.items())}
+    for name, text in files.items():
+        _write_new(out / name, text)
     folders = sorted(p.name for p in out.iterdir() if p.is_dir() and not p.name.startswith("."))
-    write_path(out / "package.xml", package_xml(export, robot))
-    write_path(out / "CMakeLists.txt", cmakelists(export.package, folders))
+    _write_new(out / "package.xml", package_xml(export, robot))
+    _write_new(out / "CMakeLists.txt", cmakelists(export.package, folders))
+
+
+def _write_new(path: Path, text: str) -> None:
+    """Write `path` unless a post_processing command wrote it already (Phobos's rule)."""
+    if not path.exists():
+        write_path(path, text)

@@ -24,7 +24,7 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
-from mpc.ir.program import Program
+from mpc.ir.program import CommandExport, Program
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -157,6 +157,12 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".mpc-tmp", dir=out.parent))
     try:
         for export in program.exports:
+            if isinstance(export, CommandExport):
+                from mpc.backends.commands import run
+
+                if sink.has_errors() or not run(export, staging, out, sink):
+                    break  # the files a command would see are incomplete, or it failed
+                continue
             model = robot
             if export.add_floating_base:
                 from mpc.ir.floating import with_floating_base

@@ -136,7 +136,26 @@ class RosPackageExport:
     type: Literal["ros_package"] = "ros_package"
 
 
-Export = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | RosPackageExport
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CommandExport:
+    """A `post_processing` command, run after the files are written (backends/commands.py).
+
+    command: the program and its arguments; with `shell`, one string for the shell.
+    cwd: where it runs, relative to the definition's folder ("" : the output folder).
+    executable: the program to start instead of command[0] (with `shell`: the shell).
+    """
+
+    span: Span
+    command: tuple[str, ...]
+    shell: bool = False
+    cwd: str = ""
+    executable: str = ""
+    add_floating_base: bool = False
+    type: Literal["command"] = "command"
+
+
+Export = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | RosPackageExport
+          | CommandExport)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

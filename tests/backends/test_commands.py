@@ -1,0 +1,84 @@
+"""post_processing: commands run from the command line's `mpc compile` on a real model."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tests.compiler.test_cli import mpc
+from tests.conftest import ERD, write
+
+SOURCE = ERD / "talos_data/robots/talos_left_arm.urdf"
+HEAD = f"""
+model:
+  robotname: arm
+  modelname: talos_arm
+  input_models: {{arm: {{basefile: "{SOURCE}"}}}}
+  assemble: {{model: arm}}
+"""
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_commands_run_in_order_in_the_output_folder(tmp_path: Path) -> None:
+    """A string without shell is split (Phobos's check_urdf line runs, urdfdom's real tool);
+    a shell line sees MPC_* and PHOBOS_CI_*; a cwd is relative to the definition; the ROS
+    files come after the commands and list the folder they made."""
+    (tmp_path / "scripts").mkdir()
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config: [{type: urdf, mesh_format: stl, ros_pathes: true}]
+  post_processing:
+    - cmd: "check_urdf urdf/arm.urdf"
+    - cmd: 'mkdir -p doc && check_urdf urdf/arm.urdf > doc/tree.txt && pwd > doc/ran_in.txt'
+      shell: true
+    - cmd: [sh, -c, 'env | grep -E "^(MPC|PHOBOS_CI)_" | sort > "$MPC_EXPORTDIR/env.txt";
+                     pwd > "$MPC_EXPORTDIR/cwd.txt"']
+      cwd: scripts
+""")
+    done = mpc("compile", spec, "-o", tmp_path / "out")
+    assert done.returncode == 0, done.stderr
+    out = tmp_path / "out"
+    assert "robot name is: arm" in (out / "doc/tree.txt").read_text()
+    staging = Path((out / "doc/ran_in.txt").read_text().strip())
+    assert staging.parent == tmp_path and staging.name.startswith(".out.") and not staging.exists()
+    env = dict(line.split("=", 1) for line in (out / "env.txt").read_text().splitlines())
+    assert env == {"MPC_DEFINITIONDIR": str(tmp_path), "MPC_EXPORTDIR": str(staging),
+                   "MPC_TARGETDIR": str(out), "PHOBOS_CI_DEFINITIONDIR": str(tmp_path),
+                   "PHOBOS_CI_EXPORTDIR": str(staging), "PHOBOS_CI_TARGETDIR": str(out)}
+    assert (out / "cwd.txt").read_text().strip() == str(tmp_path / "scripts")
+    assert "  doc\n  meshes\n  urdf\n" in (out / "CMakeLists.txt").read_text()
+
+
+def test_a_failing_command_fails_the_build_and_keeps_the_last_output(tmp_path: Path) -> None:
+    good = write(tmp_path / "m.yml", HEAD)
+    assert mpc("compile", good, "-o", tmp_path / "out").returncode == 0
+    before = tree(tmp_path / "out")
+    bad = write(tmp_path / "m.yml", HEAD + """
+  post_processing:
+    - cmd: [sh, -c, 'echo checking; echo "inertia of arm_left_4_link is not positive" >&2; exit 3']
+    - cmd: [touch, "$MPC_DEFINITIONDIR/never"]
+""")
+    done = mpc("compile", bad, "-o", tmp_path / "out")
+    assert done.returncode == 1
+    lines = done.stderr.splitlines()
+    assert lines[0] == (f"{bad}:8:12: error[E0508]: post_processing command `sh -c 'echo checking; "
+                        "echo \"inertia of arm_left_4_link is not positive\" >&2; exit 3'` failed with "
+                        "exit status 3")
+    assert lines[3:6] == ["  note: its output ends:", "    checking",
+                          "    inertia of arm_left_4_link is not positive"]
+    assert tree(tmp_path / "out") == before
+    assert not (tmp_path / "never").exists() and not list(tmp_path.glob(".out.*"))
+
+
+def test_a_program_that_is_not_there(tmp_path: Path) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + """
+  post_processing:
+    - cmd: [mpc-no-such-program, urdf/arm.urdf]
+""")
+    done = mpc("compile", spec, "-o", tmp_path / "out", "--format", "gcc")
+    assert done.returncode == 1
+    assert done.stderr.splitlines()[0] == (f"{spec}:8:12: error: post_processing command "
+                                           "`mpc-no-such-program urdf/arm.urdf` could not start: "
+                                           "No such file or directory [E0508]")
+    assert not (tmp_path / "out").exists()
