@@ -81,7 +81,7 @@ def _compile(args: argparse.Namespace) -> int:
                   file=sys.stderr)
         return 1
     files = sorted(str(p.relative_to(result.out)) for p in result.out.rglob("*") if p.is_file())
-    models = [f for f in files if not f.startswith("meshes/")]
+    models = [f for f in files if "meshes" not in Path(f).parts]
     print(f"compiled '{args.definition}' into '{result.out}': {', '.join(models)} "
           f"and {len(files) - len(models)} mesh files")
     return 0

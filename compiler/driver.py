@@ -24,7 +24,7 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
-from mpc.ir.program import CommandExport, Program
+from mpc.ir.program import CommandExport, Export, Program, SubmodelExport
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -156,24 +156,34 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".mpc-tmp", dir=out.parent))
     try:
+        submodels: dict[str, Robot | None] = {}
         for export in program.exports:
+            if isinstance(export, SubmodelExport):
+                from mpc.ir.submodel import cut
+
+                submodels[export.name] = part = cut(robot, export, sink)
+                if part is not None and export.add_floating_base:
+                    submodels[export.name] = _floating(part, export, sink)
+                continue
             if isinstance(export, CommandExport):
                 from mpc.backends.commands import run
 
                 if sink.has_errors() or not run(export, staging, out, sink):
                     break  # the files a command would see are incomplete, or it failed
                 continue
-            model = robot
+            model, folder = robot, staging
+            if getattr(export, "submodel", ""):
+                part = submodels[export.submodel]  # type: ignore[union-attr]
+                if part is None:
+                    continue
+                model, folder = part, staging / "submodels" / export.submodel  # type: ignore[union-attr]
             if export.add_floating_base:
-                from mpc.ir.floating import with_floating_base
-
-                floating = with_floating_base(robot)
+                floating = _floating(model, export, sink)
                 if floating is None:
-                    sink.error(export.span, "E0505", "add_floating_base needs the names 'world' and "
-                               "'floating_base', which the robot uses already")
                     continue
                 model = floating
-            BACKENDS[export.type]().emit(model, export, staging, sink)
+            folder.mkdir(parents=True, exist_ok=True)
+            BACKENDS[export.type]().emit(model, export, folder, sink)
         if sink.has_errors():
             return False
         _replace(staging, out)
@@ -181,6 +191,17 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
     finally:
         if staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
+
+
+def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
+    """`robot` with a floating base (ir/floating.py), or None with E0505."""
+    from mpc.ir.floating import with_floating_base
+
+    floating = with_floating_base(robot)
+    if floating is None:
+        sink.error(export.span, "E0505", "add_floating_base needs the names 'world' and "
+                   "'floating_base', which the robot uses already")
+    return floating
 
 
 def _replace(new: Path, out: Path) -> None:

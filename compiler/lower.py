@@ -47,6 +47,7 @@ from mpc.ir.program import (
     RepoRef,
     RosPackageExport,
     SdfExport,
+    SubmodelExport,
     UrdfExport,
 )
 from mpc.ir.robot import Limit, Pose
@@ -280,53 +281,94 @@ class _Lowering:
             out.append(UrdfExport(mesh_format="input_type", span=self.model.span))
         written: dict[str, Export] = {}
         for entry in self.model.export_config or ():
-            if entry.type in ("pdf", "joint_limits"):
-                export = self.simple_export(entry)
-                if export is not None:
-                    out.append(export)
-                continue
-            if entry.type not in BUILT_EXPORTS:
-                self.not_yet(entry.value_span("type"), f"export type '{entry.type}'")
-                continue
-            later = dict(_KINEMATIC_LATER)
-            if entry.type != "urdf":
-                later.update(additional_meshes=None, ros_pathes=False, enforce_zero=False)
-            for key, default in later.items():
-                if getattr(entry, key) != default:
-                    self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
-            filename = (entry.filename or self.model.robotname) + entry.filename_suffix
-            target = f"{entry.type}/{filename}"
-            if target in written:
-                self.sink.error(entry.span, "E0503", f"two {entry.type} exports would write {target} "
-                                "(Phobos silently let the last one win); give one a filename_suffix",
-                                notes=((written[target].span, "the other export"),))
-                continue
-            mesh_format = entry.mesh_format
-            if entry.type == "mjcf" and mesh_format == "input_type":
-                mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
-            export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
-                                               add_floating_base=entry.add_floating_base,
-                                               filename=filename if filename != self.model.robotname else "")
-            if entry.type == "sdf":
-                export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
-            elif entry.include_cut_joints:
-                self.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
-                                f"no meaning in a {entry.type} export: "
-                                + ("URDF cannot hold loops" if entry.type == "urdf"
-                                   else "MJCF always closes loops with equality constraints"))
-            if entry.type == "urdf":
-                extra = entry.additional_meshes
-                package = (self.model.ros_pkg_name or self.model.modelname) if entry.ros_pathes else None
-                export = replace(
-                    export, enforce_zero=entry.enforce_zero, ros_package=package,
-                    additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
-            written[target] = export
-            out.append(export)
+            if entry.type == "submodel":
+                out.extend(self.submodel(entry, written))
+            else:
+                out.extend(self.export(entry, written, self.model.robotname))
         out.extend(self.commands())
         package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
         if package is not None:
             out.append(self.ros_package(package))
         return tuple(out)
+
+    def export(self, entry: Any, written: dict[str, Export], robotname: str,
+               submodel: str = "", inherited: bool = False) -> list[Export]:
+        """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/).
+        An entry a submodel inherits from the model writes relative mesh paths: its meshes are
+        in the submodel's folder, not where the package's `package://` paths point."""
+        if inherited and getattr(entry, "ros_pathes", False):
+            entry = entry.model_copy(update={"ros_pathes": False})
+        if entry.type in ("pdf", "joint_limits"):
+            export = self.simple_export(entry)
+            return [] if export is None else [replace(export, submodel=submodel)]
+        if entry.type not in BUILT_EXPORTS:
+            self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
+                         + (" in a submodel" if submodel and entry.type == "submodel" else ""))
+            return []
+        later = dict(_KINEMATIC_LATER)
+        if entry.type != "urdf":
+            later.update(additional_meshes=None, ros_pathes=False, enforce_zero=False)
+        elif submodel:
+            later.update(ros_pathes=False)
+        for key, default in later.items():
+            if getattr(entry, key) != default:
+                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'"
+                             + (" in a submodel" if submodel and entry.type == "urdf" else ""))
+        filename = (entry.filename or robotname) + entry.filename_suffix
+        target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
+        if target in written:
+            self.sink.error(entry.span, "E0503", f"two {entry.type} exports would write {target} "
+                            "(Phobos silently let the last one win); give one a filename_suffix",
+                            notes=((written[target].span, "the other export"),))
+            return []
+        mesh_format = entry.mesh_format
+        if entry.type == "mjcf" and mesh_format == "input_type":
+            mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
+        export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
+                                           add_floating_base=entry.add_floating_base, submodel=submodel,
+                                           filename=filename if filename != robotname else "")
+        if entry.type == "sdf":
+            export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
+        elif entry.include_cut_joints:
+            self.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
+                            f"no meaning in a {entry.type} export: "
+                            + ("URDF cannot hold loops" if entry.type == "urdf"
+                               else "MJCF always closes loops with equality constraints"))
+        if entry.type == "urdf":
+            extra = entry.additional_meshes
+            package = (self.model.ros_pkg_name or self.model.modelname) if entry.ros_pathes else None
+            export = replace(
+                export, enforce_zero=entry.enforce_zero, ros_package=package,
+                additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
+        written[target] = export
+        return [export]
+
+    def submodel(self, entry: Any, written: dict[str, Export]) -> list[Export]:
+        """A `submodel` entry: the part of the robot it cuts out, then its exports (its own
+        export_config, or the model's without submodels)."""
+        for key, default in _SUBMODEL_LATER.items():
+            if getattr(entry, key) != default:
+                self.not_yet(entry.key_span(key), f"submodel option '{key}'")
+        cut = SubmodelExport(span=entry.span, name=entry.name, start=entry.start or "",
+                             stop=tuple([entry.stop] if isinstance(entry.stop, str) else entry.stop or ()),
+                             include_unstopped_branches=entry.include_unstopped_branches,
+                             add_floating_base=entry.add_floating_base)
+        if f"submodel:{entry.name}" in written:
+            self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write "
+                            f"submodels/{entry.name}", notes=((written[f"submodel:{entry.name}"].span,
+                                                               "the other submodel"),))
+            return []
+        written[f"submodel:{entry.name}"] = cut
+        out: list[Export] = [cut]
+        nested = entry.export_config
+        if nested is None:
+            nested = [e for e in self.model.export_config or () if e.type != "submodel"]
+            if self.model.export_config is None:
+                out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name))
+        for inner in nested:
+            out.extend(self.export(inner, written, entry.name, submodel=entry.name,
+                                   inherited=entry.export_config is None))
+        return out
 
     def commands(self) -> list[CommandExport]:
         """The post_processing commands. A string without `shell: true` is split as a shell
@@ -412,6 +454,11 @@ class _Lowering:
 # Export types `mpc compile` writes; the others are reported as not supported yet.
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
+# Submodel options not built yet, with their defaults.
+_SUBMODEL_LATER: dict[str, Any] = {
+    "no_submechanisms": False, "abstract_model": False, "include_human_in_abstract": False,
+    "remove_fixed": False, "remove_joints": [], "remove_links": [], "move_joint_axis_to_intersection": {},
+    "name_replacements": {}, "filename": None, "only_urdf": False}
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {

@@ -69,6 +69,7 @@ class UrdfExport:
     additional_meshes: tuple[str, ...] = ()
     ros_package: str | None = None
     enforce_zero: bool = False
+    submodel: str = ""
     type: Literal["urdf"] = "urdf"
 
 
@@ -82,6 +83,7 @@ class SdfExport:
     add_floating_base: bool = False
     include_cut_joints: bool = False
     version: Literal["1.6", "1.7", "1.9"] = "1.9"
+    submodel: str = ""
     type: Literal["sdf"] = "sdf"
 
 
@@ -94,6 +96,7 @@ class MjcfExport:
     span: Span
     filename: str = ""
     add_floating_base: bool = False
+    submodel: str = ""
     type: Literal["mjcf"] = "mjcf"
 
 
@@ -104,6 +107,7 @@ class PdfExport:
     span: Span
     filename: str = ""
     add_floating_base: bool = False
+    submodel: str = ""
     type: Literal["pdf"] = "pdf"
 
 
@@ -116,7 +120,28 @@ class JointLimitsExport:
     joints: tuple[str, ...] = ("ALL",)
     file_name: str = "joint_limits.yml"
     add_floating_base: bool = False
+    submodel: str = ""
     type: Literal["joint_limits"] = "joint_limits"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SubmodelExport:
+    """A `type: submodel` entry: the part of the robot that the exports naming it (their
+    `submodel` field) write, into `submodels/<name>/` (ir/submodel.py).
+
+    start: its root ("" : the robot's root). stop: the links (names, or regular expressions
+    matched against whole names) where it ends ("()": the leaves); only the links on the way
+    from start to a stop are kept, and with include_unstopped_branches also the branches
+    that reach no stop. add_floating_base: as for the other exports.
+    """
+
+    span: Span
+    name: str
+    start: str = ""
+    stop: tuple[str, ...] = ()
+    include_unstopped_branches: bool = False
+    add_floating_base: bool = False
+    type: Literal["submodel"] = "submodel"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -154,8 +179,8 @@ class CommandExport:
     type: Literal["command"] = "command"
 
 
-Export = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | RosPackageExport
-          | CommandExport)
+Export = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SubmodelExport
+          | RosPackageExport | CommandExport)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -8,7 +8,7 @@ and attached to its parent part; after the last attach only `root` remains.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Literal
+from typing import Any, Literal
 
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.names import Names
@@ -133,7 +133,28 @@ def keep_links(robot: Robot, kept: set[str], root: str) -> Robot:
     fragments = tuple(f for f in robot.fragments
                       if not (f.names("link") & gone_links or f.names("joint") & gone_joints))
     return replace(robot, root=root, links={n: lk for n, lk in robot.links.items() if n in kept},
-                   joints=joints, fragments=fragments)
+                   joints=joints, fragments=fragments, **_extras_kept(robot, kept, set(joints)))
+
+
+def _extras_kept(robot: Robot, links: set[str], joints: set[str]) -> dict[str, Any]:
+    """Motors, sensors, poses, loop joints and submechanisms that still name only what is kept."""
+
+    def sensor_kept(sensor: Any) -> bool:
+        return ((sensor.link is None or sensor.link in links)
+                and (sensor.joint is None or sensor.joint in joints))
+
+    def submechanism_kept(sm: Any) -> bool:
+        named = {str(j) for value in sm.definition.values() if isinstance(value, list | tuple) for j in value
+                 if str(j) in robot.joints}
+        return named <= joints
+
+    return {
+        "motors": {n: m for n, m in robot.motors.items() if m.joint in joints},
+        "sensors": {n: s for n, s in robot.sensors.items() if sensor_kept(s)},
+        "poses": {n: {j: v for j, v in p.items() if j in joints} for n, p in robot.poses.items()},
+        "cut_joints": {n: c for n, c in robot.cut_joints.items() if {c.parent, c.child} <= links},
+        "submechanisms": tuple(sm for sm in robot.submechanisms if submechanism_kept(sm)),
+    }
 
 
 @dataclass(frozen=True, kw_only=True)
