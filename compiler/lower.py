@@ -313,7 +313,7 @@ class _Lowering:
         for key, default in later.items():
             if getattr(entry, key) != default:
                 self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'"
-                             + (" in a submodel" if submodel and entry.type == "urdf" else ""))
+                             + (" in a submodel" if submodel and key == "ros_pathes" else ""))
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in written:
