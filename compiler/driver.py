@@ -24,7 +24,7 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
-from mpc.ir.program import CommandExport, Export, Program, SubmodelExport
+from mpc.ir.program import CommandExport, Export, Program, RobotExport, SubmodelExport
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -172,16 +172,13 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
                     break  # the files a command would see are incomplete, or it failed
                 continue
             model, folder = robot, staging
-            if getattr(export, "submodel", ""):
-                part = submodels[export.submodel]  # type: ignore[union-attr]
-                if part is None:
+            if isinstance(export, RobotExport):
+                if export.submodel:
+                    model, folder = submodels[export.submodel], staging / "submodels" / export.submodel
+                if model is not None and export.add_floating_base:
+                    model = _floating(model, export, sink)
+                if model is None:
                     continue
-                model, folder = part, staging / "submodels" / export.submodel  # type: ignore[union-attr]
-            if export.add_floating_base:
-                floating = _floating(model, export, sink)
-                if floating is None:
-                    continue
-                model = floating
             folder.mkdir(parents=True, exist_ok=True)
             BACKENDS[export.type]().emit(model, export, folder, sink)
         if sink.has_errors():

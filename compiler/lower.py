@@ -353,12 +353,12 @@ class _Lowering:
                              stop=tuple([entry.stop] if isinstance(entry.stop, str) else entry.stop or ()),
                              include_unstopped_branches=entry.include_unstopped_branches,
                              add_floating_base=entry.add_floating_base)
-        if f"submodel:{entry.name}" in written:
-            self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write "
-                            f"submodels/{entry.name}", notes=((written[f"submodel:{entry.name}"].span,
-                                                               "the other submodel"),))
+        folder = f"submodels/{entry.name}"
+        if folder in written:
+            self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write {folder}",
+                            notes=((written[folder].span, "the other submodel"),))
             return []
-        written[f"submodel:{entry.name}"] = cut
+        written[folder] = cut
         out: list[Export] = [cut]
         nested = entry.export_config
         if nested is None:

@@ -6,7 +6,7 @@ import numpy as np
 
 from mpc.ir import transforms as tf
 from mpc.ir.robot import Pose, Robot
-from mpc.ir.tree import parent_joint
+from mpc.ir.tree import joints_up
 
 
 def pose_matrix(pose: Pose | None) -> np.ndarray:
@@ -15,12 +15,7 @@ def pose_matrix(pose: Pose | None) -> np.ndarray:
 
 def link_in_root(robot: Robot, link: str) -> np.ndarray:
     """X_RL at q = 0: the product of the joint origins from the root down to `link`."""
-    parents = parent_joint(robot)
-    chain = []
-    while link in parents:
-        joint = parents[link]
-        chain.append(pose_matrix(joint.origin))
-        link = joint.parent
+    chain = [pose_matrix(joint.origin) for joint in joints_up(robot, link)]
     return tf.compose(*reversed(chain)) if chain else np.eye(4)
 
 

@@ -157,7 +157,6 @@ class RosPackageExport:
     version: str = "0.0.0"
     description: str = ""
     license: str = ""
-    add_floating_base: bool = False
     type: Literal["ros_package"] = "ros_package"
 
 
@@ -175,12 +174,12 @@ class CommandExport:
     shell: bool = False
     cwd: str = ""
     executable: str = ""
-    add_floating_base: bool = False
     type: Literal["command"] = "command"
 
 
-Export = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SubmodelExport
-          | RosPackageExport | CommandExport)
+# The exports that write a robot (the whole one or a submodel's), optionally floating.
+RobotExport = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport
+Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

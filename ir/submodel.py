@@ -10,7 +10,7 @@ from mpc.ir.names import Names
 from mpc.ir.ops.assembly import keep_links
 from mpc.ir.program import SubmodelExport
 from mpc.ir.robot import Robot
-from mpc.ir.tree import parent_joint
+from mpc.ir.tree import joints_up
 
 
 def _stops(pattern: str, links: set[str]) -> set[str] | None:
@@ -46,12 +46,5 @@ def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
         for stop in stops:
             kept -= names.subtree(stop) - {stop}
         if not export.include_unstopped_branches:
-            up = parent_joint(robot)
-            on_the_way = {start}
-            for stop in stops:
-                link = stop
-                while link != start and link not in on_the_way:
-                    on_the_way.add(link)
-                    link = up[link].parent
-            kept = on_the_way
+            kept = {start} | {j.child for stop in stops for j in joints_up(robot, stop) if j.child in below}
     return replace(keep_links(robot, kept, start), name=export.name)

@@ -28,6 +28,16 @@ def parent_joint(robot: Robot) -> dict[str, Joint]:
     return {joint.child: joint for joint in robot.joints.values()}
 
 
+def joints_up(robot: Robot, link: str) -> list[Joint]:
+    """The joints from `link` up to the root, nearest first."""
+    parents = parent_joint(robot)
+    out = []
+    while link in parents:
+        out.append(parents[link])
+        link = parents[link].parent
+    return out
+
+
 def depth_first(robot: Robot) -> Iterator[tuple[Joint | None, str]]:
     """(joint leading to the link, link) from the root down, children by joint name."""
     children = child_joints(robot)

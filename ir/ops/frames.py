@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
-from mpc.ir.tree import parent_joint
+from mpc.ir.tree import joints_up, parent_joint
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
@@ -88,11 +88,7 @@ class MakeRoot(Op):
         """
         from mpc.ir.kinematics import compose_poses, inverse_pose
 
-        parents = parent_joint(robot)
-        path, link = [], self.link
-        while link in parents:
-            path.append(parents[link])
-            link = parents[link].parent
+        path = joints_up(robot, self.link)
         if not path:
             return robot
         joints, links = dict(robot.joints), dict(robot.links)
