@@ -9,6 +9,7 @@ _MODULES = {
     "urdf": "mpc.backends.urdf",
     "mjcf": "mpc.backends.mjcf",
     "sdf": "mpc.backends.sdf",
+    "smurf": "mpc.backends.smurf",
     "pdf": "mpc.backends.pdf",
     "joint_limits": "mpc.backends.joint_limits",
     "ros_package": "mpc.backends.ros_package",

@@ -19,10 +19,12 @@ from mpc.ir.geometry import MeshSource
 
 
 def _environment_share_dirs() -> list[Path]:
+    import site
+
     dirs = []
-    for key in ("purelib", "platlib"):
-        site = Path(sysconfig.get_paths()[key])
-        dirs.append(site / "cmeel.prefix" / "share")
+    # A virtualenv made with --system-site-packages also sees the system's site folders.
+    for folder in [*(sysconfig.get_paths()[k] for k in ("purelib", "platlib")), *site.getsitepackages()]:
+        dirs.append(Path(folder) / "cmeel.prefix" / "share")
     dirs.append(Path(sys.prefix) / "share")
     seen: list[Path] = []
     for d in dirs:

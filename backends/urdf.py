@@ -1,7 +1,8 @@
 """The URDF backend: `read` a URDF file into the IR, `emit` a robot as URDF.
 
 Output: `<out>/urdf/<robotname>.urdf`, meshes copied to `<out>/meshes/<format>/` and
-referenced relative to the URDF file.
+referenced relative to the URDF file. What URDF cannot hold (motors, sensors, poses,
+annotations, bitmasks, …) is in the SMURF written beside it (backends/smurf.py).
 """
 
 from __future__ import annotations
@@ -21,32 +22,6 @@ from mpc.ir.robot import Robot
 __all__ = ["emit", "read", "to_string"]
 
 
-def left_out(robot: Robot) -> list[str]:
-    """What the robot holds that URDF cannot: motors, sensors, annotations, …"""
-    counts = {
-        ("motor", "motors"): len(robot.motors), ("sensor", "sensors"): len(robot.sensors),
-        ("pose", "poses"): len(robot.poses),
-        ("loop-closure joint", "loop-closure joints"): len(robot.cut_joints),
-        ("submechanism", "submechanisms"): len(robot.submechanisms),
-        ("annotation category", "annotation categories"): len(robot.annotations),
-        ("annotated link", "annotated links"): sum(bool(lk.annotations) for lk in robot.links.values()),
-        ("annotated joint", "annotated joints"): sum(bool(j.annotations) for j in robot.joints.values()),
-        ("collision bitmask or annotation", "collision bitmasks or annotations"): sum(
-            bool(c.annotations) or c.bitmask is not None
-            for lk in robot.links.values() for c in lk.collisions),
-        ("annotated visual", "annotated visuals"): sum(
-            bool(v.annotations) for lk in robot.links.values() for v in lk.visuals),
-        ("material with more than a colour", "materials with more than a colour"): sum(
-            any(getattr(m, k) is not None for k in ("ambient", "specular", "emissive", "shininess",
-                                                     "transparency", "normal_texture"))
-            or bool(m.annotations) for m in robot.materials.values()),
-    }
-    out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
-    if robot.submechanisms_file:
-        out.append("the submechanisms file")
-    return out
-
-
 def check(robot: Robot, export: UrdfExport, sink: Sink) -> bool:
     """Whether `robot` can be written as valid URDF (urdfdom's rules)."""
     ok = True
@@ -64,10 +39,6 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
     if not check(robot, export, sink):
         return
-    missing = left_out(robot)
-    if missing:
-        sink.warning(export.span, "W0500", "the URDF leaves out what URDF cannot hold: "
-                     + ", ".join(missing) + "; no export that holds them (SMURF) is implemented yet")
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return

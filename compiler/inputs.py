@@ -69,10 +69,11 @@ class InputLoader:
         return None if path is None else self._read(path)
 
     def _read(self, path: Path) -> Robot | None:
-        """A model file, by its extension: URDF or SDF."""
+        """A model file, by its extension: URDF, SDF or SMURF."""
         from mpc.backends import BACKENDS
 
-        reader = BACKENDS["sdf" if path.suffix.lower() == ".sdf" else "urdf"]()
+        suffix = path.suffix.lower()
+        reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
         return reader.read(path, self.sink, self.options.resolver)
 
     def _repo_file(self, inp: Input, fetch: bool) -> Path | None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 from mpc.compiler.passes import PassContext
 from mpc.ir.program import Program
 
-READABLE = (".urdf", ".sdf")
+READABLE = (".urdf", ".sdf", ".smurf")
 
 
 def resolve_inputs(program: Program, ctx: PassContext) -> Program:
@@ -22,5 +22,5 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
                            f"'{inp.name}' does not exist")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
-                           "supported yet; mpc reads URDF (.urdf) and SDF (.sdf)")
+                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf) and SMURF (.smurf)")
     return program

@@ -47,7 +47,7 @@ def test_commands_run_in_order_in_the_output_folder(tmp_path: Path) -> None:
                    "MPC_TARGETDIR": str(out), "PHOBOS_CI_DEFINITIONDIR": str(tmp_path),
                    "PHOBOS_CI_EXPORTDIR": str(staging), "PHOBOS_CI_TARGETDIR": str(out)}
     assert (out / "cwd.txt").read_text().strip() == str(tmp_path / "scripts")
-    assert "  doc\n  meshes\n  urdf\n" in (out / "CMakeLists.txt").read_text()
+    assert "  doc\n  meshes\n  smurf\n  urdf\n" in (out / "CMakeLists.txt").read_text()
 
 
 def test_a_failing_command_fails_the_build_and_keeps_the_last_output(tmp_path: Path) -> None:

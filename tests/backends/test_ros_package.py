@@ -46,7 +46,8 @@ def test_ros_package_of_a_real_model(tmp_path: Path) -> None:
     assert (out / "CMakeLists.txt").read_text() == (
         "cmake_minimum_required(VERSION 3.8)\nproject(talos_arm_description)\n\n"
         "find_package(ament_cmake REQUIRED)\n\n"
-        "install(DIRECTORY\n  config\n  meshes\n  sdf\n  urdf\n  DESTINATION share/${PROJECT_NAME}\n)\n\n"
+        "install(DIRECTORY\n  config\n  meshes\n  sdf\n  smurf\n  urdf\n"
+        "  DESTINATION share/${PROJECT_NAME}\n)\n\n"
         "ament_package()\n")
     urdf = etree.parse(str(out / "urdf/arm.urdf")).getroot()
     for mesh in urdf.iter("mesh"):

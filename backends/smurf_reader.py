@@ -1,0 +1,323 @@
+"""SMURF (`.smurf` + its URDF or SDF + `<name>_<category>.yml` files) → ir.Robot.
+
+The `.smurf` lists its files; exactly one of them is the URDF or SDF, read by that
+format's reader. Each annotation file is a mapping `{category: content}` whose entries
+name elements of that model: motors, sensors, poses, loop-closure joints, submechanisms
+and exoskeletons are added; annotations, bitmasks and material properties are set on the
+elements they name; any other category is a free annotation category. Whatever is wrong
+(a file that is not there, a malformed entry, a name the model lacks) is a diagnostic
+with its file:line:col. The derived keys mpc writes (a motor's maxEffort … from its
+joint's limits, an unnamed shape's name) are not kept as annotations, so that reading
+and writing again gives the same files. `files` of other producers' SMURFs (Phobos writes
+every element with all its fields) are read the same way: unknown keys become annotations.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from mpc.backends.packages import PackageResolver
+from mpc.compiler import source
+from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
+from mpc.ir.robot import Material, Pose, Robot
+
+MODEL_SUFFIXES = (".urdf", ".sdf")
+
+
+def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Robot | None:
+    """Read the SMURF at `path`; None when it has errors (all of them reported)."""
+    doc = source.load(path, sink)
+    if doc is None:
+        return None
+    before = sink.error_count
+    robot = _Reader(doc, path, sink, resolver or PackageResolver()).robot()
+    return None if robot is None or sink.error_count > before else robot
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _vector(value: Any, sizes: tuple[int, ...]) -> tuple[float, ...] | None:
+    if isinstance(value, list) and len(value) in sizes and all(_number(v) for v in value):
+        return tuple(float(v) for v in value)
+    return None
+
+
+class _Reader:
+    def __init__(self, doc: source.Document, path: Path, sink: Sink, resolver: PackageResolver) -> None:
+        self.smurf, self.path, self.sink, self.resolver = doc, path, sink, resolver
+        self.doc = doc  # the file being read
+
+    def error(self, where: tuple[str | int, ...], code: str, message: str) -> None:
+        self.sink.error(self.doc.value_span(where), code, message)
+
+    # -- the .smurf ------------------------------------------------------------------------
+
+    def robot(self) -> Robot | None:
+        data = self.smurf.data
+        files = data.get("files") if isinstance(data, dict) else None
+        if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+            where: tuple[str | int, ...] = ("files",) if isinstance(data, dict) and "files" in data else ()
+            self.error(where, "E0512", "a SMURF file is a mapping whose 'files' lists its URDF or SDF "
+                       "and its annotation files (paths relative to the .smurf)")
+            return None
+        models = [i for i, f in enumerate(files) if Path(f).suffix.lower() in MODEL_SUFFIXES]
+        if len(models) != 1:
+            what = ("lists no URDF or SDF file" if not models else
+                    f"lists {len(models)} model files ({', '.join(files[i] for i in models)}); it links one, "
+                    "the others belong in 'additional_files'")
+            self.error(("files", models[1]) if models else ("files",), "E0513", f"the SMURF {what}")
+            return None
+        robot = self.model(files[models[0]], ("files", models[0]))
+        if robot is None:
+            return None
+        self.state = _State(robot)
+        for i, name in enumerate(files):
+            if i != models[0]:
+                self.annotation_file(name, ("files", i))
+        return self.state.robot()
+
+    def listed(self, name: str, where: tuple[str | int, ...]) -> Path | None:
+        path = (self.path.parent / name).resolve()
+        if not path.is_file():
+            self.sink.error(self.smurf.value_span(where), "E0601", f"'{name}', listed in the SMURF, "
+                            "does not exist")
+            return None
+        return path
+
+    def model(self, name: str, where: tuple[str | int, ...]) -> Robot | None:
+        from mpc.backends import BACKENDS
+
+        path = self.listed(name, where)
+        if path is None:
+            return None
+        reader = BACKENDS["sdf" if path.suffix.lower() == ".sdf" else "urdf"]()
+        return reader.read(path, self.sink, self.resolver)
+
+    def annotation_file(self, name: str, where: tuple[str | int, ...]) -> None:
+        path = self.listed(name, where)
+        if path is None:
+            return
+        doc = source.load(path, self.sink)
+        if doc is None:
+            return
+        self.doc = doc
+        if not isinstance(doc.data, dict):
+            self.error((), "E0512", "a SMURF annotation file is a mapping from a category "
+                       "(motors, sensors, …) to its content")
+            return
+        for category, content in doc.data.items():
+            handler = getattr(self, f"_{category}", None)
+            if category in _LISTS and handler is not None:
+                for i, entry in self.entries(category, content):
+                    handler(entry, (category, i))
+            elif isinstance(content, dict):
+                self.state.annotations[category] = content
+            else:
+                self.error((category,), "E0512", f"annotation category '{category}' is a mapping "
+                           "(mpc keeps free annotations by name)")
+
+    def entries(self, category: str, content: Any) -> Iterator[tuple[int, dict[str, Any]]]:
+        """The entries of a list category, each a mapping with a string `name`."""
+        if not isinstance(content, list):
+            self.error((category,), "E0512", f"'{category}' is a list of entries")
+            return
+        for i, entry in enumerate(content):
+            if not isinstance(entry, dict) or not isinstance(entry.get("name"), str):
+                self.error((category, i), "E0512", f"each entry of '{category}' is a mapping with a "
+                           "'name'")
+                continue
+            yield i, dict(entry)
+
+    def known(self, kind: str, name: Any, pool: Any, where: tuple[str | int, ...]) -> bool:
+        if isinstance(name, str) and name in pool:
+            return True
+        entry = self.doc.data_at((*where[:2], "name"))
+        self.error(where, "E0514", f"{where[0]} entry '{entry}': the model has no {kind} '{name}'"
+                   + did_you_mean(str(name), set(pool)))
+        return False
+
+    # -- categories ------------------------------------------------------------------------
+
+    def _motors(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        from mpc.backends.smurf import motor_limits
+
+        s = self.state
+        if not self.known("joint", e.get("joint"), s.joints, (*at, "joint")):
+            return
+        name, joint = e.pop("name"), e.pop("joint")
+        for key, value in motor_limits(s.base, joint).items():
+            if e.get(key) == value:
+                del e[key]
+        s.motors[name] = Motor(name=name, joint=joint, settings=e)
+
+    def _sensors(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        s = self.state
+        kind = e.get("type")
+        if not isinstance(kind, str):
+            self.error(at, "E0512", f"sensor '{e['name']}' has no 'type'")
+            return
+        for key, pool in (("link", s.links), ("joint", s.joints), ("frame", s.links)):
+            if key in e and not self.known(key, e[key], pool, (*at, key)):
+                return
+        targets = e.get("targets", [])
+        if not isinstance(targets, list) or not all(
+                self.known("target", t, s.joints.keys() | s.links.keys(), (*at, "targets", i))
+                for i, t in enumerate(targets)):
+            return
+        offsets = {}
+        for key, sizes in (("position_offset", (3,)), ("orientation_offset", (3, 4))):
+            if key in e:
+                offsets[key] = _vector(e[key], sizes)
+                if offsets[key] is None:
+                    self.error((*at, key), "E0512", f"'{key}' of sensor '{e['name']}' is "
+                               f"{' or '.join(map(str, sizes))} numbers")
+                    return
+        core = ("name", "type", "link", "joint", "frame", "targets", "position_offset", "orientation_offset")
+        s.sensors[e["name"]] = Sensor(
+            name=e["name"], type=kind, link=e.get("link"), joint=e.get("joint"), frame=e.get("frame"),
+            targets=tuple(targets), annotations={k: v for k, v in e.items() if k not in core},
+            **offsets)  # type: ignore[arg-type]
+
+    def _poses(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        values = e.get("joints", {})
+        if not isinstance(values, dict) or not all(_number(v) for v in values.values()):
+            self.error((*at, "joints"), "E0512", f"'joints' of pose '{e['name']}' maps joint names "
+                       "to numbers")
+            return
+        if all(self.known("joint", j, self.state.joints, (*at, "joints", j)) for j in values):
+            self.state.poses[e["name"]] = {j: float(v) for j, v in values.items()}
+
+    def _joints(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        s = self.state
+        name = e.pop("name")
+        if e.get("cut_joint") is True:
+            self.cut_joint(name, e, at)
+        elif self.known("joint", name, s.joints, (*at, "name")):
+            s.joints[name] = replace(s.joints[name], annotations={**s.joints[name].annotations, **e})
+
+    def cut_joint(self, name: str, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        s = self.state
+        if not all(self.known("link", e.get(k), s.links, (*at, k)) for k in ("parent", "child")):
+            return
+        origin = e.get("origin", {})
+        xyz = _vector(origin.get("xyz", [0, 0, 0]), (3,)) if isinstance(origin, dict) else None
+        rpy = _vector(origin.get("rpy", [0, 0, 0]), (3,)) if isinstance(origin, dict) else None
+        axes = []
+        for i, a in enumerate(e.get("constraint_axes", [])):
+            axis = _vector(a.get("axis"), (3,)) if isinstance(a, dict) else None
+            if axis is None:
+                self.error((*at, "constraint_axes", i), "E0512", f"a constraint axis of cut joint "
+                           f"'{name}' is a mapping with an 'axis' of 3 numbers")
+                return
+            axes.append((a.get("name"), axis))
+        if xyz is None or rpy is None:
+            self.error((*at, "origin"), "E0512", f"'origin' of cut joint '{name}' has 'xyz' and 'rpy', "
+                       "3 numbers each")
+            return
+        core = ("cut_joint", "joint_type", "parent", "child", "origin", "constraint_axes")
+        s.cut_joints[name] = CutJoint(
+            name=name, type=str(e.get("joint_type", "fixed")), parent=e["parent"], child=e["child"],
+            origin=Pose(xyz, rpy), constraint_axes=tuple(axes),  # type: ignore[arg-type]
+            annotations={k: v for k, v in e.items() if k not in core})
+
+    def _links(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        s = self.state
+        name = e.pop("name")
+        if self.known("link", name, s.links, (*at, "name")):
+            s.links[name] = replace(s.links[name], annotations={**s.links[name].annotations, **e})
+
+    def _materials(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        from mpc.backends.smurf import _COLOURS, _MATERIAL_SCALARS
+
+        s = self.state
+        name = e.pop("name")
+        old = s.materials.get(name) or Material(name=name, span=self.doc.value_span(at))
+        changes: dict[str, Any] = {}
+        for field, key in (("rgba", "diffuseColor"), *_COLOURS):
+            if key in e:
+                colour = e.pop(key)
+                values = tuple(colour[c] for c in "rgba" if c in colour) if isinstance(colour, dict) else ()
+                if len(values) not in (3, 4) or not all(_number(v) for v in values) or (
+                        field == "rgba" and len(values) != 4):
+                    self.error((*at, key), "E0512", f"'{key}' of material '{name}' is a mapping r, g, b"
+                               f"{'' if field == 'rgba' else ' (and a)'}, a: numbers")
+                    return
+                changes[field] = tuple(float(v) for v in values)
+        for key in _MATERIAL_SCALARS:
+            if key in e:
+                changes[key] = e.pop(key)
+        s.materials[name] = replace(old, **changes, annotations={**old.annotations, **e})
+
+    def _collisions(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        self.shape("collision", e, at)
+
+    def _visuals(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        self.shape("visual", e, at)
+
+    def shape(self, kind: str, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        """Annotations (and a collision's bitmask) of the shape an entry names in its link."""
+        s = self.state
+        if not self.known("link", e.get("link"), s.links, (*at, "link")):
+            return
+        link_name, name = e.pop("link"), e.pop("name")
+        link = s.links[link_name]
+        shapes = list(getattr(link, f"{kind}s"))
+        index = e.get("index")
+        if (isinstance(index, int) and 0 <= index < len(shapes) and shapes[index].name is None
+                and name == f"{link_name}_{kind}"):
+            del e["index"]
+        else:
+            index = next((i for i, c in enumerate(shapes) if c.name == name), None)
+            if index is None:
+                self.error((*at, "name"), "E0514", f"{kind}s entry '{name}' names no {kind} of link "
+                           f"'{link_name}'")
+                return
+        changes: dict[str, Any] = {}
+        if kind == "collision" and "bitmask" in e:
+            bitmask = e.pop("bitmask")
+            if not isinstance(bitmask, int) or isinstance(bitmask, bool) or bitmask < 0:
+                self.error((*at, "bitmask"), "E0512", f"'bitmask' of collision '{name}' is a "
+                           "non-negative integer")
+                return
+            changes["bitmask"] = bitmask
+        shape = shapes[index]
+        shapes[index] = replace(shape, **changes, annotations={**shape.annotations, **e})
+        s.links[link_name] = replace(link, **{f"{kind}s": tuple(shapes)})
+
+    def _submechanisms(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        self.state.submechanisms.append(Submechanism(name=e["name"], definition=e))
+
+    def _exoskeletons(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
+        self.state.submechanisms.append(Submechanism(name=e["name"], exoskeleton=True, definition=e))
+
+
+_LISTS = ("motors", "sensors", "poses", "joints", "links", "materials", "collisions", "visuals",
+          "submechanisms", "exoskeletons")
+
+
+class _State:
+    """The robot being completed, as mutable mappings (the value is built once at the end)."""
+
+    def __init__(self, robot: Robot) -> None:
+        self.base = robot
+        self.links, self.joints = dict(robot.links), dict(robot.joints)
+        self.materials = dict(robot.materials)
+        self.motors, self.sensors = dict(robot.motors), dict(robot.sensors)
+        self.cut_joints, self.poses = dict(robot.cut_joints), dict(robot.poses)
+        self.submechanisms: list[Submechanism] = list(robot.submechanisms)
+        self.annotations = dict(robot.annotations)
+
+    def robot(self) -> Robot:
+        return replace(self.base, links=self.links, joints=self.joints, materials=self.materials,
+                       motors=self.motors, sensors=self.sensors, cut_joints=self.cut_joints,
+                       poses=self.poses, submechanisms=tuple(self.submechanisms),
+                       annotations=self.annotations)
+
+
+__all__ = ["MODEL_SUFFIXES", "read"]
