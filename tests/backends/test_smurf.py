@@ -301,3 +301,21 @@ def test_malformed_smurf_files(tmp_path: Path) -> None:
     spec = broken_smurf(tmp_path, "motors: [\n")
     run = mpc("check", "--format", "gcc", spec)
     assert run.stderr.startswith(f"{tmp_path}/smurf/arm_motors.yml:2:1: error: malformed YAML")
+
+
+def test_category_that_is_not_a_file_name(tmp_path: Path) -> None:
+    """A category becomes part of a file name; one with a '/' would write outside smurf/."""
+    arm(tmp_path)
+    spec = write(tmp_path / "m.yml", HEAD.replace("  export_config:\n", """\
+  annotations:
+    named_annotations:
+      ../../escape: {a: 1}
+  export_config:
+""") + "    - {type: urdf}\n")
+    run = mpc("compile", "--format", "gcc", spec, "-o", tmp_path / "out")
+    assert run.returncode == 1
+    assert run.stderr.splitlines()[0] == (
+        f"{spec}:12:3: error: the SMURF cannot write 'arm_../../escape' as file names in smurf/ (the base "
+        "name is `filename` or the robot's name, then '_' and each annotation category): no '/' or '\\', "
+        "and no '.' first [E0515]")
+    assert not (tmp_path / "out").exists() and not list(tmp_path.glob("*escape*"))
