@@ -269,8 +269,9 @@ class _Reader:
         link = s.links[link_name]
         shapes = list(getattr(link, f"{kind}s"))
         index = e.get("index")
-        if (isinstance(index, int) and 0 <= index < len(shapes) and shapes[index].name is None
-                and name == f"{link_name}_{kind}"):
+        # An unnamed shape was written by its place; an SDF names it `<link>_<kind>[_<index>]`.
+        if (isinstance(index, int) and not isinstance(index, bool) and 0 <= index < len(shapes)
+                and name == f"{link_name}_{kind}" and shapes[index].name in (None, name, f"{name}_{index}")):
             del e["index"]
         else:
             index = next((i for i, c in enumerate(shapes) if c.name == name), None)

@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from mpc.backends import smurf, urdf
-from mpc.compiler.diagnostics import Sink
+from mpc.compiler.diagnostics import Severity, Sink
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.kinematics import link_in_root
 from mpc.ir.program import SmurfExport, UrdfExport
@@ -102,6 +102,27 @@ def test_round_trip_is_byte_identical(model: str, tmp_path: Path, diags: Diags) 
         assert back.links[name].annotations == link.annotations
     assert {n: j.annotations for n, j in back.joints.items()} == \
            {n: j.annotations for n, j in robot.joints.items()}
+
+
+def test_smurf_linking_an_sdf_reads_back(tmp_path: Path, diags: Diags) -> None:
+    """The SDF names unnamed shapes (`<link>_collision_1`, …); the SMURF's entries still find
+    them by their place."""
+    from mpc.backends import sdf
+    from mpc.ir.program import SdfExport
+
+    robot = urdf.read(MODELS["talos"], diags)
+    assert robot is not None
+    robot = annotated(robot)
+    sdf.emit(robot, SdfExport(mesh_format="input_type", span=SPAN), tmp_path, diags)
+    diags.take("W0500", Severity.WARNING)  # mimic joints, motors, … (SDF cannot hold them)
+    smurf.emit(robot, SmurfExport(span=SPAN, model_file="sdf/talos.sdf"), tmp_path, diags)
+    back = smurf.read(tmp_path / "smurf/talos.smurf", diags)
+    assert back is not None
+    assert back.motors == robot.motors and back.poses == robot.poses
+    for name, link in robot.links.items():
+        assert [(c.bitmask, c.annotations) for c in back.links[name].collisions] == \
+               [(c.bitmask, c.annotations) for c in link.collisions]
+        assert [v.annotations for v in back.links[name].visuals] == [v.annotations for v in link.visuals]
 
 
 def test_files_are_yaml_that_phobos_reads(tmp_path: Path, diags: Diags) -> None:
