@@ -19,6 +19,7 @@ from mpc.backends.packages import PackageResolver
 from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
 from mpc.compiler.expr import evaluate
 from mpc.compiler.lower_edits import EditLowering
+from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import Definition
 from mpc.compiler.schema.assembly import AssembleChild, AttachJoint, NameEditing, _Part
 from mpc.compiler.schema.base import Node
@@ -47,7 +48,6 @@ from mpc.ir.program import (
     RepoRef,
     RosPackageExport,
     SdfExport,
-    SmurfExport,
     SubmodelExport,
     UrdfExport,
 )
@@ -75,10 +75,7 @@ class _Lowering:
         self.resolver, self.later = resolver, later
         self.ops: list[Op] = []
         self.rules: dict[str, tuple[NameRule, ...]] = {}
-        # SMURF, per output folder ("" : the model's; else a submodel's name): the explicit
-        # `smurf` entry and the `link_in_smurf` key that named the linked file.
-        self.smurf_entries: dict[str, Span] = {}
-        self.smurf_links: dict[str, Span] = {}
+        self.smurf = SmurfLowering(ast.model, sink)
 
     def not_yet(self, span: Span, what: str) -> None:
         message = f"{what} is not supported yet"
@@ -289,7 +286,7 @@ class _Lowering:
                 out.extend(self.submodel(entry, written))
             else:
                 out.extend(self.export(entry, written, self.model.robotname))
-        out.extend(self.smurfs(out))
+        out.extend(self.smurf.exports(out))
         out.extend(self.commands())
         package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
         if package is not None:
@@ -307,7 +304,7 @@ class _Lowering:
             export = self.simple_export(entry)
             return [] if export is None else [replace(export, submodel=submodel)]
         if entry.type == "smurf":
-            self.smurf_entry(entry, submodel)
+            self.smurf.entry(entry, submodel)
             return []
         if entry.type not in BUILT_EXPORTS:
             self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
@@ -348,7 +345,7 @@ class _Lowering:
             export = replace(
                 export, enforce_zero=entry.enforce_zero, ros_package=package,
                 additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
-        export = self.link_in_smurf(entry, export, submodel)
+        export = self.smurf.link(entry, export, submodel)
         written[target] = export
         return [export]
 
@@ -377,63 +374,6 @@ class _Lowering:
         for inner in nested:
             out.extend(self.export(inner, written, entry.name, submodel=entry.name,
                                    inherited=entry.export_config is None))
-        return out
-
-    # -- SMURF -----------------------------------------------------------------------------
-
-    def smurf_entry(self, entry: Any, submodel: str) -> None:
-        """A `type: smurf` entry. SMURF is written anyway (Phobos's rule); the entry only
-        lends its place to messages about it."""
-        first = self.smurf_entries.get(submodel)
-        if first is not None and first != entry.span:
-            self.sink.warning(entry.value_span("type"), "W0510", "SMURF is written once per output "
-                              "folder (always, without an entry); this entry repeats it",
-                              notes=((first, "the first smurf entry"),))
-        else:
-            self.smurf_entries[submodel] = entry.span
-
-    def link_in_smurf(self, entry: Any, export: Any, submodel: str) -> Any:
-        """`export` marked as the file its folder's SMURF links, when its entry says so."""
-        if not entry.link_in_smurf:
-            return export
-        span = entry.key_span("link_in_smurf")
-        if entry.type not in ("urdf", "sdf"):
-            self.sink.error(span, "E0511", f"a SMURF links a URDF or an SDF file, not {entry.type}")
-            return export
-        first = self.smurf_links.get(submodel)
-        if first is not None:
-            where = f"submodel '{submodel}'" if submodel else "the model"
-            self.sink.error(span, "E0510", f"link_in_smurf is set on two exports of {where}; "
-                            "a SMURF links one URDF or SDF file (the others go to its additional_files)",
-                            notes=((first, "the export the SMURF links"),))
-            return export
-        self.smurf_links[submodel] = span
-        return replace(export, link_in_smurf=True)
-
-    def smurfs(self, exports: list[Export]) -> list[SmurfExport]:
-        """One SMURF per output folder. It links the export with `link_in_smurf`, else the
-        first URDF (else SDF) export; the other URDF and SDF files are its additional_files."""
-        m = self.model
-        default_span = m.key_span("export_config") if m.export_config is not None else m.span
-        folders = {"": default_span} | {e.name: e.span for e in exports if isinstance(e, SubmodelExport)}
-        out = []
-        for folder, span in folders.items():
-            models = [e for e in exports if isinstance(e, UrdfExport | SdfExport) and e.submodel == folder]
-            linked = (next((e for e in models if e.link_in_smurf), None)
-                      or next((e for e in models if e.type == "urdf"), None) or next(iter(models), None))
-            name = folder or m.robotname
-
-            def path(e: UrdfExport | SdfExport, name: str = name) -> str:
-                return f"{e.type}/{e.filename or name}.{e.type}"
-
-            out.append(SmurfExport(
-                span=self.smurf_entries.get(folder, span), submodel=folder,
-                filename=(m.filename or "") if not folder else "",
-                model_file=path(linked) if linked else "",
-                additional_files=tuple((e.filename or e.type, path(e)) for e in models if e is not linked),
-                description=m.description or "", version=m.version or "",
-                autogenerated=m.mark_as_autogenerated,
-                add_floating_base=linked.add_floating_base if linked else False))
         return out
 
     def commands(self) -> list[CommandExport]:
