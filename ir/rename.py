@@ -1,8 +1,9 @@
 """Rename links, joints, collisions and visuals of a Robot, and every reference to them.
 
 References that follow a rename: joint parents and children, mimic targets, the root,
-and the names opaque fragments record (gazebo references, transmission joints,
-plugin parameters). Rename maps need not be complete: absent names stay.
+the names opaque fragments record (gazebo references, transmission joints, plugin
+parameters), and what the SMURF writes (motors, sensors, poses, loop joints,
+submechanisms, dependencies, self-collision pairs). Rename maps need not be complete: absent names stay.
 """
 
 from __future__ import annotations
@@ -77,8 +78,55 @@ def rename_robot(robot: Robot, link: Rename = _same, joint: Rename = _same,
         mimic = item.mimic and replace(item.mimic, joint=joint(item.mimic.joint))
         joints[new] = replace(item, name=new, parent=link(item.parent), child=link(item.child),
                               mimic=mimic, extras=frags(item.extras))
-    return replace(robot, links=links, joints=joints, root=link(robot.root),
-                   fragments=frags(robot.fragments))
+    renamed = replace(robot, links=links, joints=joints, root=link(robot.root),
+                      fragments=frags(robot.fragments))
+    return _follow_extras(robot, renamed, link, joint)
+
+
+def _follow_extras(old: Robot, robot: Robot, link: Rename, joint: Rename) -> Robot:
+    """`robot` whose motors, sensors, poses, loop joints, submechanisms, joint dependencies
+    and self-collision pairs name the renamed links and joints (the SMURF writes them).
+    Free annotation categories are data mpc does not interpret, and are left as they are."""
+    def either(name: str) -> str:
+        return joint(name) if name in old.joints else link(name)
+
+    def submechanism(definition: Mapping[str, object]) -> dict[str, object]:
+        out = dict(definition)
+        for key, value in definition.items():
+            if key.startswith("jointnames") and isinstance(value, list | tuple):
+                out[key] = [joint(j) if isinstance(j, str) else j for j in value]
+            elif key == "around" and isinstance(value, str):
+                out[key] = link(value)
+            elif key == "loop_constraints" and isinstance(value, list | tuple):
+                out[key] = [{k: link(v) if k.endswith("_body") and isinstance(v, str) else v
+                             for k, v in c.items()} if isinstance(c, Mapping) else c for c in value]
+        return out
+
+    def depends(j: Joint) -> Joint:
+        deps = j.annotations.get("movement_depends_on")
+        if not isinstance(deps, list | tuple):
+            return j
+        new = [{**d, "joint_name": joint(d["joint_name"])} if isinstance(d, Mapping) and
+               isinstance(d.get("joint_name"), str) else d for d in deps]
+        return replace(j, annotations={**j.annotations, "movement_depends_on": new})
+
+    annotations = dict(robot.annotations)
+    pairs = annotations.get("self_collision", {}).get("may_collide")
+    if isinstance(pairs, list | tuple):
+        annotations["self_collision"] = {**annotations["self_collision"], "may_collide": [
+            [link(n) if isinstance(n, str) else n for n in p] if isinstance(p, list | tuple) else p
+            for p in pairs]}
+    return replace(
+        robot, joints={n: depends(j) for n, j in robot.joints.items()}, annotations=annotations,
+        motors={n: replace(m, joint=joint(m.joint)) for n, m in robot.motors.items()},
+        sensors={n: replace(s, link=s.link and link(s.link), joint=s.joint and joint(s.joint),
+                            frame=s.frame and link(s.frame), targets=tuple(map(either, s.targets)))
+                 for n, s in robot.sensors.items()},
+        poses={n: {joint(j): v for j, v in p.items()} for n, p in robot.poses.items()},
+        cut_joints={n: replace(c, parent=link(c.parent), child=link(c.child))
+                    for n, c in robot.cut_joints.items()},
+        submechanisms=tuple(replace(sm, definition=submechanism(sm.definition))
+                            for sm in robot.submechanisms))
 
 
 def rename_with(mapping: Mapping[str, str]) -> Rename:

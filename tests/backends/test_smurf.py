@@ -340,3 +340,24 @@ def test_category_that_is_not_a_file_name(tmp_path: Path) -> None:
         "name is `filename` or the robot's name, then '_' and each annotation category): no '/' or '\\', "
         "and no '.' first [E0515]")
     assert not (tmp_path / "out").exists() and not list(tmp_path.glob("*escape*"))
+
+
+def test_renaming_in_a_derived_model_renames_what_the_smurf_names(tmp_path: Path, diags: Diags) -> None:
+    """A derived model that prefixes every name: its SMURF names the new links and joints,
+    so it reads back without an error."""
+    write(tmp_path / "ur5.yml", UR5)
+    write(tmp_path / "right.yml", child("derived_base", "ur5.yml").replace(
+        "    model: ur5\n", "    model: ur5\n    name_editing: {prefix: r_}\n"))
+    run = mpc("compile", tmp_path / "right.yml", "-o", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    robot = smurf.read(tmp_path / "out/smurf/ur5.smurf", diags)
+    assert robot is not None
+    assert {m.joint for m in robot.motors.values()} == {"r_shoulder_pan_joint", "r_elbow_joint"}
+    assert robot.sensors["wrist_imu"].link == "r_wrist_3_link"
+    assert robot.sensors["encoders"].targets[0] == "r_shoulder_pan_joint"
+    assert robot.poses["home"] == {"r_shoulder_lift_joint": -1.57, "r_elbow_joint": 1.57}
+    assert robot.submechanisms[0].definition["jointnames_active"] == [
+        "r_shoulder_pan_joint", "r_shoulder_lift_joint", "r_elbow_joint"]
+    pairs = robot.annotations["self_collision"]["may_collide"]
+    assert pairs and all(n.startswith("r_") for pair in pairs for n in pair)
+    assert all(c.bitmask for link in robot.links.values() for c in link.collisions)
