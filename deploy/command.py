@@ -17,11 +17,13 @@ from mpc.ir.span import Span
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The options of `mpc deploy`."""
-    parser.add_argument("definition", type=Path, help="the model definition (YAML) whose build is deployed")
+    parser.add_argument("definition", type=Path,
+                        help="the model definition (YAML) whose build is deployed")
     parser.add_argument("--built", type=Path, required=True, metavar="DIR",
                         help="the compiled model (what `mpc compile -o DIR` wrote)")
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--pipeline", type=Path, help="pipeline.yml: remote_base, forge, LFS, meshes, defaults")
+    where.add_argument("--pipeline", type=Path,
+                       help="pipeline.yml: remote_base, forge, LFS, meshes, defaults")
     where.add_argument("--remote", help="the address of the model's repository")
     parser.add_argument("--forge", choices=FORGES,
                         help="how merge requests are made (default: the pipeline's, else none)")
@@ -52,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
         try:
             protocol = args.protocol.read_text(encoding="utf-8")
         except OSError as e:
-            sink.error(Span.of_file(str(args.protocol)), "E0802", f"cannot read the test protocol: {e.strerror}")
+            sink.error(Span.of_file(str(args.protocol)), "E0802",
+                       f"cannot read the test protocol: {e.strerror}")
     result = None
     if program is not None and settings is not None and not sink.has_errors():
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,

@@ -25,7 +25,8 @@ IDENTITY = {"GIT_AUTHOR_NAME": "Test Author", "GIT_AUTHOR_EMAIL": "author@exampl
 HOOK = """\
 #!{python}
 import json, os, sys
-options = [os.environ[f"GIT_PUSH_OPTION_{{i}}"] for i in range(int(os.environ.get("GIT_PUSH_OPTION_COUNT", "0")))]
+count = int(os.environ.get("GIT_PUSH_OPTION_COUNT", "0"))
+options = [os.environ[f"GIT_PUSH_OPTION_{{i}}"] for i in range(count)]
 refs = [line.split() for line in sys.stdin.read().splitlines()]
 with open(os.path.join(os.environ.get("GIT_DIR", "."), "pushes.jsonl"), "a") as log:
     log.write(json.dumps({{"options": options, "refs": refs}}) + "\\n")
@@ -50,7 +51,8 @@ def clean_git(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.Monk
 
 
 def git(folder: Path, *args: str) -> str:
-    return subprocess.run(["git", *args], cwd=folder, check=True, capture_output=True, text=True).stdout.strip()
+    run = subprocess.run(["git", *args], cwd=folder, check=True, capture_output=True, text=True)
+    return run.stdout.strip()
 
 
 @dataclass

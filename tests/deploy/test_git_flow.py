@@ -139,7 +139,8 @@ def test_a_refused_push_is_an_error_and_nothing_is_forced(model: Model, server: 
                                                           diags: Diags) -> None:
     hook = server.path / "hooks" / "pre-receive"
     hook.write_text("#!/bin/sh\necho 'policy: no pushes today' >&2\nexit 1\n")
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), diags)
+    settings = model.settings(remote=server.url, forge="none")
+    result = deploy_model(model.compile(), model.built, settings, diags)
     assert not result.ok and server.branches() == {}
     d = diags.take_error("E0803")
     assert d.message.startswith(f"pushing to branch 'master' of '{server.url}' failed:")
@@ -176,6 +177,7 @@ def test_missing_build_and_missing_remote(model: Model, diags: Diags, tmp_path: 
 
 def test_unchanged_definition_keeps_arm_urdf_bytes(model: Model, server: Server) -> None:
     """The pushed URDF is byte for byte the build's."""
-    deploy_model(model.compile(ARM_URDF), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    settings = model.settings(remote=server.url, forge="none")
+    deploy_model(model.compile(ARM_URDF), model.built, settings, Sink())
     blob = git(server.path, "cat-file", "-p", "master:urdf/arm.urdf") + "\n"
     assert blob == (model.built / "urdf/arm.urdf").read_text()
