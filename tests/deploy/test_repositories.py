@@ -10,6 +10,10 @@ from tests.conftest import Diags
 from tests.deploy.conftest import Model, Server, definition_text, git, heavier, make_server
 
 
+def _plain(model: Model, server: Server) -> object:
+    return model.settings(remote=server.url, forge="none")
+
+
 def _gitmodules(server: Server, rev: str = "master") -> dict[str, str]:
     out = git(server.path, "config", "--blob", f"{rev}:.gitmodules", "--list")
     return dict(line.split("=", 1) for line in out.splitlines())
@@ -21,23 +25,25 @@ def _gitlink(server: Server, path: str, rev: str = "master") -> str:
     return sha
 
 
-def test_submodules_are_pinned_to_their_branch_or_commit(model: Model, server: Server, tmp_path: Path) -> None:
+def test_submodules_are_pinned_to_their_branch_or_commit(model: Model, server: Server,
+                                                         tmp_path: Path) -> None:
     lua = make_server(tmp_path, "arm-lua")
     first = lua.commit_files({"knee.lua": "-- 1\n"}, "one")
     newest = lua.commit_files({"knee.lua": "-- 2\n"}, "two")
-    model.definition.write_text(definition_text("""\
+    model.definition.write_text(definition_text(f"""\
   deployment:
     submodules:
       - repo: ../arm-lua.git
         target: lua
       - repo: ../arm-lua.git
         target: old/lua
-        commit: %s
-""" % first[:10]))
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+        commit: {first[:10]}
+"""))
+    result = deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert result.ok, result
     assert _gitmodules(server) == {
-        "submodule.lua.path": "lua", "submodule.lua.url": "../arm-lua.git", "submodule.lua.branch": "master",
+        "submodule.lua.path": "lua", "submodule.lua.url": "../arm-lua.git",
+        "submodule.lua.branch": "master",
         "submodule.old/lua.path": "old/lua", "submodule.old/lua.url": "../arm-lua.git",
         "submodule.old/lua.branch": "master"}
     assert (_gitlink(server, "lua"), _gitlink(server, "old/lua")) == (newest, first)
@@ -47,10 +53,10 @@ def test_submodules_are_pinned_to_their_branch_or_commit(model: Model, server: S
     assert (checkout / "lua/knee.lua").read_text() == "-- 2\n"
     assert (checkout / "old/lua/knee.lua").read_text() == "-- 1\n"
     # Deploying again changes nothing; a submodule that is no longer listed goes.
-    again = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    again = deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert again.commit is None
     model.definition.write_text(definition_text(""))
-    deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert ".gitmodules" not in server.files() and "lua" not in server.files()
 
 
@@ -61,7 +67,7 @@ def test_unknown_submodule_commit(model: Model, server: Server, tmp_path: Path, 
     submodules:
       - {repo: ../arm-lua.git, target: lua, commit: 0123456789abcdef}
 """))
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), diags)
+    result = deploy_model(model.compile(), model.built, _plain(model, server), diags)
     assert not result.ok and server.branches() == {}
     d = diags.take_error("E0807")
     assert d.message == (f"submodule 'lua': '{tmp_path}/server/acme/arm-lua.git' has no commit "
@@ -93,7 +99,8 @@ def test_mirror_gets_a_copy_with_submodule_files(model: Model, server: Server, t
                            "merge_request.title=Mirrored arm"]
 
 
-def test_mirror_with_submodules_uses_absolute_addresses(model: Model, server: Server, tmp_path: Path) -> None:
+def test_mirror_with_submodules_uses_absolute_addresses(model: Model, server: Server,
+                                                        tmp_path: Path) -> None:
     lua = make_server(tmp_path, "arm-lua")
     sha = lua.commit_files({"knee.lua": "-- lua\n"}, "one")
     mirror = make_server(tmp_path, "arm-mirror")
@@ -103,7 +110,7 @@ def test_mirror_with_submodules_uses_absolute_addresses(model: Model, server: Se
       - {{repo: ../arm-lua.git, target: lua}}
     mirror: {{repo: {mirror.url}, branch: master, submodules: true}}
 """))
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    result = deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert result.ok and result.mirror is not None and result.mirror.pushed
     assert _gitmodules(mirror)["submodule.lua.url"] == lua.url
     assert _gitlink(mirror, "lua") == sha
@@ -129,7 +136,8 @@ def test_central_meshes_go_to_mesh_repositories(model: Model, tmp_path: Path) ->
     assert _gitmodules(server_model)["submodule.meshes/stl.url"] == str(meshes)
     checkout = tmp_path / "checkout"
     git(tmp_path, "clone", "-q", "--recurse-submodules", str(server_model.path), str(checkout))
-    assert (checkout / "meshes/stl/tetra.stl").read_bytes() == (model.built / "meshes/stl/tetra.stl").read_bytes()
+    mesh = "meshes/stl/tetra.stl"
+    assert (checkout / mesh).read_bytes() == (model.built / mesh).read_bytes()
     # The mesh repository pools meshes: another model's file stays.
     Server(meshes).commit_files({"other.stl": "solid other\n"}, "another model")
     deploy_model(model.compile(heavier()), model.built, settings, Sink())
