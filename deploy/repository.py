@@ -41,7 +41,8 @@ class Clone:
 
 def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
     """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist."""
-    if folder.exists():
+    existed = folder.exists()
+    if existed:
         if not (folder / ".git").exists():
             raise DeployError("E0803", f"'{folder}' exists and is not a git clone; mpc clones into "
                                        "folders of its own (remove it or choose another workdir)")
@@ -54,7 +55,7 @@ def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
         Git(folder.parent)("clone", "-q", "--no-checkout", "--origin", remote, url, str(folder))
         git = Git(folder)
     clone = Clone(folder, git, remote, url, "")
-    if folder.exists():
+    if existed:
         clone.fetch()
     clone.default_branch = _default_branch(git, remote)
     return clone

@@ -181,3 +181,22 @@ def test_unchanged_definition_keeps_arm_urdf_bytes(model: Model, server: Server)
     deploy_model(model.compile(ARM_URDF), model.built, settings, Sink())
     blob = git(server.path, "cat-file", "-p", "master:urdf/arm.urdf") + "\n"
     assert blob == (model.built / "urdf/arm.urdf").read_text()
+
+
+def _snapshot(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file() and ".git" not in p.relative_to(folder).parts}
+
+
+def test_nothing_outside_the_clone_is_touched(model: Model, server: Server) -> None:
+    program = model.compile()
+    (model.built / "urdf" / "link.urdf").symlink_to("arm.urdf")
+    build, definitions = _snapshot(model.built), _snapshot(model.folder)
+    head = git(model.folder, "rev-parse", "HEAD")
+    settings = model.settings(remote=server.url, forge="none")
+    deploy_model(program, model.built, settings, Sink())
+    assert (_snapshot(model.built), _snapshot(model.folder)) == (build, definitions)
+    assert git(model.folder, "rev-parse", "HEAD") == head and git(model.folder, "status", "--porcelain") == ""
+    assert sorted(p.name for p in model.folder.parent.iterdir()) == ["build", "definitions", "server", "work"]
+    # the symbolic link inside the build stays a link in the repository
+    assert git(server.path, "ls-tree", "master", "urdf/link.urdf").split()[0] == "120000"
