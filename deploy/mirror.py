@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.deploy import content, submodules
 from mpc.deploy.forges import MergeRequest, adapter, describe
@@ -15,9 +16,12 @@ from mpc.deploy.provenance import Provenance, footer
 from mpc.deploy.repository import Clone, open_clone, publish
 from mpc.deploy.settings import DeploySettings
 
+if TYPE_CHECKING:
+    from mpc.deploy.model import DeployResult
+
 
 def deploy_mirror(source: Clone, plan: Plan, pinned: list[submodules.Pinned], settings: DeploySettings,
-                  message: str, protocol: str | None, prov: Provenance, workdir: Path):  # -> DeployResult
+                  message: str, protocol: str | None, prov: Provenance, workdir: Path) -> DeployResult:
     """Copy the model repository's tree (as just deployed) to the mirror and push it."""
     from mpc.deploy.model import DeployResult
 

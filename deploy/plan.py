@@ -74,7 +74,7 @@ def make_plan(program: Program, settings: DeploySettings, remote: str, default_b
     success = settings.success_branch or default_branch
     failure = settings.failure_branch or DEFAULT_FAILURE_BRANCH
     production = settings.production_branch or success
-    branch = failure if tests_failed else success
+    branch = settings.feature_branch or (failure if tests_failed else success)
     # Phobos §5 step 11: a failed model asks to be merged into the success branch; a passing
     # one into the production branch, when that differs. An explicit target wins.
     target = d.mr_target_branch or (success if tests_failed else production)
@@ -82,9 +82,10 @@ def make_plan(program: Program, settings: DeploySettings, remote: str, default_b
     extensions = d.add_lfs_track if d.add_lfs_track is not None else settings.add_lfs_track
     return Plan(
         modelname=program.modelname, remote=remote, branch=branch, base=success,
-        mr_target=None if target == branch else target,
+        mr_target=None if target == branch or settings.feature_branch else target,
         mr_title=d.mr_title or DEFAULT_MR_TITLE, mr_description=d.mr_description or DEFAULT_MR_DESCRIPTION,
-        mr_mention=tuple(mention), keep_files=d.keep_files, submodules=d.submodules, mirror=d.mirror,
+        mr_mention=tuple(mention), keep_files=d.keep_files, submodules=d.submodules,
+        mirror=None if settings.feature_branch else d.mirror,
         add_manifest=settings.add_manifest if d.add_manifest is None else d.add_manifest,
         lfs_patterns=lfs_patterns(tuple(extensions), settings.uses_lfs),
         tests_failed=tests_failed, span=d.span)

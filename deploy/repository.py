@@ -9,7 +9,9 @@ stops before the commit and returns the diff stat the push would carry.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import fcntl
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +39,19 @@ class Clone:
 
     def fetch(self) -> None:
         self.git("fetch", "-q", "--prune", self.remote)
+
+
+@contextmanager
+def locked(folder: Path) -> Iterator[None]:
+    """Hold `<folder>.lock` exclusively: models deployed in parallel share the central mesh
+    repositories and submodule caches, whose clones one process at a time may use."""
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    with open(folder.with_name(folder.name + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:

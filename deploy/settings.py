@@ -41,6 +41,8 @@ class DeploySettings:
         else the remote's default branch). failure_branch: where one that failed goes.
     production_branch: the default target of merge requests from the success branch.
     mesh_branch: the branch of the central mesh repositories.
+    feature_branch: when set (CI_COMMIT_BRANCH of the form `feature/*`), every model goes
+        to this branch, without merge request or mirror (Phobos's feature mode).
     remote_name: the name of the remote in mpc's clones.
     dry_run: prepare the commit, print its diff stat, push nothing.
     workdir: where the clones live (one folder per repository).
@@ -63,6 +65,7 @@ class DeploySettings:
     failure_branch: str | None = None
     production_branch: str | None = None
     mesh_branch: str | None = None
+    feature_branch: str | None = None
     remote_name: str = "origin"
     dry_run: bool = False
     workdir: Path = field(default_factory=lambda: Path("build") / ".deploy")
@@ -79,6 +82,7 @@ class DeploySettings:
             "failure_branch": env.get("GIT_FAILURE_BRANCH") or env.get("CI_UPDATE_TARGET_BRANCH") or None,
             "production_branch": env.get("GIT_PRODUCTION_BRANCH") or None,
             "mesh_branch": env.get("CI_MESH_UPDATE_TARGET_BRANCH") or None,
+            "feature_branch": _feature(env.get("CI_COMMIT_BRANCH", "")),
             "remote_name": env.get("GIT_REMOTE_NAME") or "origin",
             "github_api": env.get("GITHUB_API_URL") or "https://api.github.com",
         }
@@ -116,6 +120,10 @@ class DeploySettings:
         if not self.remote_base:
             return None
         return join_remote(self.remote_base, modelname)
+
+
+def _feature(branch: str) -> str | None:
+    return branch if branch.startswith("feature/") and len(branch) > len("feature/") else None
 
 
 def join_remote(base: str, path: str) -> str:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.deploy.gitcmd import DeployError, Git
+from mpc.deploy.repository import locked
 from mpc.ir.program import DeploySubmodule
 
 
@@ -53,12 +54,19 @@ def pin(sub: DeploySubmodule, superproject: str, default_branch: str, workdir: P
     """Fetch the submodule and find its commit."""
     fetched_from = absolute_url(sub.repo, superproject)
     cache = workdir / ".submodules" / hashlib.sha256(fetched_from.encode()).hexdigest()[:16]
+    branch = sub.branch or default_branch
+    with locked(cache):
+        sha = _find(sub, fetched_from, branch, cache)
+    return Pinned(sub.target, sub.repo, fetched_from, branch, sha, cache)
+
+
+def _find(sub: DeploySubmodule, fetched_from: str, branch: str, cache: Path) -> str:
+    """The submodule's commit, fetched into the bare `cache`."""
     if not cache.exists():
         cache.mkdir(parents=True)
         Git(cache)("init", "-q", "--bare", code="E0807")
     git = Git(cache)
     git("fetch", "-q", "--prune", fetched_from, "+refs/heads/*:refs/heads/*", code="E0807")
-    branch = sub.branch or default_branch
     if sub.commit:
         ref = f"{sub.commit}^{{commit}}"
         what = f"commit '{sub.commit}'"
@@ -67,7 +75,7 @@ def pin(sub: DeploySubmodule, superproject: str, default_branch: str, workdir: P
         what = f"branch '{branch}'"
     if not git.ok("rev-parse", "--verify", "-q", ref):
         raise DeployError("E0807", f"submodule '{sub.target}': '{fetched_from}' has no {what}")
-    return Pinned(sub.target, sub.repo, fetched_from, branch, git("rev-parse", ref), cache)
+    return git("rev-parse", ref)
 
 
 def link(git: Git, pinned: list[Pinned]) -> None:

@@ -200,3 +200,32 @@ def test_nothing_outside_the_clone_is_touched(model: Model, server: Server) -> N
     assert sorted(p.name for p in model.folder.parent.iterdir()) == ["build", "definitions", "server", "work"]
     # the symbolic link inside the build stays a link in the repository
     assert git(server.path, "ls-tree", "master", "urdf/link.urdf").split()[0] == "120000"
+
+
+def test_feature_mode_pushes_to_the_feature_branch_without_merge_request(
+        model: Model, server: Server, monkeypatch: pytest.MonkeyPatch) -> None:
+    first = deploy_model(model.compile(), model.built, model.settings(remote=server.url), Sink())
+    monkeypatch.setenv("CI_COMMIT_BRANCH", "feature/longer-arm")
+    settings = model.settings(remote=server.url)
+    result = deploy_model(model.compile(heavier()), model.built, settings, Sink(), tests_failed=True)
+    assert (result.branch, result.merge_request) == ("feature/longer-arm", None)
+    assert server.branches() == {"master": first.commit, "feature/longer-arm": result.commit}
+    assert server.pushes()[-1]["options"] == []
+
+
+def test_gitlab_answer_gives_the_merge_request_address(model: Model, server: Server) -> None:
+    hook = server.path / "hooks" / "pre-receive"
+    url = "https://gitlab.example.org/acme/arm-model/-/merge_requests/3"
+    hook.write_text(hook.read_text() + "print('View merge request for master:', file=sys.stderr)\n"
+                    f"print('  {url}', file=sys.stderr)\n")
+    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url), Sink())
+    assert result.merge_request_url == url
+
+
+def test_a_long_protocol_is_cut_to_fit_one_push_option(model: Model, server: Server) -> None:
+    protocol = "".join(f"| check {i} | passed |\n" for i in range(5000))
+    deploy_model(model.compile(), model.built, model.settings(remote=server.url), Sink(),
+                 protocol_markdown=protocol)
+    description = server.pushes()[-1]["options"][3]
+    assert description.startswith("merge_request.description=New model update")
+    assert description.endswith("… (cut)") and 60000 < len(description.encode()) < 60100
