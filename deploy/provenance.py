@@ -67,9 +67,9 @@ def provenance(program: Program, definition_repo: Path | None, protocol: str | N
         state = _repository_state(where)
         if state is not None:
             definition = state[0] + ("+dirty" if state[1] else "")
-            if file is not None:
-                file_state = _repository_state(file)
-                definition_file = file_state[2] if file_state else file.name
+        if file is not None:
+            file_state = _repository_state(file) if state is not None else None
+            definition_file = file_state[2] if file_state else file.name
     inputs = []
     for name, inp in sorted(program.inputs.items()):
         if inp.repo is not None:

@@ -155,8 +155,10 @@ def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: st
         before = clone.remote_sha(branch)
         clone.fetch()
         if clone.remote_sha(branch) == before:
+            hint = ("\n(the server does not take git push options, which forge 'gitlab' uses for "
+                    "merge requests: choose another forge)") if "does not support push options" in err else ""
             raise DeployError("E0803", f"pushing to branch '{branch}' of '{clone.url}' failed:\n"
-                                       f"{(err or out).strip()}")
+                                       f"{(err or out).strip()}{hint}")
         # The branch moved between our fetch and our push: build the commit again on top of it.
     raise DeployError("E0803", f"branch '{branch}' of '{clone.url}' moved during each of {ATTEMPTS} "
                                "attempts to push; nothing was overwritten, try again later")

@@ -229,3 +229,23 @@ def test_a_long_protocol_is_cut_to_fit_one_push_option(model: Model, server: Ser
     description = server.pushes()[-1]["options"][3]
     assert description.startswith("merge_request.description=New model update")
     assert description.endswith("… (cut)") and 60000 < len(description.encode()) < 60100
+
+
+def test_a_server_without_push_options(model: Model, server: Server, diags: Diags) -> None:
+    git(server.path, "config", "receive.advertisePushOptions", "false")
+    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url), diags)
+    assert not result.ok and server.branches() == {}
+    message = diags.take_error("E0803").message
+    assert "fatal: the receiving end does not support push options" in message
+    assert message.endswith("(the server does not take git push options, which forge 'gitlab' uses for "
+                            "merge requests: choose another forge)")
+
+
+def test_definition_outside_git_is_named_in_the_message(model: Model, server: Server, tmp_path: Path) -> None:
+    import shutil
+
+    program = model.compile()
+    shutil.rmtree(model.folder / ".git")
+    settings = model.settings(remote=server.url, forge="none")
+    deploy_model(program, model.built, settings, Sink())
+    assert server.message().splitlines()[2] == "Definition: arm_model.yml (not in a git repository)"
