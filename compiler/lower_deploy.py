@@ -20,7 +20,7 @@ from mpc.ir.span import Span
 def inside_repository(path: str) -> bool:
     """Whether a path (or glob) written in a definition stays inside the repository."""
     pure = PurePosixPath(path.replace("\\", "/"))
-    return bool(path) and not pure.is_absolute() and ".." not in pure.parts and pure.parts != (".",)
+    return bool(pure.parts) and not pure.is_absolute() and ".." not in pure.parts
 
 
 def lower_deployment(section: DeploymentSection, sink: Sink) -> Deployment:

@@ -129,3 +129,12 @@ def test_github_repository_names() -> None:
     assert repository_slug("https://token@github.com/acme/arm.git/") == "acme/arm"
     assert repository_slug("/srv/git/acme/arm.git") == "acme/arm"
     assert repository_slug("arm") is None
+
+
+@pytest.mark.parametrize(("path", "inside"), [
+    ("a/b.lua", True), ("**/*.lua", True), ("./a", True), (".", False), ("", False),
+    ("../a", False), ("a/../../b", False), ("/etc/passwd", False)])
+def test_inside_repository(path: str, inside: bool) -> None:
+    from mpc.compiler.lower_deploy import inside_repository
+
+    assert inside_repository(path) is inside
