@@ -9,7 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mpc.deploy import content, submodules
+from mpc.deploy import content, lfs, submodules
 from mpc.deploy.forges import MergeRequest, adapter, describe
 from mpc.deploy.plan import Plan
 from mpc.deploy.provenance import Provenance, footer
@@ -35,6 +35,7 @@ def deploy_mirror(source: Clone, plan: Plan, pinned: list[submodules.Pinned], se
     def fill(c: Clone) -> None:
         content.replace_content(c.folder, source.folder, set(), targets if mirror.submodules else set())
         (c.folder / ".gitmodules").unlink(missing_ok=True)
+        lfs.track(c.git, plan.lfs_patterns)  # the copied .gitattributes needs LFS in this clone too
         if mirror.submodules:
             for target in targets:
                 (c.folder / target).mkdir(parents=True, exist_ok=True)

@@ -159,3 +159,17 @@ def test_lfs_tracks_meshes(model: Model, server: Server) -> None:
     stored = server.path / "lfs" / "objects" / oid[:2] / oid[2:4] / oid
     assert stored.read_bytes() == (model.built / "meshes/stl/tetra.stl").read_bytes()
     assert "Git LFS" in server.show("master", "README.md")
+
+
+def test_mirror_of_an_lfs_repository_stores_pointers_too(model: Model, server: Server,
+                                                         tmp_path: Path) -> None:
+    mirror = make_server(tmp_path, "arm-mirror")
+    model.definition.write_text(definition_text(
+        f"  deployment:\n    mirror: {{repo: {mirror.url}, branch: master}}\n"))
+    settings = model.settings(remote=server.url, forge="none", uses_lfs=True)
+    result = deploy_model(model.compile(), model.built, settings, Sink())
+    assert result.ok and result.mirror is not None and result.mirror.pushed
+    for repo in (server, mirror):
+        pointer = repo.show("master", "meshes/stl/tetra.stl")
+        assert pointer.startswith("version https://git-lfs.github.com/spec/v1")
+    assert list((mirror.path / "lfs" / "objects").rglob("*")) != []
