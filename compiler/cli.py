@@ -41,6 +41,10 @@ def _parser() -> argparse.ArgumentParser:
     schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
     schema.add_argument("-o", "--out", type=Path, default=Path("specs/model-definition.schema.json"),
                         help="where to write it (default: specs/model-definition.schema.json); - for stdout")
+    # mpc deploy (deploy/command.py)
+    from mpc.deploy.command import add_arguments as deploy_arguments
+
+    deploy_arguments(sub.add_parser("deploy", help="deploy a built model to its git repository"))
     for p in (check,):
         p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
                        help="where the ROS package NAME is (for package:// paths); repeatable")
@@ -115,10 +119,17 @@ def _schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _deploy(args: argparse.Namespace) -> int:
+    from mpc.deploy.command import run
+
+    return run(args)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"compile": _compile, "check": _check, "schema": _schema}[args.command](args)
+        return {"compile": _compile, "check": _check, "schema": _schema,
+                "deploy": _deploy}[args.command](args)
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # a bug in mpc, not a user mistake

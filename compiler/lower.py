@@ -18,6 +18,7 @@ from typing import Any
 from mpc.backends.packages import PackageResolver
 from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
 from mpc.compiler.expr import evaluate
+from mpc.compiler.lower_deploy import lower_model_deployment
 from mpc.compiler.lower_edits import EditLowering
 from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import Definition
@@ -55,8 +56,7 @@ from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
-LATER_SECTIONS = ("test", "deployment", "append_export_config", "swing_my_robot",
-                  "add_lfs_track")
+LATER_SECTIONS = ("test", "append_export_config", "swing_my_robot")
 
 
 def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
@@ -454,7 +454,8 @@ class _Lowering:
                 self.not_yet(entry.key_span("is_human"), f"'is_human' (input model '{name}')")
         exports = self.exports()
         return Program(robotname=self.model.robotname, modelname=self.model.modelname,
-                       inputs=inputs, ops=tuple(self.ops), exports=exports, span=self.model.span)
+                       inputs=inputs, ops=tuple(self.ops), exports=exports, span=self.model.span,
+                       deployment=lower_model_deployment(self.model, self.sink))
 
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.

@@ -220,6 +220,7 @@ class Program:
     ops: rewrites in order: loading and assembling parts, then editing the robot.
     exports: what to write.
     span: the definition's `model:` section.
+    deployment: where the model goes (deploy/); None when the definition says nothing.
     """
 
     robotname: str
@@ -228,3 +229,64 @@ class Program:
     ops: tuple[Op, ...]
     exports: tuple[Export, ...]
     span: Span
+    deployment: Deployment | None = None
+
+
+# -- deployment (deploy/) -------------------------------------------------------------------
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DeploySubmodule:
+    """A `deployment.submodules` entry: a git submodule kept in the model's repository.
+
+    repo: its address; a relative one (`../meshes.git`) is relative to the model repository's.
+    target: its folder in the model repository. commit: the commit it is pinned to; else the
+    newest commit of `branch` (None: the success branch).
+    """
+
+    repo: str
+    target: str
+    span: Span
+    commit: str | None = None
+    branch: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DeployMirror:
+    """`deployment.mirror`: a second repository that gets a copy of the model's repository.
+
+    branch: where the copy goes. submodules: keep submodules as submodules (else their files
+    are copied in). merge_request: open one from `branch` into `mr_target`.
+    """
+
+    repo: str
+    span: Span
+    branch: str = "develop"
+    submodules: bool = False
+    merge_request: bool = False
+    mr_mention: tuple[str, ...] | None = None
+    mr_title: str | None = None
+    mr_target: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Deployment:
+    """The `deployment` section: where the built and tested model goes (deploy/).
+
+    None (or an empty tuple for keep_files and submodules) means "not given", so that the
+    pipeline's `default_deployment` fills it (a shallow merge, as Phobos does).
+    do_not_deploy: build and test, but push nothing. mr_*: the merge request.
+    keep_files: globs, relative to the repository, of files the update leaves alone.
+    add_lfs_track: more file types tracked with git LFS (the model's own key, if given).
+    """
+
+    span: Span
+    do_not_deploy: bool | None = None
+    mr_target_branch: str | None = None
+    mr_title: str | None = None
+    mr_description: str | None = None
+    mr_mention: tuple[str, ...] | None = None
+    keep_files: tuple[str, ...] = ()
+    submodules: tuple[DeploySubmodule, ...] = ()
+    mirror: DeployMirror | None = None
+    add_manifest: bool | None = None
+    add_lfs_track: tuple[str, ...] | None = None

@@ -1,0 +1,111 @@
+"""`mpc deploy`: deploy an existing build of one model definition (compiler/cli.py parses
+the arguments and calls `run`). Exit status: 0 deployed (or nothing to do), 1 failed."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from mpc.compiler import render
+from mpc.compiler.diagnostics import Severity, Sink
+from mpc.deploy.gitcmd import scrub
+from mpc.deploy.model import DeployResult, deploy_model
+from mpc.deploy.settings import FORGES, DeploySettings
+from mpc.ir.span import Span
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of `mpc deploy`."""
+    parser.add_argument("definition", type=Path,
+                        help="the model definition (YAML) whose build is deployed")
+    parser.add_argument("--built", type=Path, required=True, metavar="DIR",
+                        help="the compiled model (what `mpc compile -o DIR` wrote)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--pipeline", type=Path,
+                       help="pipeline.yml: remote_base, forge, LFS, meshes, defaults")
+    where.add_argument("--remote", help="the address of the model's repository")
+    parser.add_argument("--forge", choices=FORGES,
+                        help="how merge requests are made (default: the pipeline's, else none)")
+    parser.add_argument("--dry-run", action="store_true", help="print the diff stat that would be pushed")
+    parser.add_argument("--protocol", type=Path, metavar="FILE",
+                        help="the test protocol (Markdown), appended to the merge request")
+    parser.add_argument("--tests-failed", action="store_true",
+                        help="the model failed its tests: deploy to the failure branch")
+    parser.add_argument("--success-branch", help="default: $GIT_SUCCESS_BRANCH, else the remote's default")
+    parser.add_argument("--failure-branch",
+                        help="default: $GIT_FAILURE_BRANCH, else $CI_UPDATE_TARGET_BRANCH, else tests-failed")
+    parser.add_argument("--workdir", type=Path,
+                        help="where mpc keeps its clones (default: <pipeline root>/.mpc-deploy, "
+                             "else build/.deploy)")
+    parser.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                        help="how to print diagnostics (default: human)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from mpc.compiler.driver import Options, load_program
+
+    sink = Sink()
+    # A build exists already: what `compile` does not support yet is no reason to refuse it.
+    program = load_program(args.definition, sink, Options(), Severity.WARNING)
+    settings = _settings(args, sink)
+    protocol = None
+    if args.protocol is not None:
+        try:
+            protocol = args.protocol.read_text(encoding="utf-8")
+        except OSError as e:
+            sink.error(Span.of_file(str(args.protocol)), "E0802",
+                       f"cannot read the test protocol: {e.strerror}")
+    result = None
+    if program is not None and settings is not None and not sink.has_errors():
+        result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
+                              tests_failed=args.tests_failed)
+    _print_diagnostics(sink, args.format)
+    if result is None or not result.ok:
+        print(f"error: could not deploy '{args.definition}'", file=sys.stderr)
+        return 1
+    _report(result, "")
+    return 0
+
+
+def _settings(args: argparse.Namespace, sink: Sink) -> DeploySettings | None:
+    values = {"remote": args.remote, "forge": args.forge, "dry_run": args.dry_run or None,
+              "success_branch": args.success_branch, "failure_branch": args.failure_branch,
+              "workdir": args.workdir}
+    if args.pipeline is None:
+        return DeploySettings.from_environment(
+            definition_repo=args.definition.resolve().parent,
+            **{**values, "forge": args.forge or "none"})
+    from mpc.compiler import schema, source
+
+    doc = source.load(args.pipeline, sink)
+    pipeline = schema.validate_pipeline(doc, sink) if doc is not None else None
+    if pipeline is None:
+        return None
+    return DeploySettings.from_pipeline(pipeline.pipeline, args.pipeline.resolve().parent, sink, **values)
+
+
+def _report(result: DeployResult, indent: str) -> None:
+    where = f"branch '{result.branch}' of '{scrub(result.remote or '')}'"
+    if result.skipped:
+        print(f"{indent}'{result.modelname}' is not deployed (do_not_deploy)")
+    elif result.diffstat:
+        print(f"{indent}dry run: would push to {where}:\n{result.diffstat}")
+    elif result.commit is None:
+        print(f"{indent}'{result.modelname}': nothing changed on {where}")
+    else:
+        print(f"{indent}deployed '{result.modelname}' to {where}: commit {result.commit[:12]}")
+    for kind, sha in sorted(result.meshes.items()):
+        print(f"{indent}  {kind}: mesh repository at commit {sha[:12]}")
+    if result.merge_request is not None:
+        print(f"{indent}  merge request into '{result.merge_request.target}'"
+              f"{': ' + result.merge_request_url if result.merge_request_url else ''}")
+    if result.mirror is not None:
+        _report(result.mirror, indent + "mirror: ")
+
+
+def _print_diagnostics(sink: Sink, fmt: str) -> None:
+    if fmt == "json":
+        print(render.as_json(sink.diagnostics), file=sys.stderr)
+    elif sink.diagnostics:
+        print((render.gcc if fmt == "gcc" else render.human)(sink.diagnostics), file=sys.stderr)

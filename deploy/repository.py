@@ -1,0 +1,164 @@
+"""One repository's update: clone or fetch, start from the remote branch, fill the tree,
+commit, push — never forced, never deleting a branch.
+
+`publish` runs the whole round. When the push is refused because the remote branch moved
+after the fetch, it fetches again and rebuilds the commit on top of the new remote branch
+(filling the tree again), a few times at most; any other refusal is an error. A dry run
+stops before the commit and returns the diff stat the push would carry.
+"""
+
+from __future__ import annotations
+
+import fcntl
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git
+
+ATTEMPTS = 3
+
+
+@dataclass
+class Clone:
+    """mpc's clone of a repository. default_branch: the remote's HEAD branch."""
+
+    folder: Path
+    git: Git
+    remote: str
+    url: str
+    default_branch: str
+
+    def remote_sha(self, branch: str) -> str | None:
+        """The commit of `branch` on the remote, as last fetched; None if it has no such branch."""
+        ref = f"refs/remotes/{self.remote}/{branch}"
+        if not self.git.ok("rev-parse", "--verify", "-q", ref):
+            return None
+        return self.git("rev-parse", "--verify", "-q", ref)
+
+    def fetch(self) -> None:
+        self.git("fetch", "-q", "--prune", self.remote)
+
+
+@contextmanager
+def locked(folder: Path) -> Iterator[None]:
+    """Hold `<folder>.lock` exclusively: models deployed in parallel share the central mesh
+    repositories and submodule caches, whose clones one process at a time may use."""
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    with open(folder.with_name(folder.name + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
+    """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist."""
+    existed = folder.exists()
+    if existed:
+        if not (folder / ".git").exists():
+            raise DeployError("E0803", f"'{folder}' exists and is not a git clone; mpc clones into "
+                                       "folders of its own (remove it or choose another workdir)")
+        git = Git(folder)
+        current = git("remote", "get-url", remote, check=False)
+        if current != url:
+            raise DeployError("E0803", f"'{folder}' is a clone of '{current or 'nothing'}', not of '{url}'")
+    else:
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        Git(folder.parent)("clone", "-q", "--no-checkout", "--origin", remote, url, str(folder))
+        git = Git(folder)
+    clone = Clone(folder, git, remote, url, "")
+    if existed:
+        clone.fetch()
+    clone.default_branch = _default_branch(git, remote)
+    return clone
+
+
+def _default_branch(git: Git, remote: str) -> str:
+    """The remote's HEAD branch; for an empty remote, the unborn branch the clone got."""
+    listing = git("ls-remote", "--symref", remote, "HEAD", check=False)
+    for line in listing.splitlines():
+        if line.startswith("ref: refs/heads/") and line.endswith("\tHEAD"):
+            return line[len("ref: refs/heads/"):-len("\tHEAD")]
+    head = git("symbolic-ref", "-q", "HEAD", check=False)
+    return head.removeprefix("refs/heads/") if head.startswith("refs/heads/") else "master"
+
+
+def start_branch(clone: Clone, branch: str, base: str | None) -> str | None:
+    """Check out `branch` as the remote has it; a new branch starts at the remote's `base`,
+    or empty. Leftovers of earlier runs are cleaned. The commit it starts at, or None."""
+    git = clone.git
+    start = clone.remote_sha(branch) or (clone.remote_sha(base) if base else None)
+    if start is not None:
+        git("checkout", "-q", "-f", "-B", branch, start)
+    else:  # an empty remote, or neither branch exists: an orphan branch
+        git("symbolic-ref", "HEAD", f"refs/heads/{branch}")
+        if git.ok("rev-parse", "--verify", "-q", f"refs/heads/{branch}"):
+            git("update-ref", "-d", f"refs/heads/{branch}")  # a local leftover, never pushed
+        git("read-tree", "--empty")
+    git("clean", "-q", "-ffdx")
+    return start
+
+
+def staged_changes(git: Git, start: str | None) -> bool:
+    """Whether the index differs from the commit the branch starts at."""
+    return not git.ok("diff", "--cached", "--quiet", start or EMPTY_TREE)
+
+
+def diff_stat(git: Git, start: str | None) -> str:
+    return git("diff", "--cached", "--stat", start or EMPTY_TREE)
+
+
+def commit(git: Git, message: str) -> str:
+    """Commit the index; the new commit. Without an identity from the environment or git's
+    configuration, the commit is made as `mpc <mpc@localhost>`."""
+    identity = [] if git.ok("var", "GIT_COMMITTER_IDENT") and git.ok("var", "GIT_AUTHOR_IDENT") \
+        else ["-c", "user.name=mpc", "-c", "user.email=mpc@localhost"]
+    git(*identity, "commit", "-q", "--no-gpg-sign", "-m", message)
+    return git("rev-parse", "HEAD")
+
+
+@dataclass
+class Published:
+    """What `publish` did. sha: the new commit (None: nothing to commit). output: the
+    push's messages (a forge may print the merge request's address there)."""
+
+    sha: str | None
+    pushed: bool
+    diffstat: str = ""
+    output: str = ""
+    attempts: int = 1
+
+
+Fill = Callable[[Clone], None]
+
+
+def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: str,
+            push_options: list[str], dry_run: bool) -> Published:
+    """Fill `branch` (from the remote's branch, or `base`) with `fill`, commit and push."""
+    for attempt in range(1, ATTEMPTS + 1):
+        start = start_branch(clone, branch, base)
+        fill(clone)
+        if not staged_changes(clone.git, start):
+            return Published(None, False, attempts=attempt)
+        if dry_run:
+            return Published(None, False, diff_stat(clone.git, start), attempts=attempt)
+        sha = commit(clone.git, message)
+        args = ["push", "--porcelain"]
+        for option in push_options:
+            args += ["-o", option]
+        status, out, err = clone.git.result(*args, clone.remote, f"HEAD:refs/heads/{branch}")
+        if status == 0:
+            return Published(sha, True, output=f"{out}\n{err}", attempts=attempt)
+        before = clone.remote_sha(branch)
+        clone.fetch()
+        if clone.remote_sha(branch) == before:
+            hint = ("\n(the server does not take git push options, which forge 'gitlab' uses for "
+                    "merge requests: choose another forge)") if "does not support push options" in err else ""
+            raise DeployError("E0803", f"pushing to branch '{branch}' of '{clone.url}' failed:\n"
+                                       f"{(err or out).strip()}{hint}")
+        # The branch moved between our fetch and our push: build the commit again on top of it.
+    raise DeployError("E0803", f"branch '{branch}' of '{clone.url}' moved during each of {ATTEMPTS} "
+                               "attempts to push; nothing was overwritten, try again later")

@@ -1,0 +1,140 @@
+"""The small parts of deploy: lowering, settings from the environment, the shallow merge,
+LFS patterns, credential scrubbing, submodule addresses, GitHub repository names."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mpc.compiler.driver import Options, load_program
+from mpc.deploy.gitcmd import scrub
+from mpc.deploy.github import repository_slug
+from mpc.deploy.plan import lfs_patterns, make_plan, merged
+from mpc.deploy.settings import DeploySettings, join_remote
+from mpc.deploy.submodules import absolute_url
+from mpc.ir.program import Deployment, DeployMirror, Program
+from mpc.ir.span import Span
+from tests.conftest import Diags
+from tests.deploy.conftest import definition_text
+from tests.fixtures import arm
+
+S = Span("d.yml", 1, 1)
+
+
+def _program(tmp_path: Path, deployment: str, diags: Diags) -> Program | None:
+    arm(tmp_path)
+    (tmp_path / "arm_model.yml").write_text(definition_text(deployment))
+    return load_program(tmp_path / "arm_model.yml", diags, Options())
+
+
+def test_deployment_is_lowered(tmp_path: Path, diags: Diags) -> None:
+    program = _program(tmp_path, """\
+  add_lfs_track: [bobj]
+  deployment:
+    do_not_deploy: false
+    mr_mention: "@alice"
+    keep_files: ["a/*.lua"]
+    mirror: {repo: ../m.git, merge_request: true}
+""", diags)
+    assert program is not None and program.deployment is not None
+    d = program.deployment
+    assert (d.do_not_deploy, d.mr_mention, d.keep_files, d.add_lfs_track, d.mr_title) == (
+        False, ("@alice",), ("a/*.lua",), ("bobj",), None)
+    assert d.mirror == DeployMirror(repo="../m.git", span=d.mirror.span, merge_request=True)
+    assert (d.span.line, d.span.col) == (13, 3)
+
+
+def test_keep_files_outside_the_repository(tmp_path: Path, diags: Diags) -> None:
+    _program(tmp_path, """\
+  deployment:
+    keep_files: ["../secret", "ok/*"]
+    submodules: [{repo: x.git, target: /abs}]
+""", diags)
+    keep, target = diags.take_error("E0801"), diags.take_error("E0801")
+    assert keep.message == ("keep_files entry '../secret' is outside the repository; write a path "
+                            "relative to the repository's top folder")
+    assert (keep.span.line, keep.span.col) == (13, 18)
+    assert target.message == "submodule target '/abs' is not a folder inside the repository"
+
+
+def test_settings_from_the_environment_and_explicit_values() -> None:
+    env = {"GIT_SUCCESS_BRANCH": "main", "CI_UPDATE_TARGET_BRANCH": "update", "GIT_REMOTE_NAME": "autobuild",
+           "GIT_PRODUCTION_BRANCH": "stable", "CI_MESH_UPDATE_TARGET_BRANCH": "meshes"}
+    s = DeploySettings.from_environment(env, failure_branch="broken")
+    assert (s.success_branch, s.failure_branch, s.production_branch, s.mesh_branch, s.remote_name) == (
+        "main", "broken", "stable", "meshes", "autobuild")
+    assert DeploySettings.from_environment({}).failure_branch is None
+    assert DeploySettings.from_environment({"GIT_FAILURE_BRANCH": "f", "CI_UPDATE_TARGET_BRANCH": "u"}) \
+        .failure_branch == "f"
+
+
+def test_remote_addresses() -> None:
+    assert join_remote("git@host:models", "arm") == "git@host:models/arm"
+    assert join_remote("git@host:", "arm") == "git@host:arm"
+    assert join_remote("https://h/g/", "/meshes/stl") == "https://h/g/meshes/stl"
+    assert DeploySettings(remote_base="https://h/g").remote_of("arm") == "https://h/g/arm"
+    assert DeploySettings(remote_base="https://h/g", remote="r").remote_of("arm") == "r"
+    assert DeploySettings().remote_of("arm") is None
+
+
+def test_shallow_merge_of_default_deployment() -> None:
+    default = Deployment(span=S, do_not_deploy=True, mr_title="T", keep_files=("a",), mr_mention=("@x",))
+    own = Deployment(span=Span("m.yml", 3, 3), do_not_deploy=False, keep_files=("b",))
+    m = merged(default, own)
+    assert m == Deployment(span=own.span, do_not_deploy=False, mr_title="T", keep_files=("b",),
+                           mr_mention=("@x",))
+    assert merged(None, own) is own and merged(default, None) is default
+
+
+@pytest.mark.parametrize(("failed", "production", "target", "expected"), [
+    (False, None, None, ("master", None)),            # success = production: no merge request
+    (False, "stable", None, ("master", "stable")),
+    (True, None, None, ("tests-failed", "master")),   # a failure asks to go into the success branch
+    (True, None, "develop", ("tests-failed", "develop")),
+    (False, None, "master", ("master", None)),        # a request into the branch itself is none
+])
+def test_branches_and_merge_request_target(failed: bool, production: str | None, target: str | None,
+                                           expected: tuple[str, str | None]) -> None:
+    program = Program(robotname="r", modelname="m", inputs={}, ops=(), exports=(), span=S,
+                      deployment=Deployment(span=S, mr_target_branch=target))
+    plan = make_plan(program, DeploySettings(production_branch=production), "url", "master", failed)
+    assert (plan.branch, plan.mr_target) == expected
+    assert plan.base == "master"
+
+
+def test_lfs_patterns() -> None:
+    assert lfs_patterns(("Bobj", ".ply"), False) == ("*.Bobj", "*.bobj", "*.BOBJ", "*.ply", "*.PLY")
+    assert lfs_patterns((), True)[:3] == ("*.obj", "*.OBJ", "*.stl")
+    assert lfs_patterns((), False) == ()
+
+
+def test_scrub(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GITHUB_TOKEN", "tok-12345")
+    assert scrub("fatal: https://user:pa55@host/x.git and ssh://git@host/y") == \
+        "fatal: https://***@host/x.git and ssh://***@host/y"
+    assert scrub("header tok-12345 echoed") == "header *** echoed"
+
+
+def test_submodule_addresses() -> None:
+    assert absolute_url("../lua.git", "https://h/g/arm.git") == "https://h/g/lua.git"
+    assert absolute_url("../../other/lua.git", "git@h:g/arm.git") == "git@h:other/lua.git"
+    assert absolute_url("./sub", "/srv/arm") == "/srv/arm/sub"
+    assert absolute_url("https://x/y.git", "/srv/arm") == "https://x/y.git"
+
+
+def test_github_repository_names() -> None:
+    assert repository_slug("git@github.com:acme/arm.git") == "acme/arm"
+    assert repository_slug("https://github.com/acme/arm") == "acme/arm"
+    assert repository_slug("https://token@github.com/acme/arm.git/") == "acme/arm"
+    assert repository_slug("/srv/git/acme/arm.git") == "acme/arm"
+    assert repository_slug("arm") is None
+
+
+@pytest.mark.parametrize(("path", "inside"), [
+    ("a/b.lua", True), ("**/*.lua", True), ("./a", True), (".", False), ("", False),
+    ("../a", False), ("a/../../b", False), ("/etc/passwd", False)])
+def test_inside_repository(path: str, inside: bool) -> None:
+    from mpc.compiler.lower_deploy import inside_repository
+
+    assert inside_repository(path) is inside
