@@ -23,6 +23,8 @@ def _environment_share_dirs() -> list[Path]:
     for key in ("purelib", "platlib"):
         site = Path(sysconfig.get_paths()[key])
         dirs.append(site / "cmeel.prefix" / "share")
+    # A virtualenv made with --system-site-packages sees the base installation's packages.
+    dirs.extend(Path(p) / "cmeel.prefix" / "share" for p in sys.path if p.endswith("-packages"))
     dirs.append(Path(sys.prefix) / "share")
     seen: list[Path] = []
     for d in dirs:
