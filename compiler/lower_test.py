@@ -116,7 +116,7 @@ class _TestLowering:
         what = f"test '{name}'"
         test = ModelTest(name=name, span=span, dynamics=dynamics)
         if arg is None:
-            if name in PAIR_TESTS or name in ("compare_link_positions", "move_hyrodyn_model"):
+            if name in PAIR_TESTS or name == "move_hyrodyn_model":
                 self.sink.error(span, "E0703", f"{what} needs an argument: {_NEEDS[name]}")
                 return None
             return test
@@ -188,7 +188,6 @@ _NEEDS = {
     "symmetry_check_masses": "two link names [left, right]",
     "symmetry_check": "two link names [left, right]",
     "symmetry_check_torques": "two link names [left, right]",
-    "compare_link_positions": "a list of link names",
     "move_hyrodyn_model": "a joint value, a list of values or a mapping {joint: value}",
 }
 
