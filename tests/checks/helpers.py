@@ -76,11 +76,11 @@ def failing(protocol: Protocol) -> set[str]:
     return {r.name for r in protocol.results if r.status in ("failed", "waived")}
 
 
-def result(protocol: Protocol, name: str):  # noqa: ANN201 (a Result)
+def result(protocol: Protocol, name: str):
     return next(r for r in protocol.results if r.name == name)
 
 
-def edited_urdf(source: Path, target: Path, edit) -> Path:  # noqa: ANN001 (a function of the tree)
+def edited_urdf(source: Path, target: Path, edit) -> Path:
     """A copy of a real URDF at `target`, changed by `edit(root)`; package:// meshes still resolve."""
     tree = etree.parse(str(source), etree.XMLParser(remove_comments=False, resolve_entities=False))
     edit(tree.getroot())
@@ -105,5 +105,18 @@ def fmt(values: list[float]) -> str:
     return " ".join(repr(v) for v in values)
 
 
-__all__ = ["EVERY_TEST", "compile_ok", "definition", "edited_urdf", "failing", "fmt", "floats", "joint_el",
-           "link_el", "result", "run", "statuses", "write"]
+__all__ = [
+    "EVERY_TEST",
+    "compile_ok",
+    "definition",
+    "edited_urdf",
+    "failing",
+    "floats",
+    "fmt",
+    "joint_el",
+    "link_el",
+    "result",
+    "run",
+    "statuses",
+    "write",
+]

@@ -27,14 +27,15 @@ def test_a_model_against_its_release_passes_and_writes_the_protocol(tmp_path: Pa
                                "test_protocol.junit.xml\n")
     data = json.loads((tmp_path / "out/test_protocol.json").read_text())
     assert (data["failed"], data["counts"]["passed"]) == (False, 6)
-    assert (tmp_path / "out/urdf/solo.urdf").is_file() and (tmp_path / "out/test_protocol.junit.xml").is_file()
+    assert (tmp_path / "out/urdf/solo.urdf").is_file()
+    assert (tmp_path / "out/test_protocol.junit.xml").is_file()
 
 
 def test_a_failing_test_exits_1_and_built_skips_compiling(tmp_path: Path) -> None:
     write(tmp_path / "ref.yml", definition(SOLO, "solo", TESTS))
     assert mpc("compile", tmp_path / "ref.yml", "-o", tmp_path / "ref").returncode == 0
 
-    def heavier(root):  # noqa: ANN001, ANN202
+    def heavier(root):
         mass = link_el(root, "base_link").find("inertial/mass")
         mass.set("value", repr(float(mass.get("value")) + 0.1))
 

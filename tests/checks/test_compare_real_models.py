@@ -38,7 +38,7 @@ def reference(tmp_path: Path, source: Path = TALOS, name: str = "talos") -> Path
 
 
 def against_ref(tmp_path: Path, basefile: Path, tests: str = EVERY_TEST, extra: str = "",
-                name: str = "talos"):  # noqa: ANN201
+                name: str = "talos"):
     ref = tmp_path / "ref"
     text = definition(basefile, name, tests, compare=f"      path: {ref}\n", extra=extra)
     write(tmp_path / "new.yml", text)
@@ -72,7 +72,7 @@ def test_a_link_mass_changed_by_twice_the_tolerance(tmp_path: Path) -> None:
     (0.02 kg on 93 kg) stay within their tolerances, and only the mass tests fail."""
     reference(tmp_path)
 
-    def heavier(root):  # noqa: ANN001, ANN202
+    def heavier(root):
         mass = link_el(root, "base_link").find("inertial/mass")
         mass.set("value", repr(float(mass.get("value")) + 2 * TOL["mass"]))
 
@@ -89,7 +89,7 @@ def test_a_link_mass_changed_by_twice_the_tolerance(tmp_path: Path) -> None:
 def test_a_joint_origin_moved_by_twice_the_distance(tmp_path: Path) -> None:
     reference(tmp_path)
 
-    def moved(root):  # noqa: ANN001, ANN202
+    def moved(root):
         origin = joint_el(root, "arm_left_4_joint").find("origin")
         xyz = floats(origin.get("xyz"))
         xyz[0] += 2 * TOL["distance"]
@@ -124,7 +124,7 @@ def test_the_com_moved_by_a_multiple_of_the_distance(tmp_path: Path, factor: flo
     reference(tmp_path)
     total, base = 93.33572, 15.36284
 
-    def shifted(root):  # noqa: ANN001, ANN202
+    def shifted(root):
         origin = link_el(root, "base_link").find("inertial/origin")
         xyz = floats(origin.get("xyz"))
         xyz[1] += factor * TOL["distance"] * total / base  # moves the whole COM by factor·distance

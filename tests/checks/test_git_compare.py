@@ -10,7 +10,17 @@ import git
 import pytest
 
 from mpc.compiler.diagnostics import Sink
-from tests.checks.helpers import compile_ok, definition, edited_urdf, failing, link_el, result, run, statuses, write
+from tests.checks.helpers import (
+    compile_ok,
+    definition,
+    edited_urdf,
+    failing,
+    link_el,
+    result,
+    run,
+    statuses,
+    write,
+)
 from tests.conftest import ERD
 
 SOLO = ERD / "solo_description/robots/solo12.urdf"
@@ -18,7 +28,7 @@ TESTS = "      - compare_link_masses\n      - hyrodynChecks: [compare_masses, co
 
 
 def heavier_solo(tmp_path: Path) -> Path:
-    def edit(root):  # noqa: ANN001, ANN202
+    def edit(root):
         mass = link_el(root, "FL_LOWER_LEG").find("inertial/mass")
         mass.set("value", repr(float(mass.get("value")) + 0.05))
     return edited_urdf(SOLO, tmp_path / "in/solo12.urdf", edit)
@@ -52,8 +62,8 @@ def compare(repo: Path, **keys: str) -> str:
 def test_compare_at_a_commit_finds_the_difference_and_a_waiver_for_another_commit_does_not_apply(
         tmp_path: Path, remote: tuple[Path, str, str]) -> None:
     repo, first, second = remote
-    write(tmp_path / "m.yml", definition(heavier_solo(tmp_path), "solo", TESTS,
-                                         compare(repo, commit=first[:10], ignore_failing_tests_for=second[:8])))
+    keys = compare(repo, commit=first[:10], ignore_failing_tests_for=second[:8])
+    write(tmp_path / "m.yml", definition(heavier_solo(tmp_path), "solo", TESTS, keys))
     protocol = run(tmp_path / "m.yml", tmp_path / "out", tmp_path / "work")
     assert protocol.compare == f"`{repo}` at commit `{first[:12]}`"
     assert protocol.waiver == ""

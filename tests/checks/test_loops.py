@@ -21,7 +21,8 @@ SDF_WITH_LOOPS = "    - type: sdf\n      mesh_format: input_type\n      include_
 
 
 def fourbar(tmp_path: Path, tests: str, rocker_mass: float = 3.0) -> str:
-    write(tmp_path / "fourbar.urdf", FOURBAR_URDF.replace('<mass value="3"/>', f'<mass value="{rocker_mass}"/>'))
+    urdf = FOURBAR_URDF.replace('<mass value="3"/>', f'<mass value="{rocker_mass}"/>')
+    write(tmp_path / "fourbar.urdf", urdf)
     return FOURBAR_DEFINITION + SDF_WITH_LOOPS + "  test:\n" + tests
 
 
@@ -55,7 +56,8 @@ def test_fourbar_compare_torques_sees_the_rocker_through_the_loop(tmp_path: Path
     """The rocker hangs on the base, not on the crank: only the closed loop makes its mass
     load the crank, by Δτ = g sin θ Δm / 2."""
     tests = "    compare_model:\n      path: ref\n      model_in_repo: sdf/fourbar.sdf\n    tests:\n" \
-            "      - hyrodynChecks:\n          - load_in_hyrodyn\n          - move_hyrodyn_model: {crank_joint: 0.5}\n" \
+            "      - hyrodynChecks:\n          - load_in_hyrodyn\n" \
+            "          - move_hyrodyn_model: {crank_joint: 0.5}\n" \
             "          - compare_torques\n"
     write(tmp_path / "ref.yml", fourbar(tmp_path, "    tests: []\n", rocker_mass=3.2))
     compile_ok(tmp_path / "ref.yml", tmp_path / "ref")
@@ -71,7 +73,8 @@ def test_fourbar_compare_torques_sees_the_rocker_through_the_loop(tmp_path: Path
 
 def test_fourbar_against_itself_passes(tmp_path: Path) -> None:
     tests = "    compare_model:\n      path: ref\n      model_in_repo: sdf/fourbar.sdf\n    tests:\n" \
-            "      - hyrodynChecks: [load_in_hyrodyn, {move_hyrodyn_model: 0.8}, compare_torques, compare_com]\n"
+            "      - hyrodynChecks: [load_in_hyrodyn, {move_hyrodyn_model: 0.8}, compare_torques, " \
+            "compare_com]\n"
     write(tmp_path / "fourbar.yml", fourbar(tmp_path, tests))
     compile_ok(tmp_path / "fourbar.yml", tmp_path / "ref")
     protocol = run(tmp_path / "fourbar.yml", tmp_path / "out", tmp_path / "work")
@@ -84,7 +87,8 @@ CASSIE_ACTUATED = ("roll-op", "yaw-op", "pitch-op", "knee-op", "foot-op", "knee-
 def cassie_definition() -> str:
     """cassie_v2 (SDF, its four rods closed by ball joints), with motors on the five actuated
     joints of each leg and on the knee spring (stiff: it carries the shin's load)."""
-    joints = "".join(f"    {side}-{j}:\n      active: true\n" for side in ("left", "right") for j in CASSIE_ACTUATED)
+    joints = "".join(f"    {side}-{j}:\n      active: true\n"
+                     for side in ("left", "right") for j in CASSIE_ACTUATED)
     return f"""\
 model:
   robotname: cassie
@@ -144,7 +148,8 @@ def test_cassie_against_itself_passes_with_its_loops(tmp_path: Path) -> None:
     write(tmp_path / "cassie.yml", cassie_definition())
     protocol = run(tmp_path / "cassie.yml", tmp_path / "out", tmp_path / "work")
     s = statuses(protocol)
-    dynamics = ("load_in_hyrodyn", "move_hyrodyn_model", "compare_torques", "compare_com", "compare_link_positions")
+    dynamics = ("load_in_hyrodyn", "move_hyrodyn_model", "compare_torques", "compare_com",
+                "compare_link_positions")
     assert all(s[n] == "passed" for n in dynamics), protocol.markdown()
     assert result(protocol, "load_in_hyrodyn").reason.endswith("4 loop closures")
     assert "12 joint torques with 4 loop closures" in result(protocol, "compare_torques").reason

@@ -14,7 +14,7 @@ from tests.conftest import Diags, definition, write
 from tests.fixtures import ARM_URDF, tetra_stl
 
 
-def program(tmp_path: Path, test: str, diags: Diags):  # noqa: ANN201
+def program(tmp_path: Path, test: str, diags: Diags):
     write(tmp_path / "arm.urdf", ARM_URDF)
     tetra_stl(tmp_path / "meshes" / "tetra.stl")
     write(tmp_path / "arm.yml", definition("arm.urdf") + "  test:\n" + test)
@@ -71,11 +71,13 @@ def test_every_argument_form_and_the_ir_round_trip(tmp_path: Path, diags: Diags)
     ("    tests:\n      - symmetry_check_masses: [a]\n", "E0703",
      "test 'symmetry_check_masses' needs two link names [left, right], got ['a']"),
     ("    tests:\n      - hyrodynChecks: [move_hyrodyn_model]\n", "E0703",
-     "test 'move_hyrodyn_model' needs an argument: a joint value, a list of values or a mapping {joint: value}"),
+     "test 'move_hyrodyn_model' needs an argument: a joint value, a list of values or a mapping "
+     "{joint: value}"),
     ("    tests:\n      - physical_validity: loud\n", "E0703",
      "test 'physical_validity': the argument is 'error' (findings fail the test) or 'warning', got 'loud'"),
     ("    tests:\n      - hyrodynChecks: [{symmetry_check: {links: [a, b], plane: [0, 0, 0]}}]\n", "E0703",
-     "test 'symmetry_check': 'plane' is the normal of the mirror plane, three numbers not all zero, e.g. [0, 1, 0]"),
+     "test 'symmetry_check': 'plane' is the normal of the mirror plane, three numbers not all zero, "
+     "e.g. [0, 1, 0]"),
     ("    tolerances: {distance: -1}\n", "E0701", "tolerance 'distance' must not be negative, got -1"),
     ("    compare_model: {git: a.git, path: b}\n", "E0701",
      "compare_model needs either 'git' (a repository) or 'path' (a folder or model file), not both"),

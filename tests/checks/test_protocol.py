@@ -21,7 +21,8 @@ SOLO = ERD / "solo_description/robots/solo12.urdf"
 
 def sample() -> Protocol:
     p = Protocol(model="arm-model", compare="`ref` at commit `0123abcd`")
-    p.add(passed("compare_com", "COM within", figure=0.001, unit="m", tolerance="distance", tolerance_value=0.003))
+    p.add(passed("compare_com", "COM within", figure=0.001, unit="m", tolerance="distance",
+                 tolerance_value=0.003))
     p.add(failed("compare_com", "COM 4.5 mm off", figure=0.0045, unit="m", tolerance="distance",
                  tolerance_value=0.003, details=("base_link: Δ = +0.0045 m",)))
     p.add(skipped("total_mass", "no expected mass"))
@@ -72,18 +73,20 @@ def test_write_puts_three_files(tmp_path: Path) -> None:
     data = json.loads((tmp_path / "test_protocol.json").read_text())
     assert data["failed"] is True
     assert data["tests"][1] == {
-        "name": "compare_com 2", "status": "failed", "reason": "COM 4.5 mm off", "figure": 0.0045, "unit": "m",
+        "name": "compare_com 2", "status": "failed", "reason": "COM 4.5 mm off", "figure": 0.0045,
+        "unit": "m",
         "tolerance": "distance", "tolerance_value": 0.003, "details": ["base_link: Δ = +0.0045 m"], "log": ""}
     assert (tmp_path / "test_protocol.md").read_text() == sample().markdown()
     ET.parse(tmp_path / "test_protocol.junit.xml")
 
 
 def test_a_test_that_raises_does_not_end_the_others(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    def broken(ctx, test):  # noqa: ANN001, ANN202
+    def broken(ctx, test):
         return 1 / 0
 
     monkeypatch.setitem(TESTS, "compare_amount_joints", broken)
-    write(tmp_path / "m.yml", definition(SOLO, "solo", "      - compare_amount_joints\n      - load_in_pybullet\n"))
+    tests = "      - compare_amount_joints\n      - load_in_pybullet\n"
+    write(tmp_path / "m.yml", definition(SOLO, "solo", tests))
     protocol = run(tmp_path / "m.yml", tmp_path / "out", tmp_path / "work")
     crashed = result(protocol, "compare_amount_joints")
     assert crashed.status == "failed"
@@ -96,7 +99,8 @@ def test_a_test_that_raises_does_not_end_the_others(tmp_path: Path, monkeypatch:
 
 
 def test_pybullet_failure_keeps_its_console_and_a_missing_mesh_fails_the_double_check(tmp_path: Path) -> None:
-    write(tmp_path / "m.yml", definition(SOLO, "solo", "      - process_double_check\n      - load_in_pybullet\n"))
+    tests = "      - process_double_check\n      - load_in_pybullet\n"
+    write(tmp_path / "m.yml", definition(SOLO, "solo", tests))
     built = compile_ok(tmp_path / "m.yml", tmp_path / "out")
     lost = sorted((tmp_path / "out" / "meshes").rglob("*.stl"))[0]
     lost.unlink()
@@ -119,4 +123,5 @@ def test_an_output_that_was_not_compiled_fails_every_test(tmp_path: Path) -> Non
     assert set(statuses(protocol).values()) == {"failed"}
     assert [d.code for d in sink.diagnostics] == ["E0705"]
     assert sink.diagnostics[0].message == \
-        f"cannot test 'solo-model': '{tmp_path / 'empty/urdf/solo.urdf'}' does not exist: compile the model first"
+        f"cannot test 'solo-model': '{tmp_path / 'empty/urdf/solo.urdf'}' does not exist: " \
+        "compile the model first"

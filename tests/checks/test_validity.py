@@ -25,14 +25,15 @@ def test_talos_links_with_mass_but_no_inertia_are_flagged() -> None:
     """talos_full_v2: three sensor and tool frames have a mass and a zero inertia tensor."""
     found = flagged(ERD / "talos_data/robots/talos_full_v2.urdf")
     assert set(found) == {"rgbd_optical_frame", "wrist_left_ft_tool_link", "wrist_right_ft_tool_link"}
-    assert found["wrist_left_ft_tool_link"] == "inertia is not positive definite (principal moments (0, 0, 0))"
+    assert found["wrist_left_ft_tool_link"] == \
+        "inertia is not positive definite (principal moments (0, 0, 0))"
 
 
 def test_inertias_violating_the_triangle_inequality_are_flagged() -> None:
     """The allegro hands' link_3.0, link_7.0, link_11.0 and link_15.0 (their tips) have
     principal moments A + B < C; pr2's stereo mount too."""
-    triangle = {link for link, p in flagged(ERD / "allegro_hand_description/urdf/allegro_right_hand.urdf").items()
-                if "triangle inequality" in p}
+    hand = flagged(ERD / "allegro_hand_description/urdf/allegro_right_hand.urdf")
+    triangle = {link for link, p in hand.items() if "triangle inequality" in p}
     assert triangle == {"link_3.0", "link_7.0", "link_11.0", "link_15.0"}
     pr2 = flagged(ERD / "pr2_description/urdf/pr2.urdf")
     assert "violate the triangle inequality" in pr2["double_stereo_link"]
@@ -75,7 +76,8 @@ def test_findings_are_warnings_unless_configured_as_errors(tmp_path: Path) -> No
 def test_a_moving_link_without_mass_and_a_com_outside_its_shapes(tmp_path: Path) -> None:
     from tests.checks.fourbar import FOURBAR_URDF
 
-    urdf = FOURBAR_URDF.replace('<origin xyz="0 0 0.5"/><mass value="3"/>', '<origin xyz="0 0 1.5"/><mass value="3"/>')
+    urdf = FOURBAR_URDF.replace('<origin xyz="0 0 0.5"/><mass value="3"/>',
+                                '<origin xyz="0 0 1.5"/><mass value="3"/>')
     urdf = urdf.replace('<origin xyz="1 0 0"/><mass value="2"/>', '<origin xyz="1 0 0"/><mass value="0"/>')
     write(tmp_path / "f.urdf", urdf)
     robot = read(tmp_path / "f.urdf", Sink())
