@@ -1,43 +1,15 @@
 """load_in_pybullet: the written URDF loads in real PyBullet (DIRECT mode, the file's inertias).
 
-PyBullet prints from C straight to file descriptors 1 and 2, so its console is caught by
-pointing those descriptors at a temporary file while it runs; the text goes into the protocol.
+PyBullet prints from C straight to file descriptors 1 and 2; its console is caught
+(checks/console.py) and goes into the protocol.
 """
 
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
-import tempfile
-from collections.abc import Iterator
-
+from mpc.checks.console import captured_fds
 from mpc.checks.protocol import Result, failed, passed
 from mpc.checks.registry import Context, register
 from mpc.ir.program import ModelTest
-
-
-@contextlib.contextmanager
-def captured_fds() -> Iterator[list[str]]:
-    """Everything written to fds 1 and 2 inside the block, as one string in the list."""
-    out: list[str] = []
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = os.dup(1), os.dup(2)
-    with tempfile.TemporaryFile(mode="w+b") as f:
-        os.dup2(f.fileno(), 1)
-        os.dup2(f.fileno(), 2)
-        try:
-            yield out
-        finally:
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            os.close(saved[0])
-            os.close(saved[1])
-            f.seek(0)
-            out.append(f.read().decode("utf-8", "replace"))
 
 
 @register("load_in_pybullet")

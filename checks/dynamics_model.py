@@ -32,8 +32,8 @@ class DynamicsError(Exception):
 class Dynamics:
     """A Pinocchio model of a robot, its loop constraints and which joints are actuated.
 
-    actuated: the joints whose torques count: those with a motor when the robot has loops
-    and motors, else every movable joint (a tree without loops: all of them).
+    actuated: the joints whose torques count: with loops, those with a motor (else those
+    its submechanisms name in `jointnames_active`); otherwise every movable joint.
     """
 
     robot: Robot
@@ -178,20 +178,36 @@ def build(robot: Robot) -> Dynamics:
     import pinocchio as pin
 
     from mpc.backends.urdf_writer import to_string
+    from mpc.checks.console import captured_fds
 
     text = to_string(_with_full_limits(robot), lambda mesh: "mesh.stl")  # no mesh is read
-    try:
-        model = pin.buildModelFromXML(text)
-    except (RuntimeError, ValueError) as e:
-        raise DynamicsError(f"Pinocchio cannot build the model: {e}") from None
+    with captured_fds() as console:  # urdfdom prints its errors from C
+        try:
+            model = pin.buildModelFromXML(text)
+            problem = ""
+        except (RuntimeError, ValueError) as e:
+            problem = str(e)
+    if problem:
+        said = " ".join(ln.strip() for ln in console[0].splitlines() if ln.strip().startswith("Error:"))
+        raise DynamicsError(f"Pinocchio cannot build the model: {problem}" + (f" ({said})" if said else ""))
     constraints = []
     for cut in sorted(robot.cut_joints.values(), key=lambda c: c.name):
         constraints.append(_constraint(pin, model, robot, cut))
     movable = [model.names[j] for j in range(1, model.njoints) if model.nvs[j] == 1]
-    motors = {m.joint for m in robot.motors.values()} if robot.motors else set()
+    motors = {m.joint for m in robot.motors.values()} or _active_in_submechanisms(robot)
     actuated = [n for n in movable if n in motors] if constraints and motors else movable
     return Dynamics(robot=robot, model=model, data=model.createData(), constraints=constraints,
                     actuated=tuple(actuated))
+
+
+def _active_in_submechanisms(robot: Robot) -> set[str]:
+    """The joints the submechanisms name as active (HyRoDyn's `jointnames_active`)."""
+    out: set[str] = set()
+    for sub in robot.submechanisms:
+        names = sub.definition.get("jointnames_active") if isinstance(sub.definition, Mapping) else None
+        if isinstance(names, list | tuple):
+            out.update(n for n in names if isinstance(n, str))
+    return out
 
 
 def _with_full_limits(robot: Robot) -> Robot:

@@ -164,3 +164,21 @@ def test_an_underactuated_loop_fails_with_the_reason(tmp_path: Path) -> None:
     torques = result(protocol, "compare_torques")
     assert torques.status == "failed"
     assert "cannot hold this configuration against gravity" in torques.reason
+
+
+def test_without_motors_the_submechanisms_active_joints_are_driven(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from mpc.checks.dynamics_model import build
+    from mpc.ir.extras import Submechanism
+
+    write(tmp_path / "fourbar.yml", fourbar(tmp_path, "    tests: []\n"))
+    built = compile_ok(tmp_path / "fourbar.yml", tmp_path / "out")
+    model, _ = load_built(built.program, tmp_path / "out", built.robot)
+    assert model is not None
+    robot = replace(model.robot, motors={}, submechanisms=(
+        Submechanism(name="fourbar", definition={"jointnames_active": ["crank_joint"]}),))
+    dyn = build(robot)
+    assert dyn.actuated == ("crank_joint",)
+    q = dyn.configuration({"crank_joint": 0.3})
+    assert dyn.gravity_torques(q)["crank_joint"] == pytest.approx(expected_crank_torque(0.3), abs=1e-8)
