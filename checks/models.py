@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from mpc.compiler.diagnostics import Sink
+from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
 
@@ -70,6 +71,22 @@ def _urdf_of_smurf(path: Path) -> Path | None:
     return (path.parent / urdf).resolve() if urdf else None
 
 
+def read_submechanisms(path: Path) -> tuple[Submechanism, ...] | None:
+    """The submechanisms of a HyRoDyn submechanisms file (`submechanisms: [{…}]`), or None
+    when it cannot be read."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError):
+        return None
+    entries = data.get("submechanisms") if isinstance(data, dict) else None
+    if not isinstance(entries, list):
+        return None
+    return tuple(Submechanism(name=str(e.get("name", i)), definition=e)
+                 for i, e in enumerate(entries) if isinstance(e, dict))
+
+
 def built_model_file(program: Program, built: Path) -> Path | None:
     """The model file of the whole robot in an output folder: its first URDF export, else its
     first SDF export."""
@@ -95,8 +112,12 @@ def load_built(program: Program, built: Path, robot: Robot | None) -> tuple[Mode
     if read is None:
         return None, f"cannot read '{path}': {_first_error(sink)}"
     if robot is not None:
+        submechanisms = robot.submechanisms
+        if not submechanisms and robot.submechanisms_file:  # a file used as it is
+            folder = Path(program.span.file).resolve().parent
+            submechanisms = read_submechanisms(folder / robot.submechanisms_file) or ()
         read = replace(read, cut_joints=read.cut_joints or robot.cut_joints, motors=robot.motors,
-                       submechanisms=robot.submechanisms, poses=robot.poses, sensors=robot.sensors)
+                       submechanisms=submechanisms, poses=robot.poses, sensors=robot.sensors)
     return Model(robot=read, path=path, folder=built), ""
 
 
@@ -111,6 +132,7 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
         folder, commit = target.path, ""
         if not folder.exists():
             return None, f"compare model path '{folder}' does not exist"
+    root = folder if folder.is_dir() else folder.parent  # where `…_in_repo` paths start
     path = folder / target.model_in_repo if target.model_in_repo else folder
     if path.is_dir():
         folder = path
@@ -126,6 +148,11 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
     robot = read_model(path, sink)
     if robot is None:
         return None, f"cannot read the compare model '{path.name}': {_first_error(sink)}"
+    if target.submechanisms_in_repo:
+        submechanisms = read_submechanisms(root / target.submechanisms_in_repo)
+        if submechanisms is None:
+            return None, f"cannot read submechanisms_in_repo '{target.submechanisms_in_repo}'"
+        robot = replace(robot, submechanisms=submechanisms)
     return Model(robot=robot, path=path, folder=folder, commit=commit), ""
 
 

@@ -182,3 +182,21 @@ def test_without_motors_the_submechanisms_active_joints_are_driven(tmp_path: Pat
     assert dyn.actuated == ("crank_joint",)
     q = dyn.configuration({"crank_joint": 0.3})
     assert dyn.gravity_torques(q)["crank_joint"] == pytest.approx(expected_crank_torque(0.3), abs=1e-8)
+
+
+@pytest.mark.parametrize("present", [True, False])
+def test_the_compare_models_submechanisms_file_is_read(tmp_path: Path, present: bool) -> None:
+    tests = "    compare_model:\n      path: ref\n      model_in_repo: sdf/fourbar.sdf\n" \
+            "      submechanisms_in_repo: fourbar_submechanisms.yml\n    tests:\n" \
+            "      - hyrodynChecks: [load_in_hyrodyn, compare_torques]\n"
+    write(tmp_path / "fourbar.yml", fourbar(tmp_path, tests))
+    compile_ok(tmp_path / "fourbar.yml", tmp_path / "ref")
+    if present:
+        write(tmp_path / "ref/fourbar_submechanisms.yml",
+              "submechanisms:\n  - name: fourbar\n    jointnames_active: [crank_joint]\n")
+    protocol = run(tmp_path / "fourbar.yml", tmp_path / "out", tmp_path / "work")
+    if present:  # and file_consistency notices that the new output lacks it
+        assert failing(protocol) == {"file_consistency"}, protocol.markdown()
+    else:
+        assert result(protocol, "compare_torques").reason == "the compare model cannot be loaded: " \
+            "cannot read submechanisms_in_repo 'fourbar_submechanisms.yml'"
