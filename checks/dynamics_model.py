@@ -45,9 +45,9 @@ class Dynamics:
     # -- configurations ---------------------------------------------------------------------
 
     def joint_names(self) -> list[str]:
-        """The movable joints with one coordinate, in Pinocchio's (depth-first) order."""
+        """The movable joints with one degree of freedom, in Pinocchio's (depth-first) order."""
         m = self.model
-        return [m.names[j] for j in range(1, m.njoints) if m.nqs[j] == 1]
+        return [m.names[j] for j in range(1, m.njoints) if m.nvs[j] == 1]
 
     def configuration(self, values: Mapping[str, float],
                       actuated: tuple[str, ...] | None = None) -> np.ndarray:
@@ -60,8 +60,12 @@ class Dynamics:
         m = self.model
         q = pin.neutral(m)
         for name, value in values.items():
-            if m.existJointName(name) and m.nqs[m.getJointId(name)] == 1:
-                q[m.idx_qs[m.getJointId(name)]] = value
+            j = m.getJointId(name) if m.existJointName(name) else 0
+            if j and m.nvs[j] == 1:
+                if m.nqs[j] == 2:  # a continuous joint: (cos, sin) of its angle
+                    q[m.idx_qs[j]:m.idx_qs[j] + 2] = np.cos(value), np.sin(value)
+                else:
+                    q[m.idx_qs[j]] = value
         if not self.constraints:
             return q
         fixed = {m.idx_vs[m.getJointId(n)] for n in (self.actuated if actuated is None else actuated)
