@@ -200,3 +200,15 @@ def test_the_compare_models_submechanisms_file_is_read(tmp_path: Path, present: 
     else:
         assert result(protocol, "compare_torques").reason == "the compare model cannot be loaded: " \
             "cannot read submechanisms_in_repo 'fourbar_submechanisms.yml'"
+
+
+def test_cassie_against_its_own_compiled_sdf(tmp_path: Path) -> None:
+    """The compiled SDF keeps where each rod's ball joint sits, so the loops read back the same."""
+    released = f"      path: \"{ERD / 'cassie_description/robots/cassie_v2.sdf'}\"\n"
+    text = cassie_definition().replace(released, "      path: ref\n      model_in_repo: sdf/cassie.sdf\n")
+    assert "model_in_repo: sdf/cassie.sdf" in text
+    write(tmp_path / "cassie.yml", text)
+    compile_ok(tmp_path / "cassie.yml", tmp_path / "ref")
+    protocol = run(tmp_path / "cassie.yml", tmp_path / "out", tmp_path / "work")
+    assert set(statuses(protocol).values()) == {"passed"}, protocol.markdown()
+    assert result(protocol, "compare_link_positions").figure < 1e-6
