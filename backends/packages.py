@@ -19,12 +19,10 @@ from mpc.ir.geometry import MeshSource
 
 
 def _environment_share_dirs() -> list[Path]:
-    import site
-
-    dirs = []
-    # A virtualenv made with --system-site-packages also sees the system's site folders.
-    for folder in [*(sysconfig.get_paths()[k] for k in ("purelib", "platlib")), *site.getsitepackages()]:
-        dirs.append(Path(folder) / "cmeel.prefix" / "share")
+    # A virtualenv made with --system-site-packages also sees the base installation's packages.
+    sites = [*(sysconfig.get_paths()[k] for k in ("purelib", "platlib")),
+             *(p for p in sys.path if p.endswith("-packages"))]
+    dirs = [Path(folder) / "cmeel.prefix" / "share" for folder in sites]
     dirs.append(Path(sys.prefix) / "share")
     seen: list[Path] = []
     for d in dirs:

@@ -284,6 +284,12 @@ class _Writer:
         self.line(depth, f'<joint name="{_attr(cut.name)}" type="{kind}">')
         self.leaf(depth + 1, "parent", self.links.get(cut.parent, cut.parent))
         self.leaf(depth + 1, "child", self.links.get(cut.child, cut.child))
+        # Where the closure sits on the child, when it is not the child's origin (an SDF input
+        # says so; the reader keeps it as `joint_origin`): a ball joint elsewhere is another loop.
+        jo = cut.annotations.get("joint_origin")
+        if isinstance(jo, dict):
+            self.pose(depth + 1, Pose(tuple(jo.get("xyz", (0.0, 0.0, 0.0))),  # type: ignore[arg-type]
+                                      tuple(jo.get("rpy", (0.0, 0.0, 0.0)))))  # type: ignore[arg-type]
         if kind in ("revolute", "prismatic"):
             axis = cut.constraint_axes[0][1] if cut.constraint_axes else (0.0, 0.0, 1.0)
             self.line(depth + 1, "<axis>")

@@ -45,6 +45,15 @@ def _parser() -> argparse.ArgumentParser:
     from mpc.deploy.command import add_arguments as deploy_arguments
 
     deploy_arguments(sub.add_parser("deploy", help="deploy a built model to its git repository"))
+    # -- mpc test (checks/) --
+    test = sub.add_parser("test", help="compile a model definition and run its model tests")
+    test.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
+    test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
+    test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
+    test.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                      help="where the ROS package NAME is (for package:// paths); repeatable")
+    test.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                      help="how to print diagnostics (default: human)")
     for p in (check,):
         p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
                        help="where the ROS package NAME is (for package:// paths); repeatable")
@@ -125,10 +134,47 @@ def _deploy(args: argparse.Namespace) -> int:
     return run(args)
 
 
+def _test(args: argparse.Namespace) -> int:
+    """Compile (unless --built names an output), run the model tests, write the protocol into
+    the output folder and print its Markdown; 1 when a test failed and was not waived."""
+    import tempfile
+
+    from mpc.backends.packages import PackageResolver
+    from mpc.checks import run_model_tests
+    from mpc.compiler.driver import InputLoader, Options, apply, compile_model, load_program
+
+    sink = Sink()
+    options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
+    if args.built is not None:
+        loader = InputLoader(sink, options, (args.definition.resolve(),))
+        program = load_program(args.definition, sink, options, loader=loader)
+        robot = apply(program, sink, loader) if program is not None else None
+        out = args.built
+        if program is not None and not out.is_dir():
+            print(f"error: --built '{out}' is not a folder", file=sys.stderr)
+            return 1
+    else:
+        result = compile_model(args.definition, sink, options)
+        program, robot, out = result.program, result.robot, result.out  # type: ignore[assignment]
+    if program is None or robot is None or out is None:
+        _print_diagnostics(sink, args.format)
+        print(f"error: could not compile '{args.definition}' ({render.summary(sink.diagnostics)})",
+              file=sys.stderr)
+        return 1
+    with tempfile.TemporaryDirectory(prefix="mpc-test-") as work:
+        protocol = run_model_tests(program, out, sink, workdir=Path(work), robot=robot)
+    protocol.write(out)
+    _print_diagnostics(sink, args.format)
+    print(protocol.markdown())
+    print(f"wrote {out / 'test_protocol.md'}, test_protocol.json and test_protocol.junit.xml",
+          file=sys.stderr)
+    return 1 if protocol.failed else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"compile": _compile, "check": _check, "schema": _schema,
+        return {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
                 "deploy": _deploy}[args.command](args)
     except KeyboardInterrupt:
         return 130

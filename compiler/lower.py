@@ -56,7 +56,7 @@ from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
-LATER_SECTIONS = ("test", "append_export_config", "swing_my_robot")
+LATER_SECTIONS = ("append_export_config", "swing_my_robot")
 
 
 def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
@@ -453,9 +453,14 @@ class _Lowering:
             if entry.is_human:
                 self.not_yet(entry.key_span("is_human"), f"'is_human' (input model '{name}')")
         exports = self.exports()
+        test = None
+        if self.model.test is not None:
+            from mpc.compiler.lower_test import lower_test
+
+            test = lower_test(self.model.test, self.base_dir, self.sink)
         return Program(robotname=self.model.robotname, modelname=self.model.modelname,
                        inputs=inputs, ops=tuple(self.ops), exports=exports, span=self.model.span,
-                       deployment=lower_model_deployment(self.model, self.sink))
+                       test=test, deployment=lower_model_deployment(self.model, self.sink))
 
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.

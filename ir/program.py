@@ -211,6 +211,77 @@ RobotExport = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExpor
 Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 
 
+# -- the `test` section (checks/) ---------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Tolerances:
+    """Tolerances of the model tests: `mass` (kg), `distance` (m), `rad` (angles and, for
+    lack of a better one, torques are measured against `default`)."""
+
+    default: float = 0.01
+    mass: float = 0.01
+    rad: float = 0.03
+    distance: float = 0.003
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CompareTarget:
+    """The previous version of the model that the compare tests measure against.
+
+    git: a repository (cloned); path: a folder or model file on disk (one of the two).
+    branch, commit: what to check out (default: the repository's HEAD).
+    model_in_repo: the model file in it; submechanisms_in_repo: its submechanisms file.
+    ignore_failing_tests_for: a commit (prefix) of it at which failures become waivers.
+    """
+
+    span: Span
+    git: str = ""
+    path: Path | None = None
+    branch: str = ""
+    commit: str = ""
+    model_in_repo: str = ""
+    submechanisms_in_repo: str = ""
+    ignore_failing_tests_for: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ModelTest:
+    """One entry of `tests` (or of `hyrodynChecks`, then `dynamics`).
+
+    name: the test's definition name. links: the links it names (compare_link_positions,
+    symmetry checks). value: the expected figure (total_mass). plane: the mirror plane's
+    normal (symmetry checks). angle, angles, joint_angles: the configuration that
+    move_hyrodyn_model sets (one value for every joint, one per joint, or by joint name).
+    as_error: physical_validity findings fail instead of warning.
+    """
+
+    name: str
+    span: Span
+    dynamics: bool = False
+    links: tuple[str, ...] = ()
+    value: float | None = None
+    plane: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    angle: float | None = None
+    angles: tuple[float, ...] = ()
+    joint_angles: Mapping[str, float] | None = None
+    as_error: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TestPlan:
+    """The lowered `test` section: the tests in order, tolerances, the compare model and
+    the expected values of `test_data_file`."""
+
+    __test__ = False  # not a pytest test class
+
+    span: Span
+    tests: tuple[ModelTest, ...] = ()
+    tolerances: Tolerances = Tolerances()
+    compare: CompareTarget | None = None
+    expected_mass: float | None = None
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Program:
     """A lowered model definition.
@@ -219,6 +290,7 @@ class Program:
     inputs: input models by name.
     ops: rewrites in order: loading and assembling parts, then editing the robot.
     exports: what to write.
+    test: the model tests (checks/), when the definition has a `test` section.
     span: the definition's `model:` section.
     deployment: where the model goes (deploy/); None when the definition says nothing.
     """
@@ -230,6 +302,7 @@ class Program:
     exports: tuple[Export, ...]
     span: Span
     deployment: Deployment | None = None
+    test: TestPlan | None = None
 
 
 # -- deployment (deploy/) -------------------------------------------------------------------

@@ -1,0 +1,191 @@
+"""The two models a test run compares: the compiled one (from the output folder) and the
+compare model (a git repository cloned with GitPython at a branch or commit, or a folder).
+
+Both are read with mpc's own readers into robot values; a model that cannot be read is a
+reason, not an exception, so the tests that need it fail with that reason.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.extras import Submechanism
+from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
+from mpc.ir.robot import Robot
+
+
+@dataclass
+class Model:
+    """A model under test: its robot value and the file it was read from.
+
+    folder: the folder whose files belong to the model (the output folder, the clone).
+    commit: the compare repository's commit, when it came from git.
+    """
+
+    robot: Robot
+    path: Path
+    folder: Path
+    commit: str = ""
+    _dynamics: Any = field(default=None, repr=False)
+
+    def dynamics(self) -> Any:
+        """The Pinocchio model (checks/dynamics_model.py), built once; raises DynamicsError."""
+        if self._dynamics is None:
+            from mpc.checks.dynamics_model import build
+
+            self._dynamics = build(self.robot)
+        return self._dynamics
+
+
+def read_model(path: Path, sink: Sink) -> Robot | None:
+    """A URDF or SDF file (by its suffix) → a robot; diagnostics go to `sink`."""
+    if path.suffix.lower() == ".sdf":
+        from mpc.backends.sdf_reader import read as read_sdf
+
+        return read_sdf(path, sink)
+    if path.suffix.lower() == ".smurf":
+        urdf = _urdf_of_smurf(path)
+        if urdf is None:
+            return None
+        path = urdf
+    from mpc.backends.urdf_reader import read as read_urdf
+
+    return read_urdf(path, sink)
+
+
+def _urdf_of_smurf(path: Path) -> Path | None:
+    """The URDF a SMURF file lists in `files` (Phobos names the SMURF as compare model)."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError):
+        return None
+    files = data.get("files", []) if isinstance(data, dict) else []
+    urdf = next((f for f in files if isinstance(f, str) and f.endswith(".urdf")), None)
+    return (path.parent / urdf).resolve() if urdf else None
+
+
+def read_submechanisms(path: Path) -> tuple[Submechanism, ...] | None:
+    """The submechanisms of a HyRoDyn submechanisms file (`submechanisms: [{…}]`), or None
+    when it cannot be read."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError):
+        return None
+    entries = data.get("submechanisms") if isinstance(data, dict) else None
+    if not isinstance(entries, list):
+        return None
+    return tuple(Submechanism(name=str(e.get("name", i)), definition=e)
+                 for i, e in enumerate(entries) if isinstance(e, dict))
+
+
+def built_model_file(program: Program, built: Path) -> Path | None:
+    """The model file of the whole robot in an output folder: its first URDF export, else its
+    first SDF export."""
+    for kind in (UrdfExport, SdfExport):
+        for export in program.exports:
+            if isinstance(export, kind) and not export.submodel:
+                suffix = "urdf" if kind is UrdfExport else "sdf"
+                name = export.filename or program.robotname
+                return built / suffix / f"{name}.{suffix}"
+    return None
+
+
+def load_built(program: Program, built: Path, robot: Robot | None) -> tuple[Model | None, str]:
+    """The compiled model; `robot` (the program applied) lends it what URDF cannot hold:
+    cut joints, motors and submechanisms. The model or None, and the reason."""
+    path = built_model_file(program, built)
+    if path is None:
+        return None, "the definition exports no URDF or SDF of the whole robot"
+    if not path.is_file():
+        return None, f"'{path}' does not exist: compile the model first"
+    sink = Sink()
+    read = read_model(path, sink)
+    if read is None:
+        return None, f"cannot read '{path}': {_first_error(sink)}"
+    if robot is not None:
+        submechanisms = robot.submechanisms
+        if not submechanisms and robot.submechanisms_file:  # a file used as it is
+            folder = Path(program.span.file).resolve().parent
+            submechanisms = read_submechanisms(folder / robot.submechanisms_file) or ()
+        read = replace(read, cut_joints=read.cut_joints or robot.cut_joints, motors=robot.motors,
+                       submechanisms=submechanisms, poses=robot.poses, sensors=robot.sensors)
+    return Model(robot=read, path=path, folder=built), ""
+
+
+def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, str]:
+    """The compare model: cloned (git) or read from disk (path). The model or None, and why."""
+    if target.git:
+        folder, commit, problem = _clone(target, workdir)
+        if folder is None:
+            return None, problem
+    else:
+        assert target.path is not None
+        folder, commit = target.path, ""
+        if not folder.exists():
+            return None, f"compare model path '{folder}' does not exist"
+    root = folder if folder.is_dir() else folder.parent  # where `…_in_repo` paths start
+    path = folder / target.model_in_repo if target.model_in_repo else folder
+    if path.is_dir():
+        folder = path
+        patterns = ("urdf/*.urdf", "*.urdf", "sdf/*.sdf")
+        found = next((sorted(path.glob(p)) for p in patterns if any(path.glob(p))), [])
+        if not found:
+            return None, f"no model file ({', '.join(patterns)}) in '{path}'; name it with model_in_repo"
+        path = found[0]
+    elif not path.is_file():
+        return None, f"'{target.model_in_repo}' does not exist in the compare model" + (
+            f" at commit {commit[:12]}" if commit else "")
+    sink = Sink()
+    robot = read_model(path, sink)
+    if robot is None:
+        return None, f"cannot read the compare model '{path.name}': {_first_error(sink)}"
+    if target.submechanisms_in_repo:
+        submechanisms = read_submechanisms(root / target.submechanisms_in_repo)
+        if submechanisms is None:
+            return None, f"cannot read submechanisms_in_repo '{target.submechanisms_in_repo}'"
+        robot = replace(robot, submechanisms=submechanisms)
+    return Model(robot=robot, path=path, folder=folder, commit=commit), ""
+
+
+def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]:
+    """Clone the repository into `workdir` and check out the branch or commit; the work
+    tree, the commit checked out, and the reason when it failed."""
+    import git
+
+    key = hashlib.sha256(f"{target.git}\0{target.branch}\0{target.commit}".encode()).hexdigest()[:12]
+    folder = workdir / f"compare_model-{key}"
+    if folder.exists():
+        shutil.rmtree(folder)
+    workdir.mkdir(parents=True, exist_ok=True)
+    try:
+        kwargs = {"branch": target.branch} if target.branch else {}
+        repo = git.Repo.clone_from(target.git, folder, **kwargs)
+        if target.commit:
+            repo.git.checkout(target.commit)
+        commit = repo.head.commit.hexsha
+    except (git.GitCommandError, ValueError) as e:
+        shutil.rmtree(folder, ignore_errors=True)
+        what = (f"commit '{target.commit}'" if target.commit else
+                f"branch '{target.branch}'" if target.branch else "the default branch")
+        return None, "", f"cannot get {what} of compare repository '{target.git}': {_git_error(e)}"
+    return folder, commit, ""
+
+
+def _git_error(e: Exception) -> str:
+    text = str(getattr(e, "stderr", "") or e)
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    return lines[-1].removeprefix("stderr: ").strip("'") if lines else type(e).__name__
+
+
+def _first_error(sink: Sink) -> str:
+    return next((f"{d.span}: {d.message}" for d in sink.diagnostics if d.severity.name == "ERROR"),
+                "unreadable")

@@ -1,0 +1,171 @@
+"""Test results → the protocol: Markdown (a merge request's body), JSON, JUnit XML (CI test tabs).
+
+A result is passed, failed, waived (failed, but the compare model is at the commit named
+by `ignore_failing_tests_for`) or skipped (with the reason); skipped is never counted as
+passed. The protocol fails when a test failed and was not waived.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Literal
+from xml.sax.saxutils import escape, quoteattr
+
+Status = Literal["passed", "failed", "waived", "skipped"]
+_SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Result:
+    """The outcome of one test.
+
+    name: the test's definition name (`compare_com`, …), with ` 2`, ` 3` for repeats.
+    status: passed / failed / waived / skipped. reason: why, in one sentence.
+    figure: the measured value the verdict rests on (the worst one), with `unit`.
+    tolerance: the name of the tolerance it was measured against, and its value.
+    details: lines for the protocol (per link, per joint …), worst first.
+    log: what a library printed meanwhile (PyBullet's console).
+    """
+
+    name: str
+    status: Status
+    reason: str = ""
+    figure: float | None = None
+    unit: str = ""
+    tolerance: str = ""
+    tolerance_value: float | None = None
+    details: tuple[str, ...] = ()
+    log: str = ""
+
+    @property
+    def failed(self) -> bool:
+        return self.status == "failed"
+
+
+def passed(name: str, reason: str = "", **kw: object) -> Result:
+    return Result(name=name, status="passed", reason=reason, **kw)  # type: ignore[arg-type]
+
+
+def failed(name: str, reason: str, **kw: object) -> Result:
+    return Result(name=name, status="failed", reason=reason, **kw)  # type: ignore[arg-type]
+
+
+def skipped(name: str, reason: str, **kw: object) -> Result:
+    return Result(name=name, status="skipped", reason=reason, **kw)  # type: ignore[arg-type]
+
+
+def verdict(name: str, ok: bool, reason: str, **kw: object) -> Result:
+    return (passed if ok else failed)(name, reason, **kw)
+
+
+@dataclass(slots=True)
+class Protocol:
+    """Every test's result of one model, in the order they ran."""
+
+    model: str
+    results: list[Result] = field(default_factory=list)
+    compare: str = ""  # what the model was compared with (repository @ commit, or folder)
+    waiver: str = ""  # why failures are waived, when they are
+
+    def add(self, result: Result) -> None:
+        """Record `result`; a repeated name gets a suffix; a failure becomes a waiver when
+        the compare model is at the commit that `ignore_failing_tests_for` names."""
+        names = {r.name for r in self.results}
+        name, n = result.name, 1
+        while name in names:
+            n += 1
+            name = f"{result.name} {n}"
+        if result.status == "failed" and self.waiver:
+            result = replace(result, status="waived", reason=f"{result.reason} (waived: {self.waiver})")
+        self.results.append(replace(result, name=name))
+
+    @property
+    def failed(self) -> bool:
+        """Whether a test failed and was not waived."""
+        return any(r.failed for r in self.results)
+
+    def counts(self) -> dict[str, int]:
+        statuses = ("passed", "failed", "waived", "skipped")
+        return {s: sum(r.status == s for r in self.results) for s in statuses}
+
+    def summary(self) -> str:
+        c = self.counts()
+        return ", ".join(f"{n} {s}" for s, n in c.items() if n or s in ("passed", "failed"))
+
+    # -- renderers ---------------------------------------------------------------------
+
+    def markdown(self) -> str:
+        verdict_line = "**failed**" if self.failed else "**passed**"
+        lines = [f"## Model tests of `{self.model}`: {verdict_line} ({self.summary()})", ""]
+        if self.compare:
+            lines += [f"Compared with {self.compare}.", ""]
+        if self.waiver:
+            lines += [f"Failures are waived: {self.waiver}.", ""]
+        lines += ["| test | result | figure | tolerance | reason |", "|---|---|---|---|---|"]
+        for r in self.results:
+            lines.append(f"| `{r.name}` | {_SIGN[r.status]} | {_figure(r)} | {_tolerance(r)} | "
+                         f"{_cell(r.reason)} |")
+        for r in self.results:
+            if r.details or r.log:
+                lines += ["", f"<details><summary><code>{r.name}</code></summary>", "", "```"]
+                lines += list(r.details)
+                if r.log:
+                    lines += ["--- output ---", r.log.rstrip()]
+                lines += ["```", "", "</details>"]
+        return "\n".join(lines) + "\n"
+
+    def to_json(self) -> dict[str, object]:
+        return {
+            "model": self.model, "failed": self.failed, "counts": self.counts(),
+            "compare": self.compare, "waiver": self.waiver,
+            "tests": [{"name": r.name, "status": r.status, "reason": r.reason, "figure": r.figure,
+                       "unit": r.unit, "tolerance": r.tolerance, "tolerance_value": r.tolerance_value,
+                       "details": list(r.details), "log": r.log} for r in self.results],
+        }
+
+    def junit(self) -> str:
+        c = self.counts()
+        out = ['<?xml version="1.0" encoding="UTF-8"?>',
+               f'<testsuites name="mpc test" tests="{len(self.results)}" failures="{c["failed"]}">',
+               f'  <testsuite name={quoteattr(self.model)} tests="{len(self.results)}" '
+               f'failures="{c["failed"]}" skipped="{c["skipped"] + c["waived"]}" errors="0">']
+        for r in self.results:
+            head = f'    <testcase classname={quoteattr(self.model)} name={quoteattr(r.name)}'
+            text = "\n".join([f"{_figure(r)} (tolerance {_tolerance(r)})", *r.details])
+            if r.status == "passed" and not r.log:
+                out.append(head + "/>")
+                continue
+            out.append(head + ">")
+            if r.status == "failed":
+                out.append(f"      <failure message={quoteattr(r.reason)}>{escape(text)}</failure>")
+            elif r.status in ("skipped", "waived"):
+                out.append(f"      <skipped message={quoteattr(r.status + ': ' + r.reason)}/>")
+            if r.log:
+                out.append(f"      <system-out>{escape(r.log)}</system-out>")
+            out.append("    </testcase>")
+        out += ["  </testsuite>", "</testsuites>"]
+        return "\n".join(out) + "\n"
+
+    def write(self, folder: Path) -> None:
+        """Write test_protocol.md, test_protocol.json and test_protocol.junit.xml into `folder`."""
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "test_protocol.md").write_text(self.markdown(), encoding="utf-8")
+        (folder / "test_protocol.json").write_text(json.dumps(self.to_json(), indent=2) + "\n",
+                                                   encoding="utf-8")
+        (folder / "test_protocol.junit.xml").write_text(self.junit(), encoding="utf-8")
+
+
+def _figure(r: Result) -> str:
+    return "" if r.figure is None else f"{r.figure:.6g}{' ' + r.unit if r.unit else ''}"
+
+
+def _tolerance(r: Result) -> str:
+    if not r.tolerance:
+        return ""
+    return r.tolerance if r.tolerance_value is None else f"`{r.tolerance}` = {r.tolerance_value:g}"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")

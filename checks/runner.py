@@ -1,0 +1,79 @@
+"""A program and its compiled output → the protocol of its model tests.
+
+The tests run in the order the definition lists them; topological_self_consistency,
+file_consistency and physical_validity run always (after the listed ones, when not listed).
+A test that raises does not end the others: it fails with the exception as its reason.
+"""
+
+from __future__ import annotations
+
+import traceback
+from pathlib import Path
+
+from mpc.checks import bullet, dynamics, masses, process, topology, validity  # noqa: F401  (registration)
+from mpc.checks.models import load_built, load_compare
+from mpc.checks.protocol import Protocol, Result, failed
+from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
+from mpc.compiler.diagnostics import Sink
+from mpc.ir.program import ModelTest, Program, TestPlan
+from mpc.ir.robot import Robot
+
+ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity")
+
+
+def apply_program(program: Program, sink: Sink) -> Robot | None:
+    """The robot the program describes (its inputs read, its ops run), or None."""
+    from mpc.compiler.driver import Options, apply
+    from mpc.compiler.inputs import InputLoader
+
+    loader = InputLoader(sink, Options(), (Path(program.span.file).resolve(),))
+    return apply(program, sink, loader)
+
+
+def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
+                    robot: Robot | None = None) -> Protocol:
+    """Run the tests of `program` on its compiled output `built`; clones go into `workdir`.
+
+    robot: the program applied, when the caller has it (else it is built here); it says
+    what the model should contain beyond URDF: cut joints, motors, submechanisms.
+    """
+    plan = program.test or TestPlan(span=program.span)
+    if robot is None:
+        quiet = Sink()  # the build reported these already
+        robot = apply_program(program, quiet)
+    new, new_problem = load_built(program, built, robot)
+    ctx = Context(program=program, plan=plan, sink=sink, new=new, new_problem=new_problem, robot=robot)
+    protocol = Protocol(model=program.modelname)
+    if plan.compare is not None:
+        ctx.old, ctx.old_problem = load_compare(plan.compare, workdir)
+        target = plan.compare
+        where = target.git or str(target.path)
+        if ctx.old is None:
+            sink.error(target.span, "E0704", ctx.old_problem)
+        else:
+            at = f" at commit `{ctx.old.commit[:12]}`" if ctx.old.commit else ""
+            protocol.compare = f"`{where}`{at}"
+            waive = target.ignore_failing_tests_for
+            if waive and ctx.old.commit.startswith(waive):
+                protocol.waiver = (f"the compare model is at commit {ctx.old.commit[:12]}, which "
+                                   "ignore_failing_tests_for names")
+    if new is None:
+        sink.error(program.span, "E0705", f"cannot test '{program.modelname}': {new_problem}")
+    tests = list(plan.tests)
+    listed = {t.name for t in tests if not t.dynamics}
+    tests += [ModelTest(name=name, span=plan.span) for name in ALWAYS if name not in listed]
+    for test in tests:
+        protocol.add(_run(ctx, test))
+    return protocol
+
+
+def _run(ctx: Context, test: ModelTest) -> Result:
+    fn = (DYNAMICS_CHECKS if test.dynamics else TESTS).get(test.name)
+    if fn is None:  # the schema knows it, no check implements it
+        return failed(test.name, f"mpc has no implementation of test '{test.name}'")
+    try:
+        return fn(ctx, test)
+    except Exception as e:  # a bug in a check must not end the other tests
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        return failed(test.name, f"the test itself failed (a bug in mpc, please report it): "
+                      f"{type(e).__name__}: {e} at {Path(where.filename).name}:{where.lineno}")

@@ -1,0 +1,207 @@
+"""The `test` section (AST) → ir.TestPlan: tests with checked arguments, tolerances merged
+with the defaults, the compare model, and the expected values of `test_data_file`.
+
+It reads `test_data_file` (a small YAML file) but no model and no repository.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from mpc.compiler.diagnostics import Sink
+from mpc.compiler.expr import evaluate
+from mpc.compiler.schema.release import TestSection
+from mpc.ir.program import CompareTarget, ModelTest, TestPlan, Tolerances
+from mpc.ir.span import Span
+
+# Tests that take a pair of links [left, right] (and optionally a mirror plane).
+PAIR_TESTS = frozenset({"symmetry_check_masses", "symmetry_check", "symmetry_check_torques"})
+# Tests whose argument is optional: the others take none.
+_WITH_ARGUMENT = PAIR_TESTS | {"total_mass", "compare_link_positions", "move_hyrodyn_model",
+                               "physical_validity", "compare_torques"}
+_UNITS = ("deg", "rad")
+
+
+class _TestLowering:
+    def __init__(self, section: TestSection, base_dir: Path, sink: Sink) -> None:
+        self.section, self.base_dir, self.sink = section, base_dir, sink
+
+    def span(self, *path: str | int) -> Span:
+        node = self.section
+        assert node._doc is not None
+        return node._doc.value_span((*node._path, *path))
+
+    def number(self, value: Any, span: Span, what: str) -> float | None:
+        return evaluate(value, span, self.sink, what=what)
+
+    def tolerances(self) -> Tolerances:
+        tol = self.section.tolerances
+        if tol is None:
+            return Tolerances()
+        values = {}
+        for key in ("default", "mass", "rad", "distance"):
+            value = evaluate(getattr(tol, key), tol.value_span(key), self.sink, what=f"tolerance '{key}'")
+            if value is not None and value < 0:
+                self.sink.error(tol.value_span(key), "E0701", f"tolerance '{key}' must not be negative, "
+                                f"got {value:g}")
+                value = None
+            if value is not None:
+                values[key] = value
+        return Tolerances(**values)
+
+    def compare(self) -> CompareTarget | None:
+        c = self.section.compare_model
+        if c is None:
+            return None
+        if (c.git is None) == (c.path is None):
+            self.sink.error(c.span, "E0701", "compare_model needs either 'git' (a repository) or "
+                            "'path' (a folder or model file), not " + ("both" if c.git else "neither"))
+            return None
+        if c.path is not None and (c.branch or c.commit):
+            key = "branch" if c.branch else "commit"
+            self.sink.error(c.key_span(key), "E0701", f"'{key}' needs a 'git' compare model; "
+                            "'path' names a folder as it is")
+            return None
+        path = None
+        if c.path is not None:
+            file = c.value_span("path").file
+            folder = Path(file).resolve().parent if file else self.base_dir
+            path = (folder / c.path).resolve()
+        git = c.git or ""
+        if git and "://" not in git and "@" not in git.split("/")[0] and not Path(git).is_absolute():
+            git = str((self.base_dir / git).resolve())  # a local repository next to the definition
+        return CompareTarget(span=c.span, git=git, path=path, branch=c.branch or "", commit=c.commit or "",
+                             model_in_repo=c.model_in_repo or "",
+                             submechanisms_in_repo=c.submechanisms_in_repo or "",
+                             ignore_failing_tests_for=str(c.ignore_failing_tests_for or ""))
+
+    def expected_mass(self) -> float | None:
+        written = self.section.test_data_file
+        path = self.base_dir / (written or "test_data.yml")
+        if written is None and not path.is_file():
+            return None
+        span = self.span("test_data_file") if written else self.section.span
+        from mpc.compiler import source
+
+        doc = source.load(path, self.sink) if path.is_file() else None
+        if doc is None:
+            if not path.is_file():
+                self.sink.error(span, "E0702", f"test_data_file '{written}' does not exist")
+            return None
+        data = doc.data.get("test_data") if isinstance(doc.data, dict) else None
+        if not isinstance(data, dict) or "expected_mass" not in data:
+            return None
+        return evaluate(data["expected_mass"], doc.value_span(("test_data", "expected_mass")), self.sink,
+                        what="expected_mass")
+
+    def tests(self) -> tuple[ModelTest, ...]:
+        out: list[ModelTest] = []
+        for i, item in enumerate(self.section.tests):
+            name, arg = _split(item)
+            if name == "hyrodynChecks":
+                for k, check in enumerate(arg):
+                    inner, inner_arg = _split(check)
+                    test = self.test(inner, inner_arg, self.span("tests", i, "hyrodynChecks", k),
+                                     dynamics=True)
+                    if test is not None:
+                        out.append(test)
+                continue
+            test = self.test(name, arg, self.span("tests", i), dynamics=False)
+            if test is not None:
+                out.append(test)
+        return tuple(out)
+
+    def test(self, name: str, arg: Any, span: Span, dynamics: bool) -> ModelTest | None:
+        what = f"test '{name}'"
+        test = ModelTest(name=name, span=span, dynamics=dynamics)
+        if arg is None:
+            if name in PAIR_TESTS or name == "move_hyrodyn_model":
+                self.sink.error(span, "E0703", f"{what} needs an argument: {_NEEDS[name]}")
+                return None
+            return test
+        if name not in _WITH_ARGUMENT:
+            self.sink.error(span, "E0703", f"{what} takes no argument")
+            return None
+        if name == "total_mass":
+            value = self.number(arg, span, f"{what} expected mass")
+            return None if value is None else ModelTest(name=name, span=span, dynamics=dynamics, value=value)
+        if name == "physical_validity":
+            if arg not in ("error", "warning"):
+                self.sink.error(span, "E0703", f"{what}: the argument is 'error' (findings fail the "
+                                f"test) or 'warning', got {arg!r}")
+                return None
+            return ModelTest(name=name, span=span, as_error=arg == "error")
+        if name in ("compare_link_positions", "compare_torques"):
+            links = [arg] if isinstance(arg, str) else arg
+            if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
+                self.sink.error(span, "E0703", f"{what} takes a list of "
+                                f"{'link' if name == 'compare_link_positions' else 'joint'} names")
+                return None
+            return ModelTest(name=name, span=span, dynamics=dynamics, links=tuple(links))
+        if name in PAIR_TESTS:
+            return self.pair(test, arg)
+        return self.configuration(test, arg)
+
+    def pair(self, test: ModelTest, arg: Any) -> ModelTest | None:
+        what = f"test '{test.name}'"
+        plane = (0.0, 1.0, 0.0)
+        if isinstance(arg, dict):
+            unknown = set(arg) - {"links", "plane"}
+            if unknown:
+                self.sink.error(test.span, "E0703", f"{what}: unknown key '{sorted(unknown)[0]}' "
+                                "(it takes 'links' and 'plane')")
+                return None
+            if "plane" in arg:
+                values = arg["plane"]
+                got = [self.number(v, test.span, f"{what} plane") for v in values] \
+                    if isinstance(values, list) else []
+                if len(got) != 3 or None in got or all(v == 0 for v in got):
+                    self.sink.error(test.span, "E0703", f"{what}: 'plane' is the normal of the mirror "
+                                    "plane, three numbers not all zero, e.g. [0, 1, 0]")
+                    return None
+                plane = tuple(got)  # type: ignore[assignment]
+            arg = arg.get("links")
+        if not isinstance(arg, list) or len(arg) != 2 or not all(isinstance(x, str) for x in arg):
+            self.sink.error(test.span, "E0703", f"{what} needs two link names [left, right], got {arg!r}")
+            return None
+        return ModelTest(name=test.name, span=test.span, dynamics=test.dynamics, links=tuple(arg),
+                         plane=plane)
+
+    def configuration(self, test: ModelTest, arg: Any) -> ModelTest | None:
+        """move_hyrodyn_model: one value, a list (one per joint) or a mapping by joint name."""
+        what = f"test '{test.name}'"
+        base = {"name": test.name, "span": test.span, "dynamics": test.dynamics}
+        if isinstance(arg, dict):
+            values = {str(k): self.number(v, test.span, f"{what} '{k}'") for k, v in arg.items()}
+            if None in values.values():
+                return None
+            return ModelTest(**base, joint_angles=values)  # type: ignore[arg-type]
+        if isinstance(arg, list) and not (len(arg) == 2 and arg[0] in _UNITS):
+            angles = [self.number(v, test.span, f"{what}[{i}]") for i, v in enumerate(arg)]
+            return None if None in angles else ModelTest(**base, angles=tuple(angles))  # type: ignore[arg-type]
+        value = self.number(arg, test.span, what)
+        return None if value is None else ModelTest(**base, angle=value)  # type: ignore[arg-type]
+
+
+_NEEDS = {
+    "symmetry_check_masses": "two link names [left, right]",
+    "symmetry_check": "two link names [left, right]",
+    "symmetry_check_torques": "two link names [left, right]",
+    "move_hyrodyn_model": "a joint value, a list of values or a mapping {joint: value}",
+}
+
+
+def _split(item: Any) -> tuple[str, Any]:
+    if isinstance(item, dict):
+        return next(iter(item.items()))
+    return item, None
+
+
+def lower_test(section: TestSection, base_dir: Path, sink: Sink) -> TestPlan | None:
+    """The TestPlan of a validated `test` section of a definition in `base_dir`."""
+    lw = _TestLowering(section, base_dir, sink)
+    errors = sink.error_count
+    plan = TestPlan(span=section.span, tests=lw.tests(), tolerances=lw.tolerances(),
+                    compare=lw.compare(), expected_mass=lw.expected_mass())
+    return None if sink.error_count > errors else plan

@@ -1,0 +1,46 @@
+"""The dynamics model of the checks against Pinocchio used directly (free-flyer root, so the
+root link counts), and continuous joints moved like revolute ones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from mpc.backends.urdf_reader import read
+from mpc.checks.dynamics_model import build
+from mpc.compiler.diagnostics import Sink
+from tests.backends.pin_compare import load
+from tests.conftest import ERD
+
+
+@pytest.mark.parametrize("model", ["talos_data/robots/talos_full_v2.urdf",
+                                   "solo_description/robots/solo12.urdf"])
+def test_mass_com_and_placements_are_pinocchios(model: str) -> None:
+    robot = read(ERD / model, Sink())
+    assert robot is not None
+    dyn = build(robot)
+    free = load(ERD / model)  # free-flyer root at the origin: the same placements
+    data = free.createData()
+    assert dyn.total_mass() == pytest.approx(pin.computeTotalMass(free), abs=1e-12)
+    q = dyn.configuration(dict.fromkeys(dyn.joint_names(), 0.3))
+    q_free = np.concatenate([[0, 0, 0, 0, 0, 0, 1], q])
+    np.testing.assert_allclose(dyn.com(q), pin.centerOfMass(free, data, q_free), atol=1e-12)
+    pin.framesForwardKinematics(free, data, q_free)
+    placements = dyn.link_placements(q)
+    for name, X in placements.items():
+        np.testing.assert_allclose(X, data.oMf[free.getFrameId(name, pin.FrameType.BODY)].homogeneous,
+                                   atol=1e-12, err_msg=name)
+    assert len(placements) == len(robot.links)
+
+
+def test_continuous_joints_move_like_revolute_ones() -> None:
+    folder = ERD / "double_pendulum_description/urdf"
+    continuous = build(read(folder / "double_pendulum_continuous.urdf", Sink()))
+    revolute = build(read(folder / "double_pendulum.urdf", Sink()))
+    assert continuous.model.nq == 4 and revolute.model.nq == 2
+    values = {"joint1": 0.5, "joint2": -1.2}
+    tau_c = continuous.gravity_torques(continuous.configuration(values))
+    tau_r = revolute.gravity_torques(revolute.configuration(values))
+    assert tau_c == pytest.approx(tau_r, abs=1e-12)
+    assert abs(tau_r["joint1"]) > 0.005  # not a trivial zero
