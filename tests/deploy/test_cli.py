@@ -38,8 +38,8 @@ def test_dry_run_then_deploy_with_a_pipeline(model: Model, server: Server, tmp_p
     lines = dry.stdout.splitlines()
     assert lines[0] == f"dry run: would push to branch 'master' of '{url}':"
     assert [line.split("|")[0].strip() for line in lines[1:-1]] == [
-        "README.md", "meshes/stl/tetra.stl", "old.txt", "urdf/arm.urdf"]
-    assert lines[-1].strip() == "4 files changed, 56 insertions(+), 1 deletion(-)"
+        "README.md", "meshes/stl/tetra.stl", "old.txt", "smurf/arm.smurf", "urdf/arm.urdf"]
+    assert lines[-1].strip() == "5 files changed, 60 insertions(+), 1 deletion(-)"
     assert server.log() == ["by hand"] and (tmp_path / ".mpc-deploy" / "arm-model" / ".git").is_dir()
 
     run = mpc("deploy", model.definition, "--built", model.built, "--pipeline", pipeline)
