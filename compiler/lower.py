@@ -41,6 +41,7 @@ from mpc.ir.program import (
     Export,
     Input,
     JointLimitsExport,
+    KccdExport,
     MjcfExport,
     PdfExport,
     Program,
@@ -285,6 +286,8 @@ class _Lowering:
                 out.extend(self.submodel(entry, written))
             else:
                 out.extend(self.export(entry, written, self.model.robotname))
+        # A joint_limits entry that lists a submodel's joints needs that submodel cut first.
+        out = [e for e in out if not _lists_a_submodel(e)] + [e for e in out if _lists_a_submodel(e)]
         out.extend(self.commands())
         package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
         if package is not None:
@@ -298,6 +301,8 @@ class _Lowering:
         in the submodel's folder, not where the package's `package://` paths point."""
         if inherited and getattr(entry, "ros_pathes", False):
             entry = entry.model_copy(update={"ros_pathes": False})
+        if entry.type == "kccd":
+            return self.kccd(entry, written, submodel)
         if entry.type in ("pdf", "joint_limits"):
             export = self.simple_export(entry)
             return [] if export is None else [replace(export, submodel=submodel)]
@@ -349,10 +354,21 @@ class _Lowering:
         for key, default in _SUBMODEL_LATER.items():
             if getattr(entry, key) != default:
                 self.not_yet(entry.key_span(key), f"submodel option '{key}'")
+        if entry.only_urdf:
+            self.sink.warning(entry.key_span("only_urdf"), "W0523", "'only_urdf' has no effect (Phobos "
+                              "stores it and never reads it)",
+                              hint="give the submodel an export_config with only urdf entries")
         cut = SubmodelExport(span=entry.span, name=entry.name, start=entry.start or "",
                              stop=tuple([entry.stop] if isinstance(entry.stop, str) else entry.stop or ()),
                              include_unstopped_branches=entry.include_unstopped_branches,
-                             add_floating_base=entry.add_floating_base)
+                             add_floating_base=entry.add_floating_base,
+                             remove_joints=_strings(entry.remove_joints), remove_fixed=entry.remove_fixed,
+                             abstract_model=entry.abstract_model, no_submechanisms=entry.no_submechanisms)
+        for pattern in cut.remove_joints:
+            problem = bad_pattern(pattern)
+            if problem:
+                self.sink.error(entry.value_span("remove_joints"), "E0305",
+                                f"'{pattern}' is not a regular expression: {problem}")
         folder = f"submodels/{entry.name}"
         if folder in written:
             self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write {folder}",
@@ -364,9 +380,10 @@ class _Lowering:
         if nested is None:
             nested = [e for e in self.model.export_config or () if e.type != "submodel"]
             if self.model.export_config is None:
-                out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name))
+                out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name,
+                                      filename=entry.filename or ""))
         for inner in nested:
-            out.extend(self.export(inner, written, entry.name, submodel=entry.name,
+            out.extend(self.export(inner, written, entry.filename or entry.name, submodel=entry.name,
                                    inherited=entry.export_config is None))
         return out
 
@@ -423,11 +440,70 @@ class _Lowering:
         joints = tuple(entry.joints)
         from mpc.backends.joint_limits import SELECTIONS
 
-        if len(joints) == 1 and joints[0].isupper() and joints[0] not in SELECTIONS:
-            what = "submodel joint lists" if joints[0] != "ABSTRACT" else "ABSTRACT (the abstract model)"
-            self.not_yet(entry.value_span("joints"), f"joints: {joints[0]} — {what}")
+        # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
+        submodels = {e.name for e in self.model.export_config or () if e.type == "submodel"}
+        as_string = isinstance(entry._doc.data_at((*entry._path, "joints")), str)
+        if len(joints) == 1 and as_string and joints[0] in submodels:
+            return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
+        if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:
+            self.sink.error(entry.value_span("joints"), "E0524", f"joints: '{joints[0]}' is none of "
+                            f"{', '.join(SELECTIONS)} and names no submodel of this export_config"
+                            f"{did_you_mean(joints[0], set(SELECTIONS) | submodels)}")
             return None
         return JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name)
+
+    def kccd(self, entry: Any, written: dict[str, Export], submodel: str) -> list[Export]:
+        """A `kccd` entry: its numbers evaluated and its per-link settings checked; the names
+        it gives are checked against the robot when it is written (backends/kccd.py)."""
+        target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.dirname}"
+        if target in written:
+            self.sink.error(entry.span, "E0503", f"two kccd exports would write {target}/",
+                            notes=((written[target].span, "the other export"),))
+            return []
+        numbers = {key: self.num(entry, key, f"kccd {key}")
+                   for key in ("safety_distance", "report_up_to", "computation_budget")}
+        budget = numbers["computation_budget"]
+        faces, ratio = 0, 0.0
+        reduce = self.num(entry, "reduce_meshes", "kccd reduce_meshes") if entry.reduce_meshes else 0.0
+        if reduce is not None and 0 < reduce < 1:
+            ratio = reduce
+        elif reduce is not None and reduce >= 4 and float(reduce).is_integer():
+            faces = int(reduce)
+        elif reduce not in (None, 0):
+            self.sink.error(entry.value_span("reduce_meshes"), "E0521", "kccd 'reduce_meshes' is the "
+                            "fraction of each hull's faces to remove (between 0 and 1, as in Phobos) or a "
+                            f"number of faces to keep (4 or more), got {reduce:g}")
+        n_points: dict[str, int] = {}
+        shapes: dict[str, str] = {}
+        for link, settings in entry.edit_collisions.items():
+            for key, value in settings.items():
+                if key == "n_points" and isinstance(value, int) and value >= 1:
+                    n_points[link] = value
+                elif key == "shape" and value in KCCD_SHAPES:
+                    shapes[link] = str(value)
+                else:
+                    span = entry._doc.value_span((*entry._path, "edit_collisions", link, key))
+                    self.sink.error(span, "E0521", f"kccd edit_collisions of '{link}': '{key}: {value}' is "
+                                    "neither n_points (a whole number, 1 or more) nor shape "
+                                    f"({', '.join(KCCD_SHAPES)})")
+        braking: tuple[float, ...] = ()
+        if entry.braking_model is not None:
+            b = entry.braking_model
+            values = [self.num(b, key, f"braking_model {key}")
+                      for key in ("linearFactor", "invDeceleration", "uncertainty", "latency")]
+            braking = tuple(v if v is not None else 0.0 for v in values)
+        written[target] = export = KccdExport(
+            span=entry.span, dirname=entry.dirname, join_before_convexhull=entry.join_before_convexhull,
+            remove_joints=tuple(entry.remove_joints), merge_additionally=tuple(entry.merge_additionally),
+            keep_stls=entry.keep_stls, keep_urdf=entry.keep_urdf, reduce_faces=faces, reduce_ratio=ratio,
+            n_points=n_points, shapes=shapes, braking_model=braking,
+            simplify_swept_from=tuple(entry.simplify_swept_from),
+            safety_distance=numbers["safety_distance"] or 0.0, report_up_to=numbers["report_up_to"] or 0.0,
+            computation_budget=-1.0 if budget is None else budget,
+            max_approximation_order=entry.max_approximation_order,
+            no_collision_between={k: tuple(v) for k, v in entry.no_collision_between.items()},
+            submodel=submodel)
+        return [export]
 
     def program(self) -> Program:
         """The program, also after errors (values that failed are None), so that the names
@@ -456,9 +532,9 @@ _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
-    "no_submechanisms": False, "abstract_model": False, "include_human_in_abstract": False,
-    "remove_fixed": False, "remove_joints": [], "remove_links": [], "move_joint_axis_to_intersection": {},
-    "name_replacements": {}, "filename": None, "only_urdf": False}
+    "include_human_in_abstract": False, "remove_links": [], "move_joint_axis_to_intersection": {},
+    "name_replacements": {}}
+KCCD_SHAPES = ("box", "cylinder", "sphere", "convex")
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
@@ -466,6 +542,15 @@ _KINEMATIC_LATER: dict[str, Any] = {
     "float_fmt_dict": None,
 }
 
+
+
+def _lists_a_submodel(export: Export) -> bool:
+    return isinstance(export, JointLimitsExport) and bool(export.joints_of)
+
+
+def _strings(value: str | list[str] | None) -> tuple[str, ...]:
+    """A `OneOrMore` value as a tuple."""
+    return (value,) if isinstance(value, str) else tuple(value or ())
 
 
 def _item_span(node: Node, key: str, i: int) -> Span:

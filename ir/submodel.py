@@ -1,4 +1,5 @@
-"""The part of a robot that a `submodel` export writes: from `start` down to the `stop` links."""
+"""The part of a robot that a `submodel` export writes: from `start` down to the `stop` links,
+then without the joints it merges away (remove_joints, remove_fixed, abstract_model)."""
 
 from __future__ import annotations
 
@@ -47,4 +48,43 @@ def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
             kept -= names.subtree(stop) - {stop}
         if not export.include_unstopped_branches:
             kept = {start} | {j.child for stop in stops for j in joints_up(robot, stop) if j.child in below}
-    return replace(keep_links(robot, kept, start), name=export.name)
+    part = replace(keep_links(robot, kept, start), name=export.name)
+    if export.no_submechanisms:
+        part = replace(part, submechanisms=())
+    return _merged(part, export, sink)
+
+
+def _merged(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
+    """The submodel after remove_joints, remove_fixed and abstract_model (ir/merge.py)."""
+    from mpc.ir.merge import merge_joints
+
+    gone: set[str] = set()
+    for pattern in export.remove_joints:
+        found = _stops(pattern, set(part.joints))
+        if not found:
+            sink.error(export.span, "E0310", f"submodel '{export.name}': remove_joints '{pattern}' names "
+                       f"no joint of the submodel{did_you_mean(pattern, set(part.joints))}")
+            return None
+        gone |= found
+    if export.remove_fixed:
+        gone |= {n for n, j in part.joints.items() if j.type == "fixed"}
+    if export.abstract_model:
+        if not part.submechanisms:
+            sink.warning(export.span, "W0522", f"submodel '{export.name}': abstract_model needs "
+                         "submechanisms; the submodel has none, so it keeps its joints (as Phobos does)")
+        else:
+            gone |= set(part.joints) - abstract_joints(part)
+    merged = merge_joints(part, gone, sink, export.span)
+    if merged is not None and export.abstract_model and part.submechanisms:
+        merged = replace(merged, submechanisms=())  # the abstract model's tree is serial
+    return merged
+
+
+def abstract_joints(robot: Robot) -> set[str]:
+    """The joints of the abstract model (Phobos's meaning): the fixed ones, the
+    submechanisms' independent joints and the exoskeletons' dependent ones."""
+    kept = {n for n, j in robot.joints.items() if j.type == "fixed"}
+    for sm in robot.submechanisms:
+        key = "jointnames_dependent" if sm.exoskeleton else "jointnames_independent"
+        kept |= {str(j) for j in sm.definition.get(key, ())}
+    return kept & set(robot.joints)
