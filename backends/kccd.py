@@ -83,7 +83,7 @@ def emit(robot: Robot, export: KccdExport, out: Path, sink: Sink) -> None:
     folder = out / export.dirname
     urdf = folder / f"{model.name}.urdf"
     write_path(urdf, to_string(kccd_urdf(model, kept), lambda m: "../" + m.source.uri))
-    settings = settings_of(model, kept, hulls, export)
+    settings = settings_of(model, bodies, hulls, export)
     write_path(folder / f"{model.name}_kccd.yml", json.dumps(settings, indent=2, sort_keys=True) + "\n")
     run_tools(folder, model.name, settings, export, [out / b.mesh for b in kept], sink)
 
@@ -185,10 +185,26 @@ def hull_of(robot: Robot, body: Body, export: KccdExport, sink: Sink) -> Any:
     if export.reduce_ratio:
         target = math.ceil((1 - export.reduce_ratio) * faces)
     if 4 <= target < faces:
-        mesh = mesh.simplify_quadric_decimation(face_count=target)
-        if export.join_before_convexhull:
-            mesh = mesh.convex_hull  # decimation can dent a hull; the hull of what is left cannot
+        mesh = _fewer_faces(mesh, target) if export.join_before_convexhull \
+            else mesh.simplify_quadric_decimation(face_count=target)
     return mesh
+
+
+def _fewer_faces(hull: Any, faces: int) -> Any:
+    """A convex hull with at most `faces` faces: the hull of faces/2 + 2 of its vertices
+    (a closed convex mesh has at most 2·V − 4 faces), taken farthest-first from the vertex
+    farthest from the centre. Quadric decimation, Phobos's way, neither keeps a hull convex
+    nor gets a hull's slivers below a few hundred faces."""
+    points = np.asarray(hull.vertices)
+    count = min(faces // 2 + 2, len(points))
+    chosen = [int(np.argmax(np.linalg.norm(points - points.mean(axis=0), axis=1)))]
+    distance = np.linalg.norm(points - points[chosen[0]], axis=1)
+    while len(chosen) < count:
+        chosen.append(int(np.argmax(distance)))
+        distance = np.minimum(distance, np.linalg.norm(points - points[chosen[-1]], axis=1))
+    import trimesh
+
+    return trimesh.convex.convex_hull(points[chosen])
 
 
 def kccd_urdf(robot: Robot, bodies: list[Body]) -> Robot:
@@ -214,14 +230,15 @@ _BARE: dict[str, Any] = {"extras": (), "comments": (), "inner_comments": ()}
 
 def settings_of(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
                 export: KccdExport) -> dict[str, Any]:
-    """The KCCD settings file's content (see the module docstring)."""
+    """The KCCD settings file's content (see the module docstring); bodies without a hull
+    (no shapes) are left out."""
     out: dict[str, Any] = {
         "robot": robot.name, "urdf": f"{robot.name}.urdf",
         "safety_distance": _number(export.safety_distance), "report_up_to": _number(export.report_up_to),
         "computation_budget": _number(export.computation_budget),
         "max_approximation_order": export.max_approximation_order,
         "bodies": [{"link": b.link, "links": list(b.links), "mesh": f"../{b.mesh}",
-                    "n_points": n_points(robot, b.link, export)} for b in bodies],
+                    "n_points": n_points(robot, b.link, export)} for b in bodies if b.link in hulls],
         "dont_check": [list(pair) for pair in dont_check(robot, bodies, hulls, export)],
     }
     if export.braking_model:
@@ -272,7 +289,7 @@ def dont_check(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
     pairs: set[tuple[str, str]] = set()
 
     def add(a: str, b: str) -> None:
-        if a != b:
+        if a != b and a in hulls and b in hulls:
             pairs.add((min(a, b), max(a, b)))
 
     for b in bodies:
