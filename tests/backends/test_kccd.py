@@ -38,7 +38,8 @@ def build(tmp_path: Path, entries: str, diags: Diags, robot: str = "ur5") -> Pat
 
 
 def hulls(out: Path) -> dict[str, trimesh.Trimesh]:
-    return {p.stem.removeprefix("collision_"): trimesh.load(p) for p in sorted((out / "meshes/iv").glob("*.stl"))}
+    files = sorted((out / "meshes/iv").glob("*.stl"))
+    return {p.stem.removeprefix("collision_"): trimesh.load(p) for p in files}
 
 
 def inside(hull: trimesh.Trimesh, points: np.ndarray) -> bool:
@@ -191,7 +192,8 @@ model:
   "urdf": "arm.urdf"
 }
 """
-    assert sorted(p.name for p in (out / "meshes/iv").iterdir()) == ["collision_base.stl", "collision_upper.stl"]
+    assert sorted(p.name for p in (out / "meshes/iv").iterdir()) == ["collision_base.stl",
+                                                                      "collision_upper.stl"]
     box = trimesh.load(out / "meshes/iv/collision_upper.stl")
     assert np.allclose(box.bounds, [[-0.025, -0.025, -0.2], [0.025, 0.025, 0.2]])
 
