@@ -105,10 +105,16 @@ def _names(export: KccdExport, key: str, names: tuple[str, ...], robot: Robot, s
     for name in names:
         if name not in robot.joints:
             hint = f"give the joint above it, '{above[name]}'" if name in above else None
-            sink.error(export.span, "E0522", f"kccd {key} names '{name}', which is not a joint of the "
-                       f"model{'' if hint else did_you_mean(name, set(robot.joints))}", hint=hint)
+            sink.error(export.span, "E0522", f"{_kccd(export)} {key} names '{name}', which is not a "
+                       f"joint of the model{'' if hint else did_you_mean(name, set(robot.joints))}",
+                       hint=hint)
             ok = False
     return ok
+
+
+def _kccd(export: KccdExport) -> str:
+    """How messages name the export: `kccd`, or `kccd of submodel 'x'`."""
+    return f"kccd of submodel '{export.submodel}'" if export.submodel else "kccd"
 
 
 def bodies_of(robot: Robot, export: KccdExport) -> list[Body]:
@@ -142,8 +148,8 @@ def _check_links(robot: Robot, bodies: list[Body], export: KccdExport, sink: Sin
         known = body_links if needs_body else set(robot.links)
         if name not in known:
             what = "a body (a link whose parent joint is movable)" if needs_body else "a link"
-            sink.error(export.span, "E0522", f"kccd {key} names '{name}', which is not {what} of the "
-                       f"KCCD model{did_you_mean(name, known)}")
+            sink.error(export.span, "E0522", f"{_kccd(export)} {key} names '{name}', which is not "
+                       f"{what} of the KCCD model{did_you_mean(name, known)}")
             ok = False
 
     for link in export.simplify_swept_from:

@@ -302,9 +302,16 @@ class _Lowering:
         if inherited and getattr(entry, "ros_pathes", False):
             entry = entry.model_copy(update={"ros_pathes": False})
         if entry.type == "kccd":
-            return self.kccd(entry, written, submodel)
+            if not inherited:
+                return self.kccd(entry, written, submodel)
+            sink, self.sink = self.sink, Sink()  # the model's own use of the entry reported
+            try:
+                lowered = self.kccd(entry, written, submodel)
+                return [] if self.sink.has_errors() else lowered
+            finally:
+                self.sink = sink
         if entry.type in ("pdf", "joint_limits"):
-            export = self.simple_export(entry)
+            export = self.simple_export(entry, inherited)
             return [] if export is None else [replace(export, submodel=submodel)]
         if entry.type not in BUILT_EXPORTS:
             self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
@@ -331,7 +338,7 @@ class _Lowering:
             mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
         export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                            add_floating_base=entry.add_floating_base, submodel=submodel,
-                                           filename=filename if filename != robotname else "")
+                                           filename=filename if filename != (submodel or robotname) else "")
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
@@ -433,8 +440,9 @@ class _Lowering:
         return RosPackageExport(span=m.span, package=package, version=version,
                                 description=m.description or "", license=m.license or "")
 
-    def simple_export(self, entry: Any) -> Export | None:
-        """The pdf and joint_limits entries (no meshes, no kinematic options)."""
+    def simple_export(self, entry: Any, inherited: bool = False) -> Export | None:
+        """The pdf and joint_limits entries (no meshes, no kinematic options). An entry a
+        submodel inherits reports nothing: the model's own use of it did."""
         if entry.type == "pdf":
             return PdfExport(span=entry.span)
         joints = tuple(entry.joints)
@@ -446,6 +454,8 @@ class _Lowering:
         if len(joints) == 1 and as_string and joints[0] in submodels:
             return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
         if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:
+            if inherited:
+                return None
             self.sink.error(entry.value_span("joints"), "E0524", f"joints: '{joints[0]}' is none of "
                             f"{', '.join(SELECTIONS)} and names no submodel of this export_config"
                             f"{did_you_mean(joints[0], set(SELECTIONS) | submodels)}")

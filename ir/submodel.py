@@ -8,6 +8,7 @@ from dataclasses import replace
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.names import Names
+from mpc.ir.ops import CompleteSubmechanisms, Effects
 from mpc.ir.ops.assembly import keep_links
 from mpc.ir.program import SubmodelExport
 from mpc.ir.robot import Robot
@@ -76,7 +77,9 @@ def _merged(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
             gone |= set(part.joints) - abstract_joints(part)
     merged = merge_joints(part, gone, sink, export.span)
     if merged is not None and export.abstract_model and part.submechanisms:
-        merged = replace(merged, submechanisms=())  # the abstract model's tree is serial
+        # The abstract model's tree is serial: its submechanisms are made anew, as Phobos does.
+        op = CompleteSubmechanisms(span=export.span)
+        merged = op.apply(replace(merged, submechanisms=()), Effects(sink, op))
     return merged
 
 

@@ -1,0 +1,159 @@
+"""Submodel options that merge joints (remove_fixed, remove_joints, abstract_model), filename,
+and the joint_limits selections ABSTRACT and `<submodel name>`, on TALOS with Pinocchio."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from mpc.compiler.diagnostics import Severity
+from tests.backends.test_submodel import HEAD
+from tests.conftest import Diags, compile_file, write
+
+GRIPPER = ["gripper_left_joint", "gripper_left_inner_double_joint", "gripper_left_fingertip_1_joint",
+           "gripper_left_fingertip_2_joint", "gripper_left_motor_single_joint",
+           "gripper_left_inner_single_joint", "gripper_left_fingertip_3_joint"]
+# The left gripper as HyRoDyn sees it: one closed mechanism, driven by gripper_left_joint,
+# which the six mimic joints follow.
+SUBMECHANISMS = f"""
+  submechanisms:
+    - name: gripper_left
+      type: 1R
+      contextual_name: gripper_left
+      jointnames_spanningtree: {GRIPPER}
+      jointnames_independent: [gripper_left_joint]
+      jointnames_active: [gripper_left_joint]
+"""
+
+
+def centroidal(urdf: Path) -> tuple[float, np.ndarray, np.ndarray]:
+    """Total mass, COM and centroidal inertia (about the COM) at q = 0 with Pinocchio."""
+    model = pin.buildModelFromUrdf(str(urdf))
+    data = model.createData()
+    q = pin.neutral(model)
+    pin.ccrba(model, data, q, np.zeros(model.nv))
+    return pin.computeTotalMass(model), pin.centerOfMass(model, data, q), data.Ig.inertia.copy()
+
+
+def joints_of(urdf: Path) -> dict[str, str]:
+    from lxml import etree
+
+    return {j.get("name"): j.get("type") for j in etree.parse(str(urdf)).getroot().iterfind("joint")}
+
+
+def test_remove_fixed_keeps_every_joint_body(tmp_path: Path, diags: Diags) -> None:
+    """The left arm with remove_fixed: no fixed joint is left, the links they carried are
+    gone, and each movable joint's body has the mass, COM and inertia Pinocchio gives it in
+    the whole robot (where it merges fixed links itself)."""
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: urdf}
+    - {type: submodel, name: arm, start: arm_left_1_link, remove_fixed: true}
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    urdf = out / "submodels/arm/urdf/arm.urdf"
+    assert "fixed" not in joints_of(urdf).values()
+    whole = pin.buildModelFromUrdf(str(out / "urdf/talos.urdf"))
+    arm = pin.buildModelFromUrdf(str(urdf))
+    assert {f.name for f in arm.frames if f.type == pin.FrameType.FIXED_JOINT} == {"universe"}
+    assert "gripper_left_base_link" not in {f.name for f in arm.frames}
+    for jid in range(1, arm.njoints):
+        theirs = whole.inertias[whole.getJointId(arm.names[jid])]
+        ours = arm.inertias[jid]
+        assert np.isclose(ours.mass, theirs.mass, rtol=0, atol=1e-12), arm.names[jid]
+        assert np.allclose(ours.lever, theirs.lever, atol=1e-12), arm.names[jid]
+        assert np.allclose(ours.inertia, theirs.inertia, atol=1e-12), arm.names[jid]
+
+
+def test_abstract_model_keeps_the_independent_joints(tmp_path: Path, diags: Diags) -> None:
+    """abstract_model on TALOS with the left gripper as a submechanism: the six mimic joints
+    merge away, every other joint stays; mass, COM and centroidal inertia at q = 0 are the
+    whole robot's. joint_limits ABSTRACT lists the same movable joints."""
+    spec = write(tmp_path / "m.yml", HEAD + SUBMECHANISMS + """
+  export_config:
+    - {type: urdf}
+    - {type: joint_limits, joints: ABSTRACT, file_name: abstract_limits.yml}
+    - {type: submodel, name: abstract, abstract_model: true}
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    diags.take("W0500", Severity.WARNING)  # the submechanisms, in the model's URDF
+    diags.take("W0500", Severity.WARNING)  # and in the abstract model's (serial chains, made anew)
+    whole, abstract = out / "urdf/talos.urdf", out / "submodels/abstract/urdf/abstract.urdf"
+    assert set(joints_of(whole)) - set(joints_of(abstract)) == set(GRIPPER[1:])
+    (m1, c1, I1), (m2, c2, I2) = centroidal(whole), centroidal(abstract)
+    assert np.isclose(m1, m2, rtol=0, atol=1e-12)
+    assert np.allclose(c1, c2, atol=1e-12)
+    assert np.allclose(I1, I2, atol=1e-10)
+    movable = [n for n, t in joints_of(abstract).items() if t != "fixed"]
+    listed = json.loads((out / "abstract_limits.yml").read_text())["limits"]["names"]
+    assert sorted(listed) == sorted(movable)
+    assert "gripper_left_joint" in listed and "gripper_left_fingertip_1_joint" not in listed
+    # The abstract model (which inherits the entry) is its own abstract model.
+    again = json.loads((out / "submodels/abstract/abstract_limits.yml").read_text())["limits"]["names"]
+    assert again == listed
+
+
+def test_abstract_model_without_submechanisms(tmp_path: Path, diags: Diags) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: submodel, name: abstract, abstract_model: true, export_config: [{type: urdf}]}
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    d = diags.take("W0522", Severity.WARNING)
+    assert d.message == "submodel 'abstract': abstract_model needs submechanisms; the submodel has none, " \
+                        "so it keeps its joints (as Phobos does)"
+    assert "gripper_left_fingertip_1_joint" in joints_of(out / "submodels/abstract/urdf/abstract.urdf")
+
+
+def test_remove_joints_by_pattern_and_the_limits_of_a_submodel(tmp_path: Path, diags: Diags) -> None:
+    """remove_joints takes regular expressions; `joints: <submodel>` in the model's export_config
+    lists that submodel's movable joints, in the model's folder; `filename` names the files."""
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: joint_limits, joints: left_arm, file_name: left_arm_limits.yml}
+    - type: submodel
+      name: left_arm
+      filename: arm_only
+      start: arm_left_1_link
+      remove_joints: ["gripper_left_.*_joint", arm_left_7_joint]
+      export_config: [{type: urdf}]
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    urdf = out / "submodels/left_arm/urdf/arm_only.urdf"
+    kept = [n for n, t in joints_of(urdf).items() if t != "fixed"]
+    expected = [f"arm_left_{i}_joint" for i in range(2, 7)] + ["gripper_left_joint"]
+    assert sorted(kept) == sorted(expected)
+    listed = json.loads((out / "left_arm_limits.yml").read_text())["limits"]["names"]
+    assert listed == expected
+    assert not (out / "submodels/left_arm/joint_limits.yml").exists()
+
+
+def test_a_pattern_that_names_no_joint(tmp_path: Path, diags: Diags) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: submodel, name: arm, start: arm_left_1_link, remove_joints: [arm_left_8_joint]}
+""")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    assert diags.take_error("E0310").message == (
+        "submodel 'arm': remove_joints 'arm_left_8_joint' names no joint of the submodel; did you mean "
+        "'arm_left_7_joint'?")
+
+
+def test_only_urdf_has_no_effect(tmp_path: Path, diags: Diags) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: submodel, name: arm, start: arm_left_1_link, only_urdf: true, export_config: [{type: pdf}]}
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    d = diags.take("W0523", Severity.WARNING)
+    assert (d.message, d.hint) == ("'only_urdf' has no effect (Phobos stores it and never reads it)",
+                                   "give the submodel an export_config with only urdf entries")
+    assert (out / "submodels/arm/arm.pdf.gv").is_file()
