@@ -370,12 +370,23 @@ class _Lowering:
                              include_unstopped_branches=entry.include_unstopped_branches,
                              add_floating_base=entry.add_floating_base,
                              remove_joints=_strings(entry.remove_joints), remove_fixed=entry.remove_fixed,
-                             abstract_model=entry.abstract_model, no_submechanisms=entry.no_submechanisms)
-        for pattern in cut.remove_joints:
-            problem = bad_pattern(pattern)
-            if problem:
-                self.sink.error(entry.value_span("remove_joints"), "E0305",
-                                f"'{pattern}' is not a regular expression: {problem}")
+                             abstract_model=entry.abstract_model, no_submechanisms=entry.no_submechanisms,
+                             name_replacements=tuple(entry.name_replacements.items()))
+        for key, patterns in (("remove_joints", cut.remove_joints),
+                              ("name_replacements", entry.name_replacements)):
+            for pattern in patterns:
+                problem = bad_pattern(pattern)
+                if problem:
+                    self.sink.error(entry.value_span(key), "E0305",
+                                    f"'{pattern}' is not a regular expression: {problem}")
+        moves = {}
+        for joint, pair in entry.move_joint_axis_to_intersection.items():
+            if len(pair) != 2:
+                span = entry._doc.value_span((*entry._path, "move_joint_axis_to_intersection", joint))
+                self.sink.error(span, "E0526", f"move_joint_axis_to_intersection of '{joint}' names "
+                                f"{len(pair)} joint{'' if len(pair) == 1 else 's'}; it takes the two whose axes meet")
+            moves[joint] = tuple(pair)
+        cut = replace(cut, move_joint_axis_to_intersection=moves)
         folder = f"submodels/{entry.name}"
         if folder in written:
             self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write {folder}",
@@ -542,8 +553,7 @@ _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
-    "include_human_in_abstract": False, "remove_links": [], "move_joint_axis_to_intersection": {},
-    "name_replacements": {}}
+    "include_human_in_abstract": False, "remove_links": []}
 KCCD_SHAPES = ("box", "cylinder", "sphere", "convex")
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).

@@ -139,7 +139,9 @@ class SubmodelExport:
     child links merge into their parents (ir/merge.py); remove_fixed: every fixed joint too.
     abstract_model: keep only the fixed joints and the submechanisms' independent ones (and
     the exoskeletons' dependent ones), merging the rest; the submechanisms go.
-    no_submechanisms: the submodel has none.
+    no_submechanisms: the submodel has none. move_joint_axis_to_intersection: joint → the
+    two joints whose axes' meeting point its frame moves to. name_replacements: (pattern,
+    replacement) applied to every name last, after the merges.
     """
 
     span: Span
@@ -152,6 +154,8 @@ class SubmodelExport:
     remove_fixed: bool = False
     abstract_model: bool = False
     no_submechanisms: bool = False
+    move_joint_axis_to_intersection: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    name_replacements: tuple[tuple[str, str], ...] = ()
     type: Literal["submodel"] = "submodel"
 
 

@@ -52,7 +52,45 @@ def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
     part = replace(keep_links(robot, kept, start), name=export.name)
     if export.no_submechanisms:
         part = replace(part, submechanisms=())
-    return _merged(part, export, sink)
+    merged = _merged(part, export, sink)
+    if merged is not None:
+        merged = _moved_axes(merged, export, sink)
+    if merged is not None and export.name_replacements:
+        merged = _renamed(merged, export, sink)
+    return merged
+
+
+def _moved_axes(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
+    """move_joint_axis_to_intersection, joint by joint (ir/ops/joints.py)."""
+    from mpc.ir.ops.joints import MoveJointAxisToIntersection
+
+    for joint, (a, b) in export.move_joint_axis_to_intersection.items():
+        for name in (joint, a, b):
+            if name not in part.joints:
+                sink.error(export.span, "E0310", f"submodel '{export.name}': move_joint_axis_to_intersection "
+                           f"names '{name}', which is not a joint of the submodel"
+                           f"{did_you_mean(name, set(part.joints))}")
+                return None
+        op = MoveJointAxisToIntersection(span=export.span, joint=joint, a=a, b=b)
+        before = len(sink.diagnostics)
+        part = op.apply(part, Effects(sink, op))
+        if sink.has_errors() and len(sink.diagnostics) > before:
+            return None
+    return part
+
+
+def _renamed(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
+    """name_replacements on every name (name editing's rules, ir/naming.py); E0302 when two
+    links or two joints would get one name."""
+    from mpc.ir.naming import NameRule
+    from mpc.ir.ops import EditNames
+
+    op = EditNames(span=export.span, rules=(NameRule(replacements=export.name_replacements),))
+    before = len(sink.diagnostics)
+    op.effect(Names.of(part), Effects(sink, op))
+    if len(sink.diagnostics) > before:
+        return None
+    return replace(op.apply(part, Effects(sink, op)), name=export.name)
 
 
 def _merged(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:

@@ -157,3 +157,80 @@ def test_only_urdf_has_no_effect(tmp_path: Path, diags: Diags) -> None:
     assert (d.message, d.hint) == ("'only_urdf' has no effect (Phobos stores it and never reads it)",
                                    "give the submodel an export_config with only urdf entries")
     assert (out / "submodels/arm/arm.pdf.gv").is_file()
+
+
+def test_name_replacements_rename_the_submodel(tmp_path: Path, diags: Diags) -> None:
+    """name_replacements (regular expressions) rename every name of the submodel, after the
+    merges; the arm is the same arm under its new names."""
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: urdf}
+    - type: submodel
+      name: arm
+      start: arm_left_1_link
+      name_replacements: {"_left_": "_"}
+      export_config: [{type: urdf}, {type: joint_limits}]
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    arm = pin.buildModelFromUrdf(str(out / "submodels/arm/urdf/arm.urdf"))
+    assert list(arm.names)[1:7] == [f"arm_{i}_joint" for i in range(2, 8)]
+    whole = pin.buildModelFromUrdf(str(out / "urdf/talos.urdf"))
+    for i in range(2, 8):
+        theirs = whole.inertias[whole.getJointId(f"arm_left_{i}_joint")]
+        ours = arm.inertias[arm.getJointId(f"arm_{i}_joint")]
+        assert np.isclose(ours.mass, theirs.mass, rtol=0, atol=1e-12)
+    assert "arm_left" not in (out / "submodels/arm/joint_limits.yml").read_text()
+
+
+def test_name_replacements_that_merge_two_names(tmp_path: Path, diags: Diags) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: submodel, name: arm, start: arm_left_6_link, name_replacements: {"_[67]_": "_"}}
+""")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    assert diags.take_error("E0302").message == \
+        "name editing gives two links the name 'arm_left_link' ('arm_left_6_link' and 'arm_left_7_link')"
+
+
+def test_move_joint_axis_to_intersection(tmp_path: Path, diags: Diags) -> None:
+    """arm_left_1_joint's frame (0.232 m off torso_2_joint's axis) moves to where the axes of
+    torso_2_joint and arm_left_1_joint meet; the link's body stays where it was (Pinocchio,
+    q = 0)."""
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - {type: urdf}
+    - type: submodel
+      name: arm
+      start: torso_1_link
+      stop: arm_left_2_link
+      move_joint_axis_to_intersection: {arm_left_1_joint: [torso_2_joint, arm_left_1_joint]}
+      export_config: [{type: urdf}]
+""")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    arm = pin.buildModelFromUrdf(str(out / "submodels/arm/urdf/arm.urdf"))
+    whole = pin.buildModelFromUrdf(str(out / "urdf/talos.urdf"))
+
+    def placed(model: pin.Model) -> tuple[pin.Data, pin.SE3]:
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, pin.neutral(model))
+        return data, data.oMf[model.getFrameId("torso_1_link")]
+
+    def axis_line(model: pin.Model, data: pin.Data, base: pin.SE3, joint: str) -> tuple[np.ndarray, ...]:
+        i = model.getJointId(joint)
+        X = base.actInv(data.oMi[i])
+        return X.translation, X.rotation[:, "XYZ".index(model.joints[i].extract().shortname()[-1])]
+
+    (da, ba), (dw, bw) = placed(arm), placed(whole)
+    (p2, d2), (p1, _) = axis_line(arm, da, ba, "torso_2_joint"), axis_line(arm, da, ba, "arm_left_1_joint")
+    (q2, e2) = axis_line(whole, dw, bw, "torso_2_joint")
+    (q1, _) = axis_line(whole, dw, bw, "arm_left_1_joint")
+    assert np.linalg.norm(np.cross(q1 - q2, e2)) > 0.2  # off the axis in the whole robot
+    assert np.linalg.norm(np.cross(p1 - p2, d2)) < 1e-9  # on it in the submodel
+
+    def com(model: pin.Model, data: pin.Data, base: pin.SE3) -> np.ndarray:
+        i = model.getJointId("arm_left_1_joint")
+        return base.actInv(data.oMi[i]).act(model.inertias[i].lever)
+
+    assert np.allclose(com(arm, da, ba), com(whole, dw, bw), atol=1e-12)
