@@ -383,8 +383,9 @@ class _Lowering:
         for joint, pair in entry.move_joint_axis_to_intersection.items():
             if len(pair) != 2:
                 span = entry._doc.value_span((*entry._path, "move_joint_axis_to_intersection", joint))
+                count = f"{len(pair)} joint{'' if len(pair) == 1 else 's'}"
                 self.sink.error(span, "E0526", f"move_joint_axis_to_intersection of '{joint}' names "
-                                f"{len(pair)} joint{'' if len(pair) == 1 else 's'}; it takes the two whose axes meet")
+                                f"{count}; it takes the two whose axes meet")
             moves[joint] = tuple(pair)
         cut = replace(cut, move_joint_axis_to_intersection=moves)
         folder = f"submodels/{entry.name}"
