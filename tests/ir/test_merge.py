@@ -11,7 +11,7 @@ from mpc.backends.urdf_reader import read
 from mpc.compiler.diagnostics import Severity
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.merge import merge_joints
-from mpc.ir.robot import Pose
+from mpc.ir.robot import Pose, Robot
 from mpc.ir.span import Span
 from tests.conftest import Diags
 from tests.fixtures import arm
@@ -19,7 +19,7 @@ from tests.fixtures import arm
 SPAN = Span("m.yml", 1, 1, 1, 2)
 
 
-def arm_with_extras(tmp_path: Path, diags: Diags):
+def arm_with_extras(tmp_path: Path, diags: Diags) -> Robot:
     robot = read(arm(tmp_path), diags)
     assert robot is not None
     return replace(
