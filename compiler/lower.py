@@ -477,6 +477,11 @@ class _Lowering:
     def kccd(self, entry: Any, written: dict[str, Export], submodel: str) -> list[Export]:
         """A `kccd` entry: its numbers evaluated and its per-link settings checked; the names
         it gives are checked against the robot when it is written (backends/kccd.py)."""
+        parts = Path(entry.dirname).parts
+        if not parts or Path(entry.dirname).is_absolute() or ".." in parts:
+            self.sink.error(entry.value_span("dirname"), "E0521", f"kccd 'dirname' is a folder inside the "
+                            f"output, got '{entry.dirname}'")
+            return []
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.dirname}"
         if target in written:
             self.sink.error(entry.span, "E0503", f"two kccd exports would write {target}/",
