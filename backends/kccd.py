@@ -82,7 +82,8 @@ def emit(robot: Robot, export: KccdExport, out: Path, sink: Sink) -> None:
     kept = [b for b in bodies if b.link in hulls]
     folder = out / export.dirname
     urdf = folder / f"{model.name}.urdf"
-    write_path(urdf, to_string(kccd_urdf(model, kept), lambda m: "../" + m.source.uri))
+    up = "../" * len(Path(export.dirname).parts)  # from the KCCD folder to the output's
+    write_path(urdf, to_string(kccd_urdf(model, kept), lambda m: up + m.source.uri))
     settings = settings_of(model, bodies, hulls, export)
     write_path(folder / f"{model.name}_kccd.yml", json.dumps(settings, indent=2, sort_keys=True) + "\n")
     run_tools(folder, model.name, settings, export, [out / b.mesh for b in kept], sink)
@@ -238,12 +239,13 @@ def settings_of(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
                 export: KccdExport) -> dict[str, Any]:
     """The KCCD settings file's content (see the module docstring); bodies without a hull
     (no shapes) are left out."""
+    up = "../" * len(Path(export.dirname).parts)
     out: dict[str, Any] = {
         "robot": robot.name, "urdf": f"{robot.name}.urdf",
         "safety_distance": _number(export.safety_distance), "report_up_to": _number(export.report_up_to),
         "computation_budget": _number(export.computation_budget),
         "max_approximation_order": export.max_approximation_order,
-        "bodies": [{"link": b.link, "links": list(b.links), "mesh": f"../{b.mesh}",
+        "bodies": [{"link": b.link, "links": list(b.links), "mesh": up + b.mesh,
                     "n_points": n_points(robot, b.link, export)} for b in bodies if b.link in hulls],
         "dont_check": [list(pair) for pair in dont_check(robot, bodies, hulls, export)],
     }

@@ -25,15 +25,15 @@ model:
   assemble: {{model: ur5}}
   export_config:
 """
-MISSING = ("urdf2kccd is not on PATH: wrote the hulls, kccd/{0}.urdf and kccd/{0}_kccd.yml; urdf2kccd "
-           "would have made kccd/{0}.cfg and {0}Kinematics.cfg from them, and kccdcoveriv each body's "
+MISSING = ("urdf2kccd is not on PATH: wrote the hulls, {1}/{0}.urdf and {1}/{0}_kccd.yml; urdf2kccd "
+           "would have made {1}/{0}.cfg and {0}Kinematics.cfg from them, and kccdcoveriv each body's "
            "fitted volume")
 
 
-def build(tmp_path: Path, entries: str, diags: Diags, robot: str = "ur5") -> Path:
+def build(tmp_path: Path, entries: str, diags: Diags, robot: str = "ur5", folder: str = "kccd") -> Path:
     out = compile_file(write(tmp_path / "m.yml", HEAD + entries), tmp_path / "out", diags).out
     assert out is not None, diags.summary()
-    assert diags.take("W0520", Severity.WARNING).message == MISSING.format(robot)
+    assert diags.take("W0520", Severity.WARNING).message == MISSING.format(robot, folder)
     return out
 
 
@@ -146,7 +146,7 @@ model:
 """)
     out = compile_file(spec, tmp_path / "out", diags).out
     assert out is not None
-    assert diags.take("W0520", Severity.WARNING).message == MISSING.format("arm")
+    assert diags.take("W0520", Severity.WARNING).message == MISSING.format("arm", "kccd")
     assert (out / "kccd/arm_kccd.yml").read_text() == """\
 {
   "bodies": [
@@ -231,3 +231,13 @@ def test_kccd_in_a_submodel(tmp_path: Path, diags: Diags) -> None:
 """, diags, robot="wrist")
     assert set(hulls(out / "submodels/wrist")) == {"wrist_1_link", "wrist_2_link", "wrist_3_link"}
     assert (out / "submodels/wrist/kccd/wrist.urdf").is_file()
+
+
+def test_a_nested_dirname_refers_to_the_hulls(tmp_path: Path, diags: Diags) -> None:
+    """With `dirname: models/kccd` the URDF and the settings still point at the hulls."""
+    out = build(tmp_path, "    - {type: kccd, dirname: models/kccd}\n", diags, folder="models/kccd")
+    folder = out / "models/kccd"
+    settings = json.loads((folder / "ur5_kccd.yml").read_text())
+    assert all((folder / b["mesh"]).resolve().is_file() for b in settings["bodies"])
+    assert settings["bodies"][0]["mesh"] == "../../meshes/iv/collision_world.stl"
+    assert 'filename="../../meshes/iv/collision_world.stl"' in (folder / "ur5.urdf").read_text()
