@@ -241,3 +241,46 @@ def test_a_nested_dirname_refers_to_the_hulls(tmp_path: Path, diags: Diags) -> N
     assert all((folder / b["mesh"]).resolve().is_file() for b in settings["bodies"])
     assert settings["bodies"][0]["mesh"] == "../../meshes/iv/collision_world.stl"
     assert 'filename="../../meshes/iv/collision_world.stl"' in (folder / "ur5.urdf").read_text()
+
+
+def test_the_settings_go_into_urdf2kccds_cfg(tmp_path: Path, diags: Diags) -> None:
+    """Where urdf2kccd is installed, its `.cfg` gets the settings as Phobos writes them in:
+    appended to the TITLE block, the BRAKINGMODEL template filled in, OVERWRITE lines, and
+    DONTCHECK lines for the pairs (named by urdf2kccd's body names). The `.cfg` here is
+    shaped as Phobos's reading of it expects; kccdcoveriv is not installed (W0520)."""
+    from mpc.backends.kccd_tools import _configured
+    from mpc.ir.program import KccdExport
+    from mpc.ir.span import Span
+
+    cfg = ("TITLE arm\n\n# BRAKINGMODEL <linearFactor> <invDeceleration> UNCERTAINTY <uncertainty> "
+           "LATENCY <latency>\n\n# OVERWRITE\n\n"
+           "BODY B_base MOVESWITH J_root a b c d ../../meshes/iv/collision_base.iv\nBODYPOINT 0 0 0\n\n"
+           "BODY B_upper MOVESWITH J_shoulder a b c d ../../meshes/iv/collision_upper.iv\nBODYPOINT 0 0 0\n")
+    settings = {"safety_distance": 0.01, "report_up_to": 0, "computation_budget": -1,
+                "max_approximation_order": 1,
+                "braking_model": {"linearFactor": 0, "invDeceleration": 0.02, "uncertainty": 0, "latency": 0},
+                "order_0_joints": {"upper": ["elbow"]}, "dont_check": [["base", "upper"]],
+                "bodies": [{"link": "base", "n_points": 25}, {"link": "upper", "n_points": 8}]}
+    export = KccdExport(span=Span("m.yml", 1, 1, 1, 2))
+    assert _configured(cfg, settings, export, tmp_path, diags) == """
+TITLE arm
+SAFETYDISTANCE 0.01
+REPORTUPTO 0
+COMPUTATIONBUDGET -1
+MAXAPPROXIMATIONORDER 1
+
+BRAKINGMODEL 0 0.02 UNCERTAINTY 0 LATENCY 0
+
+# OVERWRITE
+OVERWRITE elbow WITH ORDER 0 END
+
+BODY B_base MOVESWITH J_root a b c d ../meshes/iv/collision_base.iv
+BODYPOINT 0 0 0
+
+BODY B_upper MOVESWITH J_shoulder a b c d ../meshes/iv/collision_upper.iv
+BODYPOINT 0 0 0
+
+DONTCHECK B_base WITH B_upper END
+"""
+    assert diags.take("W0520", Severity.WARNING).message == (
+        "kccdcoveriv is not on PATH: the bodies keep the points urdf2kccd gave them, without a fitted volume")
