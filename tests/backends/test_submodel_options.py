@@ -234,3 +234,29 @@ def test_move_joint_axis_to_intersection(tmp_path: Path, diags: Diags) -> None:
         return base.actInv(data.oMi[i]).act(model.inertias[i].lever)
 
     assert np.allclose(com(arm, da, ba), com(whole, dw, bw), atol=1e-12)
+
+
+def test_from_the_command_line(tmp_path: Path) -> None:
+    """`mpc compile` on TALOS: the legs without fixed joints (sole links merged into the
+    ankles), their joint limits, and the KCCD model of the legs; the one warning is W0520."""
+    from tests.compiler.test_cli import mpc
+
+    spec = write(tmp_path / "m.yml", HEAD + """
+  export_config:
+    - type: submodel
+      name: legs
+      stop: ["leg_.*_6_link"]
+      remove_fixed: true
+      export_config: [{type: urdf}, {type: joint_limits}, {type: kccd}]
+""")
+    run = mpc("compile", spec, "-o", tmp_path / "out", "--format", "gcc")
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == (
+        f"{spec}:12:59: warning: urdf2kccd is not on PATH: wrote the hulls, kccd/legs.urdf and "
+        "kccd/legs_kccd.yml; urdf2kccd would have made kccd/legs.cfg and legsKinematics.cfg from them, "
+        "and kccdcoveriv each body's fitted volume [W0520]\n")
+    legs = tmp_path / "out/submodels/legs"
+    assert "fixed" not in joints_of(legs / "urdf/legs.urdf").values()
+    names = json.loads((legs / "joint_limits.yml").read_text())["limits"]["names"]
+    assert len(names) == 12
+    assert len(list((legs / "meshes/iv").glob("*.stl"))) == 13  # base_link and twelve leg links
