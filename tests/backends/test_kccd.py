@@ -284,3 +284,15 @@ DONTCHECK B_base WITH B_upper END
 """
     assert diags.take("W0520", Severity.WARNING).message == (
         "kccdcoveriv is not on PATH: the bodies keep the points urdf2kccd gave them, without a fitted volume")
+
+
+def test_two_kccd_exports_with_different_hulls(tmp_path: Path, diags: Diags) -> None:
+    """Both write meshes/iv/collision_<link>.stl (Phobos's layout), so they must agree."""
+    spec = write(tmp_path / "m.yml", HEAD + """    - {type: kccd}
+    - {type: kccd, dirname: reduced, reduce_meshes: 0.5}
+""")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    diags.take("W0520", Severity.WARNING)
+    assert diags.take_error("E0525").message == \
+        "two kccd exports write different hulls to meshes/iv/collision_world.stl"
+    assert not (tmp_path / "out").exists()
