@@ -41,7 +41,6 @@ from mpc.ir.program import (
     Export,
     Input,
     JointLimitsExport,
-    KccdExport,
     MjcfExport,
     PdfExport,
     Program,
@@ -302,11 +301,13 @@ class _Lowering:
         if inherited and getattr(entry, "ros_pathes", False):
             entry = entry.model_copy(update={"ros_pathes": False})
         if entry.type == "kccd":
+            from mpc.compiler.lower_kccd import lower_kccd
+
             if not inherited:
-                return self.kccd(entry, written, submodel)
+                return lower_kccd(self, entry, written, submodel)
             sink, self.sink = self.sink, Sink()  # the model's own use of the entry reported
             try:
-                lowered = self.kccd(entry, written, submodel)
+                lowered = lower_kccd(self, entry, written, submodel)
                 return [] if self.sink.has_errors() else lowered
             finally:
                 self.sink = sink
@@ -474,64 +475,6 @@ class _Lowering:
             return None
         return JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name)
 
-    def kccd(self, entry: Any, written: dict[str, Export], submodel: str) -> list[Export]:
-        """A `kccd` entry: its numbers evaluated and its per-link settings checked; the names
-        it gives are checked against the robot when it is written (backends/kccd.py)."""
-        parts = Path(entry.dirname).parts
-        if not parts or Path(entry.dirname).is_absolute() or ".." in parts:
-            self.sink.error(entry.value_span("dirname"), "E0521", f"kccd 'dirname' is a folder inside the "
-                            f"output, got '{entry.dirname}'")
-            return []
-        target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.dirname}"
-        if target in written:
-            self.sink.error(entry.span, "E0503", f"two kccd exports would write {target}/",
-                            notes=((written[target].span, "the other export"),))
-            return []
-        numbers = {key: self.num(entry, key, f"kccd {key}")
-                   for key in ("safety_distance", "report_up_to", "computation_budget")}
-        budget = numbers["computation_budget"]
-        faces, ratio = 0, 0.0
-        reduce = self.num(entry, "reduce_meshes", "kccd reduce_meshes") if entry.reduce_meshes else 0.0
-        if reduce is not None and 0 < reduce < 1:
-            ratio = reduce
-        elif reduce is not None and reduce >= 4 and float(reduce).is_integer():
-            faces = int(reduce)
-        elif reduce not in (None, 0):
-            self.sink.error(entry.value_span("reduce_meshes"), "E0521", "kccd 'reduce_meshes' is the "
-                            "fraction of each hull's faces to remove (between 0 and 1, as in Phobos) or a "
-                            f"number of faces to keep (4 or more), got {reduce:g}")
-        n_points: dict[str, int] = {}
-        shapes: dict[str, str] = {}
-        for link, settings in entry.edit_collisions.items():
-            for key, value in settings.items():
-                if key == "n_points" and isinstance(value, int) and value >= 1:
-                    n_points[link] = value
-                elif key == "shape" and value in KCCD_SHAPES:
-                    shapes[link] = str(value)
-                else:
-                    span = entry._doc.value_span((*entry._path, "edit_collisions", link, key))
-                    self.sink.error(span, "E0521", f"kccd edit_collisions of '{link}': '{key}: {value}' is "
-                                    "neither n_points (a whole number, 1 or more) nor shape "
-                                    f"({', '.join(KCCD_SHAPES)})")
-        braking: tuple[float, ...] = ()
-        if entry.braking_model is not None:
-            b = entry.braking_model
-            values = [self.num(b, key, f"braking_model {key}")
-                      for key in ("linearFactor", "invDeceleration", "uncertainty", "latency")]
-            braking = tuple(v if v is not None else 0.0 for v in values)
-        written[target] = export = KccdExport(
-            span=entry.span, dirname=entry.dirname, join_before_convexhull=entry.join_before_convexhull,
-            remove_joints=tuple(entry.remove_joints), merge_additionally=tuple(entry.merge_additionally),
-            keep_stls=entry.keep_stls, keep_urdf=entry.keep_urdf, reduce_faces=faces, reduce_ratio=ratio,
-            n_points=n_points, shapes=shapes, braking_model=braking,
-            simplify_swept_from=tuple(entry.simplify_swept_from),
-            safety_distance=numbers["safety_distance"] or 0.0, report_up_to=numbers["report_up_to"] or 0.0,
-            computation_budget=-1.0 if budget is None else budget,
-            max_approximation_order=entry.max_approximation_order,
-            no_collision_between={k: tuple(v) for k, v in entry.no_collision_between.items()},
-            submodel=submodel)
-        return [export]
-
     def program(self) -> Program:
         """The program, also after errors (values that failed are None), so that the names
         in it can still be checked; the errors stop the build later."""
@@ -560,7 +503,6 @@ _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
     "include_human_in_abstract": False, "remove_links": []}
-KCCD_SHAPES = ("box", "cylinder", "sphere", "convex")
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
