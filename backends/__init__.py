@@ -12,6 +12,7 @@ _MODULES = {
     "smurf": "mpc.backends.smurf",
     "pdf": "mpc.backends.pdf",
     "joint_limits": "mpc.backends.joint_limits",
+    "kccd": "mpc.backends.kccd",
     "ros_package": "mpc.backends.ros_package",
 }
 

@@ -3,9 +3,10 @@
 Format (Phobos's): `{limits: {names: [...], elements: [{max: {position, speed, effort},
 min: {position}}]}}`. Fixed joints are never listed; a missing limit is written as 0.
 Selections: ALL (every movable joint), ACTIVE and INDEPENDENT (the submechanisms'
-`jointnames_active` / `jointnames_independent`), ACTUATED (joints with a motor), or a
-list of joint names. Written as JSON-compatible YAML with sorted keys, so it diffs
-cleanly.
+`jointnames_active` / `jointnames_independent`), ABSTRACT (the movable joints of the
+abstract model, ir/submodel.py), ACTUATED (joints with a motor), or a list of joint names;
+`joints: <submodel>` is ALL of that submodel (the driver passes it in). Written as
+JSON-compatible YAML with sorted keys, so it diffs cleanly.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from mpc.ir.program import JointLimitsExport
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first
 
-SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED")
+SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
 
 
 def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:
@@ -27,13 +28,18 @@ def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:
     movable = [j.name for j, _ in depth_first(robot) if j is not None and j.type != "fixed"]
     if export.joints == ("ALL",):
         return movable
-    if export.joints in (("ACTIVE",), ("INDEPENDENT",)):
-        key = f"jointnames_{export.joints[0].lower()}"
-        chosen = {str(j) for sm in robot.submechanisms for j in sm.definition.get(key, ())}  # type: ignore[union-attr]
+    if export.joints in (("ACTIVE",), ("INDEPENDENT",), ("ABSTRACT",)):
         if not robot.submechanisms:
             sink.warning(export.span, "W0503", f"joints: {export.joints[0]} needs submechanisms; this "
                          "model has none, so every movable joint is listed (as Phobos does)")
             return movable
+        if export.joints == ("ABSTRACT",):
+            from mpc.ir.submodel import abstract_joints
+
+            chosen = abstract_joints(robot)
+        else:
+            key = f"jointnames_{export.joints[0].lower()}"
+            chosen = {str(j) for sm in robot.submechanisms for j in sm.definition.get(key, ())}  # type: ignore[union-attr]
         return [j for j in movable if j in chosen]
     if export.joints == ("ACTUATED",):
         driven = {m.joint for m in robot.motors.values()}

@@ -24,7 +24,7 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
-from mpc.ir.program import CommandExport, Export, Program, RobotExport, SubmodelExport
+from mpc.ir.program import CommandExport, Export, JointLimitsExport, Program, RobotExport, SubmodelExport
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -175,6 +175,8 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
             if isinstance(export, RobotExport):
                 if export.submodel:
                     model, folder = submodels[export.submodel], staging / "submodels" / export.submodel
+                if isinstance(export, JointLimitsExport) and export.joints_of:
+                    model = submodels[export.joints_of]  # its joints, written where the entry is
                 if model is not None and export.add_floating_base:
                     model = _floating(model, export, sink)
                 if model is None:

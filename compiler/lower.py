@@ -286,6 +286,8 @@ class _Lowering:
                 out.extend(self.submodel(entry, written))
             else:
                 out.extend(self.export(entry, written, self.model.robotname))
+        # A joint_limits entry that lists a submodel's joints needs that submodel cut first.
+        out = [e for e in out if not _lists_a_submodel(e)] + [e for e in out if _lists_a_submodel(e)]
         out.extend(self.smurf.exports(out))
         out.extend(self.commands())
         package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
@@ -300,8 +302,19 @@ class _Lowering:
         in the submodel's folder, not where the package's `package://` paths point."""
         if inherited and getattr(entry, "ros_pathes", False):
             entry = entry.model_copy(update={"ros_pathes": False})
+        if entry.type == "kccd":
+            from mpc.compiler.lower_kccd import lower_kccd
+
+            if not inherited:
+                return lower_kccd(self, entry, written, submodel)
+            sink, self.sink = self.sink, Sink()  # the model's own use of the entry reported
+            try:
+                lowered = lower_kccd(self, entry, written, submodel)
+                return [] if self.sink.has_errors() else lowered
+            finally:
+                self.sink = sink
         if entry.type in ("pdf", "joint_limits"):
-            export = self.simple_export(entry)
+            export = self.simple_export(entry, inherited)
             return [] if export is None else [replace(export, submodel=submodel)]
         if entry.type == "smurf":
             self.smurf.entry(entry, submodel)
@@ -331,7 +344,7 @@ class _Lowering:
             mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
         export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                            add_floating_base=entry.add_floating_base, submodel=submodel,
-                                           filename=filename if filename != robotname else "")
+                                           filename=filename if filename != (submodel or robotname) else "")
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
@@ -355,10 +368,33 @@ class _Lowering:
         for key, default in _SUBMODEL_LATER.items():
             if getattr(entry, key) != default:
                 self.not_yet(entry.key_span(key), f"submodel option '{key}'")
+        if entry.only_urdf:
+            self.sink.warning(entry.key_span("only_urdf"), "W0523", "'only_urdf' has no effect (Phobos "
+                              "stores it and never reads it)",
+                              hint="give the submodel an export_config with only urdf entries")
         cut = SubmodelExport(span=entry.span, name=entry.name, start=entry.start or "",
                              stop=tuple([entry.stop] if isinstance(entry.stop, str) else entry.stop or ()),
                              include_unstopped_branches=entry.include_unstopped_branches,
-                             add_floating_base=entry.add_floating_base)
+                             add_floating_base=entry.add_floating_base,
+                             remove_joints=_strings(entry.remove_joints), remove_fixed=entry.remove_fixed,
+                             abstract_model=entry.abstract_model, no_submechanisms=entry.no_submechanisms,
+                             name_replacements=tuple(entry.name_replacements.items()))
+        for key, patterns in (("remove_joints", cut.remove_joints),
+                              ("name_replacements", entry.name_replacements)):
+            for pattern in patterns:
+                problem = bad_pattern(pattern)
+                if problem:
+                    self.sink.error(entry.value_span(key), "E0305",
+                                    f"'{pattern}' is not a regular expression: {problem}")
+        moves = {}
+        for joint, pair in entry.move_joint_axis_to_intersection.items():
+            if len(pair) != 2:
+                span = entry._doc.value_span((*entry._path, "move_joint_axis_to_intersection", joint))
+                count = f"{len(pair)} joint{'' if len(pair) == 1 else 's'}"
+                self.sink.error(span, "E0526", f"move_joint_axis_to_intersection of '{joint}' names "
+                                f"{count}; it takes the two whose axes meet")
+            moves[joint] = tuple(pair)
+        cut = replace(cut, move_joint_axis_to_intersection=moves)
         folder = f"submodels/{entry.name}"
         if folder in written:
             self.sink.error(entry.value_span("name"), "E0503", f"two submodels would write {folder}",
@@ -370,9 +406,10 @@ class _Lowering:
         if nested is None:
             nested = [e for e in self.model.export_config or () if e.type != "submodel"]
             if self.model.export_config is None:
-                out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name))
+                out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name,
+                                      filename=entry.filename or ""))
         for inner in nested:
-            out.extend(self.export(inner, written, entry.name, submodel=entry.name,
+            out.extend(self.export(inner, written, entry.filename or entry.name, submodel=entry.name,
                                    inherited=entry.export_config is None))
         return out
 
@@ -422,16 +459,25 @@ class _Lowering:
         return RosPackageExport(span=m.span, package=package, version=version,
                                 description=m.description or "", license=m.license or "")
 
-    def simple_export(self, entry: Any) -> Export | None:
-        """The pdf and joint_limits entries (no meshes, no kinematic options)."""
+    def simple_export(self, entry: Any, inherited: bool = False) -> Export | None:
+        """The pdf and joint_limits entries (no meshes, no kinematic options). An entry a
+        submodel inherits reports nothing: the model's own use of it did."""
         if entry.type == "pdf":
             return PdfExport(span=entry.span)
         joints = tuple(entry.joints)
         from mpc.backends.joint_limits import SELECTIONS
 
-        if len(joints) == 1 and joints[0].isupper() and joints[0] not in SELECTIONS:
-            what = "submodel joint lists" if joints[0] != "ABSTRACT" else "ABSTRACT (the abstract model)"
-            self.not_yet(entry.value_span("joints"), f"joints: {joints[0]} — {what}")
+        # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
+        submodels = {e.name for e in self.model.export_config or () if e.type == "submodel"}
+        as_string = isinstance(entry._doc.data_at((*entry._path, "joints")), str)
+        if len(joints) == 1 and as_string and joints[0] in submodels:
+            return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
+        if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:
+            if inherited:
+                return None
+            self.sink.error(entry.value_span("joints"), "E0524", f"joints: '{joints[0]}' is none of "
+                            f"{', '.join(SELECTIONS)} and names no submodel of this export_config"
+                            f"{did_you_mean(joints[0], set(SELECTIONS) | submodels)}")
             return None
         return JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name)
 
@@ -468,9 +514,7 @@ _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
-    "no_submechanisms": False, "abstract_model": False, "include_human_in_abstract": False,
-    "remove_fixed": False, "remove_joints": [], "remove_links": [], "move_joint_axis_to_intersection": {},
-    "name_replacements": {}, "filename": None, "only_urdf": False}
+    "include_human_in_abstract": False, "remove_links": []}
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
 _KINEMATIC_LATER: dict[str, Any] = {
@@ -478,6 +522,15 @@ _KINEMATIC_LATER: dict[str, Any] = {
     "float_fmt_dict": None,
 }
 
+
+
+def _lists_a_submodel(export: Export) -> bool:
+    return isinstance(export, JointLimitsExport) and bool(export.joints_of)
+
+
+def _strings(value: str | list[str] | None) -> tuple[str, ...]:
+    """A `OneOrMore` value as a tuple."""
+    return (value,) if isinstance(value, str) else tuple(value or ())
 
 
 def _item_span(node: Node, key: str, i: int) -> Span:

@@ -7,7 +7,7 @@ The compiler's output and the input of the apply and emit phases. `mpc compile
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
@@ -117,14 +117,16 @@ class PdfExport:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class JointLimitsExport:
-    """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED or names),
-    written to `file_name`."""
+    """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED, ABSTRACT or
+    names), written to `file_name`. joints_of: the submodel whose movable joints are listed
+    (`joints: <submodel name>`); the file is still written where the entry stands."""
 
     span: Span
     joints: tuple[str, ...] = ("ALL",)
     file_name: str = "joint_limits.yml"
     add_floating_base: bool = False
     submodel: str = ""
+    joints_of: str = ""
     type: Literal["joint_limits"] = "joint_limits"
 
 
@@ -137,6 +139,13 @@ class SubmodelExport:
     matched against whole names) where it ends ("()": the leaves); only the links on the way
     from start to a stop are kept, and with include_unstopped_branches also the branches
     that reach no stop. add_floating_base: as for the other exports.
+    remove_joints: joints (names, or regular expressions matched against whole names) whose
+    child links merge into their parents (ir/merge.py); remove_fixed: every fixed joint too.
+    abstract_model: keep only the fixed joints and the submechanisms' independent ones (and
+    the exoskeletons' dependent ones), merging the rest; the submechanisms go.
+    no_submechanisms: the submodel has none. move_joint_axis_to_intersection: joint → the
+    two joints whose axes' meeting point its frame moves to. name_replacements: (pattern,
+    replacement) applied to every name last, after the merges.
     """
 
     span: Span
@@ -145,6 +154,12 @@ class SubmodelExport:
     stop: tuple[str, ...] = ()
     include_unstopped_branches: bool = False
     add_floating_base: bool = False
+    remove_joints: tuple[str, ...] = ()
+    remove_fixed: bool = False
+    abstract_model: bool = False
+    no_submechanisms: bool = False
+    move_joint_axis_to_intersection: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    name_replacements: tuple[tuple[str, str], ...] = ()
     type: Literal["submodel"] = "submodel"
 
 
@@ -206,8 +221,47 @@ class SmurfExport:
     type: Literal["smurf"] = "smurf"
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class KccdExport:
+    """A `type: kccd` entry: the collision model KCCD reads (backends/kccd.py).
+
+    One convex hull per body: a link whose parent joint is movable and not in
+    merge_additionally, with the shapes of the links hanging from it by fixed joints (or by
+    merge_additionally joints), after remove_joints merged those joints' children.
+    dirname: the folder of the KCCD URDF and configuration. join_before_convexhull: one hull
+    of all shapes (else the union of one hull per shape). reduce_faces / reduce_ratio: a
+    face budget, or the fraction of faces removed (Phobos's meaning here), 0: none.
+    n_points, shapes: edit_collisions, per link. braking_model: linearFactor,
+    invDeceleration, uncertainty, latency (empty: none given). no_collision_between: link →
+    links never checked against it.
+    """
+
+    span: Span
+    dirname: str = "kccd"
+    join_before_convexhull: bool = True
+    remove_joints: tuple[str, ...] = ()
+    merge_additionally: tuple[str, ...] = ()
+    keep_stls: bool = False
+    keep_urdf: bool = False
+    reduce_faces: int = 0
+    reduce_ratio: float = 0.0
+    n_points: Mapping[str, int] = field(default_factory=dict)
+    shapes: Mapping[str, str] = field(default_factory=dict)
+    braking_model: tuple[float, ...] = ()
+    simplify_swept_from: tuple[str, ...] = ()
+    safety_distance: float = 0.0
+    report_up_to: float = 0.0
+    computation_budget: float = -1.0
+    max_approximation_order: int = 1
+    no_collision_between: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    add_floating_base: bool = False
+    submodel: str = ""
+    type: Literal["kccd"] = "kccd"
+
+
 # The exports that write a robot (the whole one or a submodel's), optionally floating.
-RobotExport = UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SmurfExport
+RobotExport = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SmurfExport
+               | KccdExport)
 Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 
 

@@ -76,9 +76,9 @@ def test_key_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
 
 def test_export_of_a_later_version(tmp_path: Path, diags: Diags) -> None:
     arm(tmp_path)
-    _compile(tmp_path, diags, definition("arm.urdf") + "    - type: kccd\n")
+    _compile(tmp_path, diags, definition("arm.urdf") + "    - {type: submodel, name: s, remove_links: [x]}\n")
     d = diags.take_error("E0202")
-    assert (d.message, _where(d)) == ("export type 'kccd' is not supported yet", (12, 13))
+    assert (d.message, _where(d)) == ("submodel option 'remove_links' is not supported yet", (12, 33))
 
 
 def test_wrong_type(tmp_path: Path, diags: Diags) -> None:
