@@ -47,7 +47,8 @@ def test_dry_run_then_deploy_with_a_pipeline(model: Model, server: Server, tmp_p
     head = git(server.path, "rev-parse", "master")
     assert run.stdout == (f"deployed 'arm-model' to branch 'master' of '{url}': commit {head[:12]}\n"
                           "  merge request into 'develop'\n")
-    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "notes/todo.md", "urdf/arm.urdf"]
+    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "notes/todo.md", "smurf/arm.smurf",
+                                       "urdf/arm.urdf"]
     options = server.pushes()[-1]["options"]
     assert options[1:3] == ["merge_request.target=develop", "merge_request.title=Default title"]
     assert options[-1] == "merge_request.assign=carol"

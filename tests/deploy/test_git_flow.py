@@ -26,7 +26,8 @@ def test_first_deploy_pushes_the_build_with_its_provenance(model: Model, server:
                           protocol_markdown=PROTOCOL)
     assert sink.diagnostics == [] and result.ok and result.pushed
     assert (result.branch, server.branches()) == ("master", {"master": result.commit})
-    assert sorted(server.files()) == [".gitignore", "README.md", "meshes/stl/tetra.stl", "urdf/arm.urdf"]
+    assert sorted(server.files()) == [".gitignore", "README.md", "meshes/stl/tetra.stl",
+                                    "smurf/arm.smurf", "urdf/arm.urdf"]
     assert server.show("master", "urdf/arm.urdf") == (model.built / "urdf/arm.urdf").read_text().rstrip("\n")
     assert "# arm-model" in server.show("master", "README.md")
     definitions = git(model.folder, "rev-parse", "HEAD")
@@ -79,8 +80,8 @@ def test_keep_files_survive_and_everything_else_is_replaced(model: Model, server
     server.commit_files({"submechanisms/knee.lua": "-- by hand\n", "old/stale.urdf": "<robot/>\n",
                          ".gitattributes": "*.bin binary\n"}, "hand-written files")
     deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
-    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "submechanisms/knee.lua",
-                                      "urdf/arm.urdf"]
+    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf",
+                                      "submechanisms/knee.lua", "urdf/arm.urdf"]
     assert server.show("master", "submechanisms/knee.lua") == "-- by hand"
     assert server.log() == ["[mpc] Update arm-model", "hand-written files"]
 
@@ -154,8 +155,8 @@ def test_dry_run_reports_the_diff_stat_and_pushes_nothing(model: Model, server: 
     assert server.branches() == {} and server.pushes() == []
     lines = result.diffstat.splitlines()
     assert [line.split("|")[0].strip() for line in lines[:-1]] == ["README.md", "meshes/stl/tetra.stl",
-                                                                    "urdf/arm.urdf"]
-    assert lines[-1].strip().startswith("3 files changed")
+                                                                    "smurf/arm.smurf", "urdf/arm.urdf"]
+    assert lines[-1].strip().startswith("4 files changed")
 
 
 def test_do_not_deploy(model: Model, server: Server) -> None:

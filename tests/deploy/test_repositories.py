@@ -92,7 +92,7 @@ def test_mirror_gets_a_copy_with_submodule_files(model: Model, server: Server, t
     result = deploy_model(model.compile(), model.built, model.settings(remote=server.url), Sink())
     assert result.ok and result.mirror is not None and result.mirror.pushed
     assert sorted(mirror.files("develop")) == ["README.md", "lua/knee.lua", "meshes/stl/tetra.stl",
-                                               "urdf/arm.urdf"]
+                                               "smurf/arm.smurf", "urdf/arm.urdf"]
     assert mirror.log("develop") == ["[mpc] Update arm-model", "start"]
     options = mirror.pushes()[-1]["options"]
     assert options[:3] == ["merge_request.create", "merge_request.target=master",
