@@ -18,10 +18,11 @@ import shutil
 import signal
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 from multiprocessing.connection import Connection, wait
 from multiprocessing.process import BaseProcess
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.pipeline import dag
@@ -37,6 +38,9 @@ from mpc.compiler.pipeline.status import (
 )
 from mpc.compiler.pipeline.store import Store
 from mpc.ir.span import Span
+
+if TYPE_CHECKING:
+    from mpc.compiler.driver import Options
 
 
 @dataclass
@@ -80,15 +84,10 @@ class Runner:
     """Runs one plan once (see the module docstring)."""
 
     def __init__(self, plan: Plan, opts: RunOptions, reporter: Reporter) -> None:
-        from mpc.backends.packages import PackageResolver
-        from mpc.compiler.driver import Options
-
         self.plan, self.opts, self.reporter = plan, opts, reporter
         self.store = Store(opts.build or plan.root / "build")
         self.parents = plan.parents()
         self.selected = [n for n in plan.models if not opts.only or n in opts.only]
-        self.options = Options(resolver=PackageResolver(package_map=dict(opts.package_map)),
-                               defaults=plan.defaults)
         self.status = RunStatus(str(plan.file), opts.stages, opts.jobs)
         self.fingerprints: dict[str, str | None] = {}  # compile fingerprints of finished models
         self.done: set[str] = set()
@@ -151,7 +150,7 @@ class Runner:
                 state = self.status.models[parent].stages[self.opts.stages[0]].state
                 self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
                 return None
-        packages = repr(sorted(self.options.resolver.package_map.items()))
+        packages = repr(sorted((k, str(v)) for k, v in self.opts.package_map.items()))
         pre = digest(mpc_version(), data_digest(model.data), packages, str(self.opts.werror),
                      *(f"{p}={self._fingerprint_of(p)}" for p in sorted(model.parents)))
         failure = self._cached_failure(name, pre)
@@ -210,6 +209,16 @@ class Runner:
         return "unbuilt:" + data_digest(self.plan.models[parent].data)
 
     # -- workers -----------------------------------------------------------------------------
+
+    @cached_property
+    def options(self) -> Options:
+        """Compile options of every worker (made when the first one starts: a run where all
+        is cached never imports the compiler)."""
+        from mpc.backends.packages import PackageResolver
+        from mpc.compiler.driver import Options
+
+        return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
+                       defaults=self.plan.defaults)
 
     def _start(self, name: str, pre: str, cached: list[str]) -> None:
         from mpc.compiler.cache import cache_dir
