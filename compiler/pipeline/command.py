@@ -112,7 +112,10 @@ def run(args: argparse.Namespace) -> int:
                     status=str(status_file))
         return exit_status
     for name in sorted(status.models):
-        _print_diagnostics(status.models[name].diagnostics(), args.format)
+        diagnostics = status.models[name].diagnostics()
+        if diagnostics and args.format == "human":
+            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
+        _print_diagnostics(diagnostics, args.format)
     if sys.stdout.isatty():
         progress.rich_table(status)
     else:

@@ -16,6 +16,7 @@ import multiprocessing
 import os
 import shutil
 import signal
+import sys
 import time
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -233,6 +234,8 @@ class Runner:
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
                        pipeline=self.plan.settings, root=self.plan.root, options=self.options)
         run = [s for s in self.opts.stages if s not in cached]
+        sys.stdout.flush()  # a forked worker must not write out what the runner had buffered
+        sys.stderr.flush()
         ctx = multiprocessing.get_context("fork")
         receive, send = ctx.Pipe(duplex=False)
         ignore = [self.store.build.resolve(), cache_dir("x").parent]
@@ -262,7 +265,13 @@ class Runner:
             r.process.join()
             r.conn.close()
             del self.running[r.model]
-            self._collect(r)
+            # Moving the output into place and saving its state happen together or not at
+            # all: an interruption waits until both are done.
+            blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+            try:
+                self._collect(r)
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
     def _collect(self, r: _Running) -> None:
         """Record what a finished worker did; move its output into place when compile succeeded."""

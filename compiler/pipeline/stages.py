@@ -134,7 +134,8 @@ def compile_stage(job: StageJob) -> StageOutcome:
     job.built = result.out
     files = [p for p in result.out.rglob("*") if p.is_file()]
     meshes = sum("meshes" in p.relative_to(result.out).parts for p in files)
-    return StageOutcome("ok", f"{len(files) - meshes} files, {meshes} meshes",
+    n = len(files) - meshes
+    return StageOutcome("ok", f"{n} file{'s' * (n != 1)}, {meshes} mesh{'es' * (meshes != 1)}",
                         details={"files": len(files), "meshes": meshes})
 
 

@@ -116,7 +116,7 @@ def model_state(model: ModelRecord) -> str:
 def record_json(r: StageRecord) -> dict[str, Any]:
     out: dict[str, Any] = {"state": r.state, "seconds": round(r.seconds, 3)}
     if r.summary:
-        out["reason" if r.state == "skipped" else "summary"] = r.summary
+        out["reason" if r.state in ("skipped", "interrupted") else "summary"] = r.summary
     if r.fingerprint:
         out["fingerprint"] = r.fingerprint
     if r.diagnostics:

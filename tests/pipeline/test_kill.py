@@ -119,3 +119,35 @@ def test_sigterm_to_a_worker_keeps_the_previous_output_and_the_next_run_complete
     assert again.returncode == 0, again.stderr
     assert again.states() == {"slow": "ok", "child": "ok", "other": "cached"}
     assert b'value="0.2"' in (build / "slow/urdf/slow.urdf").read_bytes()
+
+
+def test_sigterm_to_the_run_stops_its_workers_and_keeps_every_output(tmp_path: Path) -> None:
+    folder = tmp_path / "p"
+    folder.mkdir()
+    pipeline, cache = _write(folder), tmp_path / "cache"
+    assert run_json(pipeline, cache=cache).returncode == 0
+    build = folder / "build"
+    previous = (build / "slow/urdf/slow.urdf").read_bytes()
+    (folder / "hold").write_text("")
+    argv = [sys.executable, "-m", "mpc.compiler.cli", "run", str(pipeline), "--force", "--log-format", "json"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env(cache))
+    try:
+        deadline = time.monotonic() + 120
+        while not (folder / "waiting").exists():
+            assert time.monotonic() < deadline and proc.poll() is None
+            time.sleep(0.05)
+        helper = int((folder / "waiting").read_text())
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    status = json.loads((build / ".mpc/status.json").read_text())
+    assert status["models"]["slow"]["stages"]["compile"] == {
+        "state": "interrupted", "reason": "the run was interrupted", "seconds": 0.0}
+    assert (build / "slow/urdf/slow.urdf").read_bytes() == previous
+    assert list((build / ".mpc/staging").iterdir()) == []
+    assert not Path(f"/proc/{helper}").exists() or "Z" in Path(f"/proc/{helper}/stat").read_text().split()[2]
+    (folder / "hold").unlink()
+    assert run_json(pipeline, cache=cache).states() == {"slow": "cached", "child": "cached", "other": "cached"}
