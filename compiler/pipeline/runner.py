@@ -328,6 +328,8 @@ class Runner:
                                                    fingerprint=stages.get(stage, {}).get("fingerprint"))
                 continue
             o = outcomes[stage]
+            if o["details"].get("internal_error"):
+                self.status.internal_error = True
             sfp = self._stage_fingerprint(fp, stage) if fp else None
             record.stages[stage] = StageRecord(
                 o["state"], o["summary"], o["diagnostics"], o["seconds"],

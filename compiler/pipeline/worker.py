@@ -16,9 +16,10 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.diagnostics import Sink
+from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
 from mpc.compiler.pipeline.fingerprint import ReadRecorder, dep_entry
 from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome, ensure_program, first_error
+from mpc.ir.span import Span
 
 
 def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ignore: list[Path],
@@ -36,6 +37,13 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
     conn.close()
 
 
+def bug(job: StageJob, error: Exception) -> Diagnostic:
+    """E0614 for an exception raised while building `job`'s model, with its traceback."""
+    return Diagnostic(Severity.ERROR, "E0614", f"mpc failed while building model '{job.model}' (a bug in "
+                      f"mpc, please report it): {type(error).__name__}: {error}",
+                      Span.of_file(str(job.definition)), notes=((None, traceback.format_exc()),))
+
+
 def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadRecorder,
                werror: bool) -> dict[str, Any]:
     outcomes: dict[str, dict[str, Any]] = {}
@@ -50,7 +58,10 @@ def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadR
         elif name != "compile" and not ensure_program(job):
             outcome = StageOutcome("failed", first_error(job.sink.diagnostics))
         else:
-            outcome = stage.run(job)
+            try:
+                outcome = stage.run(job)
+            except Exception as e:  # a bug in mpc (or in a stage): this stage fails, as one
+                outcome = StageOutcome("failed", diagnostics=[bug(job, e)], details={"internal_error": True})
         diagnostics = [*job.sink.diagnostics, *outcome.diagnostics]
         if outcome.state == "failed" and not outcome.summary:
             outcome.summary = first_error(diagnostics)

@@ -124,6 +124,18 @@ def test_pipeline_default_export_config_applies_to_models_without_one(fleet: Fle
     assert all(m.get("filename").endswith(".stl") for m in arm.iter("mesh"))
 
 
+def test_the_state_lists_the_files_the_build_read(fleet: Fleet) -> None:
+    state = json.loads((fleet.build / ".mpc/state/arm.json").read_text())
+    read = {Path(d[0]) for d in state["deps"]}
+    here = fleet.pipeline.parent
+    assert {here / "arm.yml", here / "ur5.urdf"} <= read
+    meshes = {p.name for p in read if p.suffix in (".dae", ".stl")}
+    assert {"base.dae", "shoulder.dae", "wrist3.dae", "base.stl", "wrist3.stl"} <= meshes
+    assert all(p.suffix not in (".py", ".pyc", ".so") for p in read)
+    assert not any(fleet.cache in p.parents or fleet.build in p.parents for p in read)
+    assert all(len(d[3]) == 64 for d in state["deps"])
+
+
 def test_second_run_rebuilds_nothing(fleet: Fleet) -> None:
     run = fleet.noop
     assert run.started() == []

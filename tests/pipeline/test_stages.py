@@ -104,3 +104,22 @@ def test_verify_counts_a_stage_that_skipped_by_its_own_choice_unless_allowed(pip
     assert status.exit_status() == 0
     assert status.exit_status(verify=True) == 1
     assert status.exit_status(verify=True, allow_na=True) == 0
+
+
+def failing_stage(job: StageJob) -> StageOutcome:
+    raise RuntimeError("a bug in a stage")
+
+
+def test_a_stage_that_raises_is_reported_as_a_bug_in_mpc(pipeline: Path,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(STAGES, "test", Stage("test", failing_stage, needs=("compile",)))
+    pipeline.write_text(pipeline.read_text().replace("bad.yml, ", ""))
+    status = _run(pipeline)
+    record = status.models["good"].stages["test"]
+    assert record.state == "failed"
+    [diag] = record.diagnostics
+    assert diag.code == "E0614"
+    assert diag.message == ("mpc failed while building model 'good' (a bug in mpc, please report it): "
+                            "RuntimeError: a bug in a stage")
+    assert "in failing_stage" in diag.notes[0][1]
+    assert status.exit_status() == 3
