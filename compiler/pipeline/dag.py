@@ -75,18 +75,6 @@ def descendants(parents: Mapping[str, Iterable[str]], node: str) -> set[str]:
     return seen
 
 
-def ancestors(parents: Mapping[str, Iterable[str]], node: str) -> set[str]:
-    """Every node that `node` depends on."""
-    seen: set[str] = set()
-    todo = [p for p in parents.get(node, ()) if p in parents]
-    while todo:
-        n = todo.pop()
-        if n not in seen:
-            seen.add(n)
-            todo.extend(p for p in parents.get(n, ()) if p in parents)
-    return seen
-
-
 def weights(parents: Mapping[str, Iterable[str]]) -> dict[str, int]:
     """How many models wait for each one (its descendants): the scheduler starts the models
     that unblock the most first, a cheap stand-in for the critical path."""

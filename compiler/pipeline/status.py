@@ -176,6 +176,3 @@ def summary_line(status: RunStatus) -> str:
 
 _ORDER = ["ok", "cached", "failed", "skipped", "interrupted"]
 
-
-def has_errors(diagnostics: list[Diagnostic]) -> bool:
-    return any(d.severity is Severity.ERROR for d in diagnostics)

@@ -27,7 +27,6 @@ def test_order_cycles_and_dependants() -> None:
     assert dag.order(parents) == ["a", "b", "c", "d"]
     assert dag.cycles(parents) == [["x", "y", "x"]]
     assert dag.descendants(parents, "b") == {"c", "d"}
-    assert dag.ancestors(parents, "d") == {"a", "b", "c"}
     assert dag.weights(parents)["a"] == 3
 
 
@@ -157,3 +156,14 @@ def test_check_applies_the_pipeline_defaults(tmp_path: Path) -> None:
     done = mpc("check", "pipeline.yml", cwd=tmp_path)
     assert done.returncode == 1
     assert "pipeline.yml:4:55: error[E0203]: 'filename_suffix' must be a string, got int '7'" in done.stderr
+
+
+def test_a_modelname_that_cannot_name_a_folder(tmp_path: Path) -> None:
+    write(tmp_path / "m.yml", _model("robots/arm"))
+    write(tmp_path / "pipeline.yml", "pipeline:\n  root: .\n  model_definitions: [m.yml]\n")
+    plan = load_plan(tmp_path / "pipeline.yml", Sink())
+    assert plan is not None
+    [diag] = plan.models["robots/arm"].diagnostics
+    assert (diag.code, diag.message, diag.hint) == (
+        "E0612", "modelname 'robots/arm' cannot name an output folder",
+        "a modelname is a folder name: no '/', and not starting with '.'")
