@@ -29,7 +29,7 @@ from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.pipeline import dag
 from mpc.compiler.pipeline.fingerprint import data_digest, deps_current, digest, mpc_version, with_deps
 from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.stages import STAGES, StageJob
+from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome
 from mpc.compiler.pipeline.status import (
     ModelRecord,
     RunStatus,
@@ -233,6 +233,11 @@ class Runner:
         job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
                        pipeline=self.plan.settings, root=self.plan.root, options=self.options)
+        done = self.store.state(name).get("stages", {})
+        for stage in cached:
+            kept = done.get(stage, {})
+            job.results[stage] = StageOutcome("ok", kept.get("summary", ""), details=kept.get("details", {}),
+                                              cached=True)
         run = [s for s in self.opts.stages if s not in cached]
         sys.stdout.flush()  # a forked worker must not write out what the runner had buffered
         sys.stderr.flush()
@@ -335,7 +340,8 @@ class Runner:
                 o["state"], o["summary"], o["diagnostics"], o["seconds"],
                 sfp if o["state"] == "ok" else None, o["details"], o["blocked"])
             if o["state"] == "ok" and sfp:
-                stages[stage] = {"fingerprint": sfp, "seconds": round(o["seconds"], 3)}
+                stages[stage] = {"fingerprint": sfp, "seconds": round(o["seconds"], 3),
+                                 "summary": o["summary"], "details": o["details"]}
             else:
                 stages.pop(stage, None)
         if fp is not None:

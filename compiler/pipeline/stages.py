@@ -31,9 +31,13 @@ class StageOutcome:
     state: ok, failed, or skipped (the stage had nothing to do, e.g. `do_not_deploy`; it is
         never cached, and `--verify` counts it as not done unless `--allow-na`).
     summary: one line for the status table. diagnostics: what it reported (besides `job.sink`).
-    details: JSON data for status.json (figures, a protocol's file name, a pushed commit).
-    data: any value for the later stages of the same model (e.g. the test protocol);
-        stays in the worker, not recorded.
+    details: JSON data for status.json (figures, a protocol, a pushed commit); kept in the
+        model's state when the stage succeeded, so later stages see it also in a run where
+        this stage is cached.
+    data: any value for the later stages of the same model in this run; stays in the
+        worker, not recorded.
+    cached: set by the runner on the outcome of a stage that did not run because its
+        result from an earlier run still holds (then state "ok", summary, details; no data).
     """
 
     state: Literal["ok", "failed", "skipped"]
@@ -41,6 +45,7 @@ class StageOutcome:
     diagnostics: list[Diagnostic] = field(default_factory=list)
     details: dict[str, Any] = field(default_factory=dict)
     data: Any = None
+    cached: bool = False
 
 
 @dataclass
@@ -60,7 +65,7 @@ class StageJob:
     options: compile options (packages, the pipeline's defaults hook).
     sink: where the running stage reports (a fresh one per stage).
     program, robot: set by compile (or, when compile is cached, program by `ensure_program`).
-    results: outcomes of the earlier stages of this run, by name (cached ones absent).
+    results: outcomes of the earlier stages, by name (cached ones with `cached` set).
     """
 
     model: str

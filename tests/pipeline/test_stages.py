@@ -26,7 +26,8 @@ def recording_stage(job: StageJob) -> StageOutcome:
     seen = {"model": job.model, "program": job.program.modelname, "built": str(job.built),
             "out": str(job.out),
             "files": sorted(str(p.relative_to(job.built)) for p in job.built.rglob("*.urdf")),
-            "compile": job.results["compile"].state if "compile" in job.results else "cached",
+            "compile": "cached" if job.results["compile"].cached else job.results["compile"].state,
+            "compile_summary": job.results["compile"].summary,
             "mr_mention": job.pipeline.get("mr_mention"), "root": str(job.root)}
     (job.workdir / "seen.json").write_text(json.dumps(seen))
     if job.model == "na":
@@ -79,6 +80,7 @@ def test_a_stage_gets_the_program_and_files_and_is_skipped_after_a_failed_compil
     build = pipeline.parent / "build"
     assert seen == {"model": "good", "program": "good", "built": str(build / ".mpc/staging/good/out"),
                     "out": str(build / "good"), "files": ["urdf/good.urdf"], "compile": "ok",
+                    "compile_summary": "1 file, 0 meshes",
                     "mr_mention": None, "root": str(pipeline.parent)}
     assert status.exit_status() == 1
 
@@ -92,8 +94,8 @@ def test_unchanged_stages_are_cached_and_a_changed_setting_reruns_the_later_stag
     third = _run(pipeline)
     assert {s: r.state for s, r in third.models["good"].stages.items()} == {"compile": "cached", "test": "ok"}
     seen = _seen(pipeline, "good")
-    assert (seen["built"], seen["compile"], seen["mr_mention"]) == (
-        str(pipeline.parent / "build/good"), "cached", "@robots")
+    assert (seen["built"], seen["compile"], seen["compile_summary"], seen["mr_mention"]) == (
+        str(pipeline.parent / "build/good"), "cached", "1 file, 0 meshes", "@robots")
 
 
 def test_verify_counts_a_stage_that_skipped_by_its_own_choice_unless_allowed(pipeline: Path) -> None:
