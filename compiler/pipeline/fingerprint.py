@@ -140,15 +140,18 @@ class ReadRecorder:
     def _hook(self, event: str, args: tuple[Any, ...]) -> None:
         if event != "open":
             return
-        path, mode = args[0], args[1]
+        path, mode, flags = args[0], args[1], args[2]
         if not isinstance(path, str | os.PathLike):
             return
         text = os.fspath(path)
         if not isinstance(text, str):
             return
-        if isinstance(mode, str) and any(c in mode for c in "wax+"):
+        # open() gives a mode; os.open (tempfile, …) gives flags instead.
+        writes = (any(c in mode for c in "wax+") if isinstance(mode, str)
+                  else isinstance(flags, int) and bool(flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT)))
+        if writes:
             self.written.add(os.path.abspath(text))
-        elif mode is None or isinstance(mode, str):
+        else:
             self.read.setdefault(os.path.abspath(text))
 
     def inputs(self) -> list[Path]:
