@@ -156,6 +156,9 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
                                f"model definition '{name}' does not exist")
                 else:
                     front_end(model, sink, options, Severity.WARNING)
+            from mpc.compiler.pipeline.plan import check_models
+
+            check_models(path, sink)
         return
     front_end(path, sink, options, Severity.WARNING, doc=doc)
 

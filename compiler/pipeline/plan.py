@@ -99,6 +99,25 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     return Plan(path, doc, settings, root, models)
 
 
+# What `mpc check pipeline.yml` adds to checking each definition: the problems of the
+# pipeline as a whole (checking the definitions reports the rest, cycles as E0308).
+_WHOLE_PIPELINE = ("E0610", "E0612", "W0610", "W0611")
+
+
+def check_models(path: Path, sink: Sink) -> None:
+    """Report what only the pipeline as a whole shows: clashing modelnames, names that
+    cannot be folders, derived_base parents outside the pipeline, definitions listed twice."""
+    quiet = Sink()
+    plan = load_plan(path, quiet)
+    for d in quiet.diagnostics:
+        if d.code in _WHOLE_PIPELINE:
+            sink.report(d)
+    for model in plan.models.values() if plan else ():
+        for d in model.diagnostics:
+            if d.code in _WHOLE_PIPELINE:
+                sink.report(d)
+
+
 def _load_model(pipeline: Path, written: str, definition: Path, span: Span,
                 defaults: PipelineDefaults) -> tuple[PlannedModel, list[tuple[Path, Span]]]:
     """One definition, with its defaults applied, and the derived_base files it names."""

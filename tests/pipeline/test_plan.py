@@ -167,3 +167,13 @@ def test_a_modelname_that_cannot_name_a_folder(tmp_path: Path) -> None:
     assert (diag.code, diag.message, diag.hint) == (
         "E0612", "modelname 'robots/arm' cannot name an output folder",
         "a modelname is a folder name: no '/', and not starting with '.'")
+
+
+def test_check_reports_what_only_the_whole_pipeline_shows(tmp_path: Path) -> None:
+    write(tmp_path / "one.yml", _model("same"))
+    write(tmp_path / "two.yml", _model("same"))
+    write(tmp_path / "pipeline.yml", "pipeline:\n  root: .\n  model_definitions: [one.yml, two.yml]\n")
+    done = mpc("check", "pipeline.yml", cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr.splitlines()[0] == ("pipeline.yml:3:32: error[E0610]: model definitions 'one.yml' and "
+                                           "'two.yml' both build model 'same'")
