@@ -111,7 +111,9 @@ def run(args: argparse.Namespace) -> int:
         report.emit("end", exit_status=exit_status, counts=status.counts(), seconds=round(status.seconds, 3),
                     status=str(status_file))
         return exit_status
-    for name in sorted(status.models):
+    if args.format == "json":  # one list for tools
+        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
+    for name in sorted(status.models) if args.format != "json" else ():
         diagnostics = status.models[name].diagnostics()
         if diagnostics and args.format == "human":
             print(f"── {name} ({status.models[name].definition})", file=sys.stderr)

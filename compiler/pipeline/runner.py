@@ -157,7 +157,7 @@ class Runner:
         failure = self._cached_failure(name, pre)
         if failure is not None:
             self._finish_all(name, "failed", "unchanged since it failed: " + failure["summary"],
-                             diagnostics_from_json(failure["diagnostics"]))
+                             diagnostics_from_json(failure["diagnostics"]), details={"cached": True})
             return None
         cached = self._cached(name, pre)
         if len(cached) == len(self.opts.stages):
@@ -388,11 +388,12 @@ class Runner:
         return record
 
     def _finish_all(self, name: str, state: str, summary: str, diagnostics: list[Diagnostic] | None = None,
-                    blocked: bool = False) -> None:
+                    blocked: bool = False, details: dict[str, Any] | None = None) -> None:
         """The first stage gets `state`; the later ones are skipped because of it."""
         record = self.status.models.get(name) or self._record(self.plan.models[name])
         first, *rest = self.opts.stages
-        record.stages[first] = StageRecord(state, summary, diagnostics or [], blocked=blocked)
+        record.stages[first] = StageRecord(state, summary, diagnostics or [], blocked=blocked,
+                                           details=details or {})
         for stage in rest:
             record.stages[stage] = StageRecord("skipped", summary if state == "skipped" else
                                                f"{first} {_past(state)}", blocked=True)

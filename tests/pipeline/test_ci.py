@@ -89,3 +89,14 @@ def test_a_pipeline_with_errors_gets_no_ci_file(tmp_path: Path) -> None:
     assert done.returncode == 1
     assert "error[E0611]: derived_base cycle: a.yml → b.yml → a.yml" in done.stderr
     assert not (tmp_path / "w.yml").exists()
+
+
+def test_the_documented_parent_pipeline_is_valid(tmp_path: Path) -> None:
+    """specs/pipeline.md shows how a GitLab parent pipeline runs the generated child."""
+    spec = (Path(__file__).resolve().parents[2] / "specs/pipeline.md").read_text()
+    snippet = spec.split("generate:\n", 1)[1].split("```", 1)[0]
+    path = tmp_path / "parent.yml"
+    path.write_text("generate:\n" + snippet)
+    _validate(path, "vendor.gitlab-ci")
+    assert yaml.safe_load(path.read_text())["models"]["trigger"]["include"] == [
+        {"artifact": "models.yml", "job": "generate"}]

@@ -142,6 +142,7 @@ def test_second_run_rebuilds_nothing(fleet: Fleet) -> None:
     assert run.states() == {**dict.fromkeys(BUILT, "cached"), "broken": "failed", "broken_child": "skipped"}
     broken = run.status["models"]["broken"]["stages"]["compile"]
     assert broken["summary"].startswith("unchanged since it failed: E0310 remove_beyond refers to unknown")
+    assert broken["details"] == {"cached": True}
     assert broken["diagnostics"][0]["span"]["line"] == 6
     assert fleet.mtimes_after_noop == fleet.mtimes_after_cold
     assert run.returncode == 1
