@@ -18,6 +18,8 @@ import shutil
 import signal
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 from multiprocessing.connection import Connection, wait
@@ -115,7 +117,8 @@ class Runner:
                                 queue.append(decided)
                             progressed = True
                     while queue and len(self.running) < max(1, self.opts.jobs):
-                        self._start(*queue.pop(0))
+                        with _uninterrupted():  # a started worker is always in self.running
+                            self._start(*queue.pop(0))
                         progressed = True
                     if self.running:
                         self._wait()
@@ -272,11 +275,8 @@ class Runner:
             del self.running[r.model]
             # Moving the output into place and saving its state happen together or not at
             # all: an interruption waits until both are done.
-            blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
-            try:
+            with _uninterrupted():
                 self._collect(r)
-            finally:
-                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
     def _collect(self, r: _Running) -> None:
         """Record what a finished worker did; move its output into place when compile succeeded."""
@@ -403,6 +403,16 @@ class Runner:
     def _done(self, name: str) -> None:
         self.done.add(name)
         self.reporter.finished(name, self.status.models[name])
+
+
+@contextmanager
+def _uninterrupted() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM until the block is done (they are delivered after it)."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def _past(state: str) -> str:

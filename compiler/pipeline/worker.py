@@ -27,6 +27,8 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
     """The worker's body: run the stages in `run` (those in `cached` are done already)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the runner stops its workers itself
+    # The runner forks with these held (runner._uninterrupted); a worker takes them at once.
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     os.setpgid(0, 0)
     recorder = ReadRecorder(ignore).install()
     try:
