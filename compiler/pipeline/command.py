@@ -31,9 +31,8 @@ def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
 def parse_stages(text: str) -> tuple[str, ...]:
     """The stages named on the command line, with the stages they need, in run order."""
     from mpc.compiler.pipeline.runner import stages_with_needs
-    from mpc.compiler.pipeline.stages import KNOWN, STAGES, load_plugins
+    from mpc.compiler.pipeline.stages import KNOWN, STAGES
 
-    load_plugins()
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:
         raise UsageError("--stages names no stage")

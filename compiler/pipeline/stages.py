@@ -3,8 +3,15 @@
 A stage is a function `(job: StageJob) -> StageOutcome`, registered under its name with
 the stages of the same model it needs. The runner calls the selected stages in the
 order of `KNOWN` inside one worker process per model; status, skipping and caching are
-the runner's, the same for every stage. Only `compile` is registered here; `test` and
-`deploy` are plugged in by their packages (`register(Stage("test", run, needs=("compile",)))`).
+the runner's, the same for every stage. Only `compile` is registered so far. Another stage
+is an adapter here that imports its package when it runs (so `mpc check` never does):
+
+    def test_stage(job: StageJob) -> StageOutcome:
+        from mpc.checks import run_model_tests
+        protocol = run_model_tests(job.program, job.built, job.sink, workdir=job.workdir)
+        ...  # StageOutcome("ok" or "failed", summary, details={...}, data=protocol)
+
+    register(Stage("test", test_stage, needs=("compile",)))
 """
 
 from __future__ import annotations
@@ -94,16 +101,6 @@ class Stage:
 
 
 STAGES: dict[str, Stage] = {}
-# Modules that register further stages when imported (e.g. the model tests' and deployment's
-# packages); imported by `load_plugins` before a run, so `mpc check` never imports them.
-PLUGINS: tuple[str, ...] = ()
-
-
-def load_plugins() -> None:
-    import importlib
-
-    for module in PLUGINS:
-        importlib.import_module(module)
 
 
 def register(stage: Stage) -> None:
