@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import json
 import os
+import pty
+import re
+import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -212,3 +216,31 @@ def test_verify_fails_when_a_model_failed_and_passes_on_a_clean_selection(fleet:
     assert mpc("run", fleet.pipeline, "--verify", cache=fleet.cache).returncode == 1
     clean = mpc("run", fleet.pipeline, "--verify", "--only", "quad_pair", "finger", cache=fleet.cache)
     assert clean.returncode == 0, clean.stderr
+
+
+def test_on_a_terminal_a_live_display_then_the_table(fleet: Fleet) -> None:
+    """stdout and stderr on a pseudo-terminal: rich's progress display (finished models
+    printed above it), then the coloured table."""
+    main, side = pty.openpty()
+    argv = [sys.executable, "-m", "mpc.compiler.cli", "run", str(fleet.pipeline), "--only", "pendulum",
+            "finger", "--force", "-j", "2"]
+    proc = subprocess.Popen(argv, stdin=side, stdout=side, stderr=side, close_fds=True,
+                            env={**os.environ, "MPC_CACHE_DIR": str(fleet.cache), "COLUMNS": "100"})
+    os.close(side)
+    chunks = []
+    while True:
+        try:
+            data = os.read(main, 65536)
+        except OSError:  # the terminal closed: the run ended
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.close(main)
+    assert proc.wait(timeout=120) == 0
+    text = b"".join(chunks).decode("utf-8", "replace")
+    plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)
+    assert plain != text  # a live, coloured display
+    assert "2 models" in plain  # the progress bar's label
+    assert re.search(r"✓ pendulum ok \d+ files, 3 meshes", plain)
+    assert "2 models: 2 ok in" in plain
