@@ -54,6 +54,38 @@ def _parser() -> argparse.ArgumentParser:
                       help="where the ROS package NAME is (for package:// paths); repeatable")
     test.add_argument("--format", choices=("human", "gcc", "json"), default="human",
                       help="how to print diagnostics (default: human)")
+    # -- pipeline runs and CI generation (compiler/pipeline/) --
+    run = sub.add_parser("run", help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
+    run.add_argument("pipeline", type=Path, help="the pipeline file")
+    run.add_argument("--only", nargs="+", action="extend", default=[], metavar="MODEL",
+                     help="build only these models (modelnames or definition files); others' outputs stay")
+    run.add_argument("--stages", default="compile", metavar="STAGE,…",
+                     help="stages to run, comma-separated: compile, test, deploy (default: compile)")
+    run.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                     help="models built at once (default: the number of cores)")
+    run.add_argument("--force", action="store_true", help="rebuild even what is unchanged")
+    run.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
+    run.add_argument("--verify", action="store_true",
+                     help="fail unless every selected stage of every selected model is ok or cached")
+    run.add_argument("--allow-na", action="store_true",
+                     help="with --verify: stages that skipped by their own choice (not applicable) pass")
+    run.add_argument("--log-format", choices=("text", "json"), default="text",
+                     help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
+    ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
+    ci.add_argument("system", choices=("gitlab", "github"),
+                    help="gitlab: a child pipeline; github: a workflow")
+    ci.add_argument("pipeline", type=Path, help="the pipeline file")
+    ci.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
+    ci.add_argument("--stages", default="compile", metavar="STAGE,…", help="stages each job runs")
+    ci.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container)")
+    ci.add_argument("--setup", default="pip install model-pipeline-compiler",
+                    help="command that installs mpc in a job (default: %(default)s)")
+    for p in (run,):
+        p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                       help="where the ROS package NAME is (for package:// paths); repeatable")
+        p.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                       help="how to print diagnostics (default: human)")
+        p.add_argument("--werror", action="store_true", help="treat warnings as errors")
     for p in (check,):
         p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
                        help="where the ROS package NAME is (for package:// paths); repeatable")
@@ -171,11 +203,18 @@ def _test(args: argparse.Namespace) -> int:
     return 1 if protocol.failed else 0
 
 
+def _pipeline(args: argparse.Namespace) -> int:
+    """`mpc run` and `mpc ci` (compiler/pipeline/command.py)."""
+    from mpc.compiler.pipeline import command
+
+    return command.run(args) if args.command == "run" else command.ci(args)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         return {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
-                "deploy": _deploy}[args.command](args)
+                "deploy": _deploy, "run": _pipeline, "ci": _pipeline}[args.command](args)
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # a bug in mpc, not a user mistake

@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -35,6 +36,11 @@ class Options:
 
     out: Path | None = None
     resolver: PackageResolver = field(default_factory=PackageResolver)
+    # Pipeline runs (compiler/pipeline/): the pipeline's defaults, applied to each definition
+    # after its own defaults chain; and where the output goes once the runner moves it from
+    # `out` (a staging folder) into place, which post_processing commands see as their target.
+    defaults: Callable[[source.Document], source.Document] | None = None
+    target: Path | None = None
 
 
 @dataclass
@@ -59,6 +65,8 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     doc = inherit.resolve(doc, path, sink)                                # merge defaults
     if doc is None:
         return None
+    if options.defaults is not None:
+        doc = options.defaults(doc)                                       # pipeline defaults
     ast = schema.validate(doc, sink)                                      # validate schema
     if ast is None:
         return None
@@ -138,6 +146,9 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
     if isinstance(doc.data, dict) and "pipeline" in doc.data:
         pipeline = schema.validate_pipeline(doc, sink)
         if pipeline is not None:
+            from mpc.compiler.pipeline.defaults import PipelineDefaults
+
+            options = replace(options, defaults=PipelineDefaults(doc))
             for i, name in enumerate(pipeline.pipeline.model_definitions):
                 model = (path.resolve().parent / name)
                 if not model.is_file():
@@ -145,11 +156,14 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
                                f"model definition '{name}' does not exist")
                 else:
                     front_end(model, sink, options, Severity.WARNING)
+            from mpc.compiler.pipeline.plan import check_models
+
+            check_models(path, sink)
         return
     front_end(path, sink, options, Severity.WARNING, doc=doc)
 
 
-def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
+def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | None = None) -> bool:
     """Write every export into a fresh folder next to `out`, then swap it into place."""
     from mpc.backends import BACKENDS
 
@@ -168,7 +182,7 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink) -> bool:
             if isinstance(export, CommandExport):
                 from mpc.backends.commands import run
 
-                if sink.has_errors() or not run(export, staging, out, sink):
+                if sink.has_errors() or not run(export, staging, target or out, sink):
                     break  # the files a command would see are incomplete, or it failed
                 continue
             model, folder = robot, staging
@@ -229,6 +243,6 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     if result.robot is None:
         return result
     out = options.out or Path("build") / result.program.modelname
-    if emit(result.program, result.robot, out, sink):    # emit, rename into place
+    if emit(result.program, result.robot, out, sink, options.target):  # emit, rename into place
         result.out = out
     return result

@@ -1,0 +1,167 @@
+"""`mpc run` and `mpc ci`: command-line arguments → a run or a CI file; diagnostics, the
+status table and the exit status (0 ok, 1 a model failed, 2 bad command line, 3 a bug,
+130 interrupted)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+from pathlib import Path
+
+from mpc.compiler import render
+from mpc.compiler.diagnostics import Diagnostic, Severity, Sink, did_you_mean
+from mpc.compiler.pipeline.plan import Plan, load_plan
+
+
+class UsageError(Exception):
+    """A command line that cannot be run (exit status 2)."""
+
+
+def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
+    if not diagnostics:
+        return
+    if fmt == "json":
+        print(render.as_json(diagnostics), file=sys.stderr)
+    else:
+        print((render.gcc if fmt == "gcc" else render.human)(diagnostics), file=sys.stderr)
+
+
+def parse_stages(text: str) -> tuple[str, ...]:
+    """The stages named on the command line, with the stages they need, in run order."""
+    from mpc.compiler.pipeline.runner import stages_with_needs
+    from mpc.compiler.pipeline.stages import KNOWN, STAGES
+
+    names = [s.strip() for s in text.split(",") if s.strip()]
+    if not names:
+        raise UsageError("--stages names no stage")
+    for name in names:
+        if name not in KNOWN:
+            raise UsageError(f"unknown stage '{name}'{did_you_mean(name, set(KNOWN))} "
+                             f"(stages: {', '.join(KNOWN)})")
+        if name not in STAGES:
+            raise UsageError(f"stage '{name}' is not available")
+    return stages_with_needs(tuple(names))
+
+
+def select(plan: Plan, only: list[str]) -> tuple[str, ...]:
+    """The models named by `--only`: modelnames, or definition files as the pipeline writes
+    them or as paths from here."""
+    out = []
+    by_file = {m.definition: name for name, m in plan.models.items()}
+    for word in only:
+        if word in plan.models:
+            out.append(word)
+            continue
+        match = next((n for n, m in plan.models.items() if word == m.written), None)
+        match = match or by_file.get(Path(word).resolve())
+        if match is None:
+            near = did_you_mean(word, set(plan.models))
+            raise UsageError(f"--only: no model '{word}' in '{plan.file}'{near}")
+        out.append(match)
+    return tuple(dict.fromkeys(out))
+
+
+def _load(args: argparse.Namespace, sink: Sink) -> Plan | None:
+    plan = load_plan(args.pipeline, sink)
+    _print_diagnostics(sink.diagnostics, getattr(args, "format", "human"))
+    return plan
+
+
+def run(args: argparse.Namespace) -> int:
+    """`mpc run PIPELINE`."""
+    from mpc.compiler.pipeline import progress
+    from mpc.compiler.pipeline.runner import Runner, RunOptions
+    from mpc.compiler.pipeline.status import plain_table
+    from mpc.compiler.pipeline.store import BuildFolderBusy
+
+    sink = Sink(werror=args.werror)
+    plan = _load(args, sink)
+    if plan is None:
+        return 1
+    try:
+        stages = parse_stages(args.stages)
+        only = select(plan, args.only)
+        jobs = args.jobs if args.jobs is not None else os.cpu_count() or 1
+        if jobs < 1:
+            raise UsageError("-j needs at least 1")
+    except UsageError as e:
+        print(f"mpc run: error: {e}", file=sys.stderr)
+        return 2
+    opts = RunOptions(stages=stages, only=only, jobs=jobs, force=args.force,
+                      build=args.out.resolve() if args.out else None,
+                      package_map={name: folder for name, folder in args.package}, werror=args.werror)
+    report = progress.reporter(args.log_format)
+    runner = Runner(plan, opts, report)
+    previous = signal.signal(signal.SIGTERM, _interrupt)  # a stopped run stops its workers first
+    try:
+        status = runner.run()
+    except BuildFolderBusy as e:
+        print(f"mpc run: error: another `mpc run` is using the build folder '{e}'", file=sys.stderr)
+        return 1
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        report.close()
+    exit_status = status.exit_status(args.verify, args.allow_na)
+    status_file = runner.store.meta / "status.json"
+    if args.log_format == "json":
+        assert isinstance(report, progress.JsonLog)
+        report.emit("end", exit_status=exit_status, counts=status.counts(), seconds=round(status.seconds, 3),
+                    status=str(status_file))
+        return exit_status
+    if args.format == "json":  # one list for tools
+        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
+    for name in sorted(status.models) if args.format != "json" else ():
+        diagnostics = status.models[name].diagnostics()
+        if diagnostics and args.format == "human":
+            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
+        _print_diagnostics(diagnostics, args.format)
+    if sys.stdout.isatty():
+        progress.rich_table(status)
+    else:
+        print(plain_table(status))
+    print(f"status: {status_file}")
+    return exit_status
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+def ci(args: argparse.Namespace) -> int:
+    """`mpc ci gitlab|github PIPELINE`."""
+    from mpc.compiler.pipeline import ci as generate
+
+    sink = Sink()
+    plan = _load(args, sink)
+    if plan is None:
+        return 1
+    try:
+        stages = parse_stages(args.stages)
+    except UsageError as e:
+        print(f"mpc ci: error: {e}", file=sys.stderr)
+        return 2
+    errors = [d for m in plan.models.values() for d in m.diagnostics if d.severity is Severity.ERROR]
+    if errors:
+        _print_diagnostics(errors, "human")
+        print("mpc ci: error: the pipeline has errors; no CI file was written", file=sys.stderr)
+        return 1
+    here = Path.cwd()
+    build = os.path.relpath(plan.root / "build", here)
+    pipeline = os.path.relpath(args.pipeline.resolve(), here)
+    if build.startswith(".."):
+        print(f"mpc ci: error: the build folder '{plan.root / 'build'}' is outside the current folder, "
+              "where CI jobs keep their artifacts; run `mpc ci` from the project's top folder, or set "
+              "the pipeline's `root` inside it", file=sys.stderr)
+        return 1
+    command = " ".join(["mpc", "ci", args.system, pipeline])
+    text = (generate.gitlab if args.system == "gitlab" else generate.github)(
+        plan, pipeline, build, stages, args.image, args.setup, command)
+    if args.output is None:
+        sys.stdout.write(text)
+    else:
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        args.output.write_text(text, encoding="utf-8")
+        print(f"wrote {args.output}: {len(plan.models)} jobs")
+    return 0

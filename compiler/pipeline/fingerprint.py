@@ -1,0 +1,172 @@
+"""What a model's build depends on → fingerprints; and the files a build read, recorded.
+
+A model's fingerprint hashes: mpc's version (with a hash of its own source files, so an
+edited checkout counts as a new version), the definition after inheritance and pipeline
+defaults, how packages are found, the parents' fingerprints, and the content of every
+file the build read (input models, meshes, submechanism files). Files are compared by
+size and modification time first and re-hashed only when those differ, so `touch` alone
+rebuilds nothing and a no-op run hashes nothing.
+
+The files a build reads are found with an audit hook on `open` in the worker process
+(`ReadRecorder`), so a new reader cannot forget to declare its inputs. Not seen: files
+that programs started by `post_processing` read (they are other processes).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from collections.abc import Iterable
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+# File types that are code, not inputs: modules imported while building.
+_CODE_SUFFIXES = frozenset({".py", ".pyc", ".so", ".pyd", ".pth", ".pyi", ".typed", ".lark"})
+_SYSTEM = ("/proc/", "/sys/", "/dev/", "/etc/")
+
+
+def digest(*parts: str) -> str:
+    h = hashlib.sha256()
+    for part in parts:
+        h.update(part.encode())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def data_digest(data: Any) -> str:
+    """A digest of YAML data, independent of key order in the file."""
+    return digest(json.dumps(data, sort_keys=True, separators=(",", ":"), default=str))
+
+
+def file_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+@cache
+def mpc_version() -> str:
+    """mpc's version and a digest of its source files (compiler, ir, backends, grammar, …)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    import mpc.compiler
+
+    try:
+        ver = version("model-pipeline-compiler")
+    except PackageNotFoundError:  # running from a checkout without installing
+        ver = "unknown"
+    h = hashlib.sha256(ver.encode())
+    top = Path(mpc.compiler.__file__).resolve().parent.parent
+    for folder in sorted(top.iterdir()):
+        if not (folder / "__init__.py").is_file() and folder.name != "grammar":
+            continue
+        for file in sorted(folder.rglob("*")):
+            if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts:
+                h.update(str(file.relative_to(top)).encode())
+                h.update(file.read_bytes())
+    return f"{ver}+{h.hexdigest()[:16]}"
+
+
+MISSING = "missing"  # the digest of a file the build looked for and did not find
+
+
+def dep_entry(path: Path) -> list[Any] | None:
+    """[path, size, mtime_ns, sha256] of a file; [path, -1, 0, "missing"] when there is no such
+    file (a build that failed on it runs again once it appears); None when it cannot be read."""
+    try:
+        st = os.stat(path)
+        return [str(path), st.st_size, st.st_mtime_ns, file_digest(path)]
+    except FileNotFoundError:
+        return [str(path), -1, 0, MISSING]
+    except OSError:
+        return None
+
+
+def deps_current(deps: list[list[Any]]) -> list[list[Any]] | None:
+    """The recorded deps, refreshed where only the time changed; None when a file's content
+    changed or the file is gone."""
+    out = []
+    for path, size, mtime, sha in deps:
+        try:
+            st = os.stat(path)
+        except OSError:
+            if sha == MISSING and not os.path.lexists(path):
+                out.append([path, size, mtime, sha])
+                continue
+            return None
+        if sha == MISSING:
+            return None
+        if st.st_size == size and st.st_mtime_ns == mtime:
+            out.append([path, size, mtime, sha])
+            continue
+        if st.st_size != size:
+            return None
+        entry = dep_entry(Path(path))
+        if entry is None or entry[3] != sha:
+            return None
+        out.append(entry)
+    return out
+
+
+def with_deps(pre: str, deps: Iterable[list[Any]]) -> str:
+    """The fingerprint: the part known before building plus the content of what it read."""
+    return digest(pre, *(f"{d[0]}\0{d[3]}" for d in sorted(deps)))
+
+
+class ReadRecorder:
+    """Records the files opened for reading in this process (an audit hook; install once per
+    worker process, since audit hooks cannot be removed).
+
+    ignore: folders whose files are not inputs (outputs, caches of derived data).
+    """
+
+    def __init__(self, ignore: Iterable[Path]) -> None:
+        self.ignore = tuple(str(p.resolve()) + os.sep for p in ignore)
+        self.read: dict[str, None] = {}
+        self.written: set[str] = set()
+        # The Python installation holds code; its `share/` folders hold data (robot packages).
+        self.code = tuple({os.path.realpath(p) + os.sep for p in (sys.prefix, sys.base_prefix,
+                                                                    sys.exec_prefix)})
+
+    def install(self) -> ReadRecorder:
+        sys.addaudithook(self._hook)
+        return self
+
+    def _hook(self, event: str, args: tuple[Any, ...]) -> None:
+        if event != "open":
+            return
+        path, mode, flags = args[0], args[1], args[2]
+        if not isinstance(path, str | os.PathLike):
+            return
+        text = os.fspath(path)
+        if not isinstance(text, str):
+            return
+        # open() gives a mode; os.open (tempfile, …) gives flags instead.
+        writes = (any(c in mode for c in "wax+") if isinstance(mode, str)
+                  else isinstance(flags, int) and bool(flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT)))
+        if writes:
+            self.written.add(os.path.abspath(text))
+        else:
+            self.read.setdefault(os.path.abspath(text))
+
+    def inputs(self) -> list[Path]:
+        """The files read that are inputs of the build (see the filters above)."""
+        out = []
+        for text in self.read:
+            if text in self.written or text.startswith(_SYSTEM) or text.startswith(self.ignore):
+                continue
+            path = Path(text)
+            if path.suffix in _CODE_SUFFIXES or any(p.endswith(".dist-info") or p == "__pycache__"
+                                                    for p in path.parts):
+                continue
+            real = os.path.realpath(text)
+            if real.startswith(self.code) and f"{os.sep}share{os.sep}" not in real:
+                continue
+            if path.is_file() or not path.exists():
+                out.append(path)
+        return sorted(set(out))

@@ -1,0 +1,193 @@
+"""pipeline.yml → the plan of a run: the settings, the folders, and each model's definition
+(after its defaults chain and the pipeline's defaults) with its derived_base edges.
+
+Only YAML is read here: no input model, no lowering, so planning stays fast enough for a
+no-op run. Problems of one model (a missing file, a cycle, a clashing modelname) are kept
+with that model, which then fails without stopping the others.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mpc.compiler import inherit, source
+from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
+from mpc.compiler.pipeline import dag
+from mpc.compiler.pipeline.defaults import PipelineDefaults
+from mpc.compiler.source import Document
+from mpc.ir.span import Span
+
+
+@dataclass
+class PlannedModel:
+    """One entry of `model_definitions`.
+
+    name: its modelname (the output folder's name); the file's stem when it has none.
+    definition: the definition file (absolute). written: the path as the pipeline writes it.
+    span: that entry in pipeline.yml. data: the definition after its defaults chain and the
+    pipeline's defaults (None when it could not be loaded). parents: the names of the
+    pipeline's models it takes as derived_base. diagnostics: what planning found.
+    """
+
+    name: str
+    definition: Path
+    written: str
+    span: Span
+    data: Any = None
+    parents: tuple[str, ...] = ()
+    parent_spans: dict[str, Span] = field(default_factory=dict)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+    @property
+    def failed(self) -> bool:
+        return any(d.severity is Severity.ERROR for d in self.diagnostics)
+
+
+@dataclass
+class Plan:
+    """A loaded pipeline file: its path, document, settings (the `pipeline` mapping), the
+    workspace root and the models in the file's order."""
+
+    file: Path
+    doc: Document
+    settings: dict[str, Any]
+    root: Path
+    models: dict[str, PlannedModel]
+
+    @property
+    def defaults(self) -> PipelineDefaults:
+        return PipelineDefaults(self.doc)
+
+    def parents(self) -> dict[str, tuple[str, ...]]:
+        return {name: m.parents for name, m in self.models.items()}
+
+
+def load_plan(path: Path, sink: Sink) -> Plan | None:
+    """The plan of the pipeline file at `path`; None (errors in `sink`) when the file itself
+    is unusable. Problems of single models stay with those models."""
+    from mpc.compiler import schema
+
+    doc = source.load(path, sink)
+    if doc is None or schema.validate_pipeline(doc, sink) is None:
+        return None
+    settings = doc.data["pipeline"]
+    # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
+    root = (path.resolve().parent / os.path.expandvars(settings.get("root", ".."))).resolve()
+    defaults = PipelineDefaults(doc)
+    by_file: dict[Path, PlannedModel] = {}
+    derived: dict[Path, list[tuple[Path, Span]]] = {}
+    for i, written in enumerate(settings["model_definitions"]):
+        span = doc.value_span(("pipeline", "model_definitions", i))
+        definition = (path.resolve().parent / written).resolve()
+        if definition in by_file:
+            sink.warning(span, "W0611", f"model definition '{written}' is listed twice; it is built once",
+                         notes=((by_file[definition].span, "first listed here"),))
+            continue
+        model, parents = _load_model(path, written, definition, span, defaults)
+        by_file[definition] = model
+        derived[definition] = parents
+    _link(by_file, derived)
+    models: dict[str, PlannedModel] = {}
+    for model in by_file.values():
+        _check_name(model, models)
+        models.setdefault(model.name, model)
+    _break_cycles(models)
+    return Plan(path, doc, settings, root, models)
+
+
+# What `mpc check pipeline.yml` adds to checking each definition: the problems of the
+# pipeline as a whole (checking the definitions reports the rest, cycles as E0308).
+_WHOLE_PIPELINE = ("E0610", "E0612", "W0610", "W0611")
+
+
+def check_models(path: Path, sink: Sink) -> None:
+    """Report what only the pipeline as a whole shows: clashing modelnames, names that
+    cannot be folders, derived_base parents outside the pipeline, definitions listed twice."""
+    quiet = Sink()
+    plan = load_plan(path, quiet)
+    for d in quiet.diagnostics:
+        if d.code in _WHOLE_PIPELINE:
+            sink.report(d)
+    for model in plan.models.values() if plan else ():
+        for d in model.diagnostics:
+            if d.code in _WHOLE_PIPELINE:
+                sink.report(d)
+
+
+def _load_model(pipeline: Path, written: str, definition: Path, span: Span,
+                defaults: PipelineDefaults) -> tuple[PlannedModel, list[tuple[Path, Span]]]:
+    """One definition, with its defaults applied, and the derived_base files it names."""
+    sink = Sink()
+    model = PlannedModel(Path(written).stem, definition, written, span)
+    display = os.path.normpath(os.path.join(os.path.dirname(str(pipeline)), written))
+    if not definition.is_file():
+        sink.error(span, "E0601", f"model definition '{written}' does not exist")
+        model.diagnostics = sink.diagnostics
+        return model, []
+    doc = source.load(definition, sink, display=display, origin=span)
+    doc = inherit.resolve(doc, definition, sink) if doc is not None else None
+    if doc is not None:
+        doc = defaults(doc)
+        model.data = doc.data
+    model.diagnostics = sink.diagnostics
+    spec = doc.data.get("model") if doc is not None and isinstance(doc.data, dict) else None
+    if not isinstance(spec, dict):
+        return model, []
+    if isinstance(spec.get("modelname"), str) and spec["modelname"]:
+        model.name = spec["modelname"]
+    parents = []
+    inputs = spec.get("input_models")
+    for key, entry in (inputs.items() if isinstance(inputs, dict) else ()):
+        if isinstance(entry, dict) and isinstance(entry.get("derived_base"), str):
+            at = doc.value_span(("model", "input_models", key, "derived_base"))
+            # Relative to the file that wrote it (a defaults file, or the definition).
+            folder = Path(at.file).resolve().parent if at.file else definition.parent
+            parents.append(((folder / entry["derived_base"]).resolve(), at))
+    return model, parents
+
+
+def _link(by_file: dict[Path, PlannedModel], derived: dict[Path, list[tuple[Path, Span]]]) -> None:
+    """Turn derived_base files into edges between models; warn about parents outside the pipeline."""
+    for definition, parents in derived.items():
+        model = by_file[definition]
+        names = []
+        for parent, at in parents:
+            if parent in by_file:
+                names.append(by_file[parent].name)
+                model.parent_spans.setdefault(by_file[parent].name, at)
+            else:
+                model.diagnostics.append(Diagnostic(
+                    Severity.WARNING, "W0610", f"derived_base '{parent.name}' is not one of the pipeline's "
+                    "model_definitions; it is compiled in memory for this model but not built on its own",
+                    at))
+        model.parents = tuple(dict.fromkeys(names))
+
+
+def _check_name(model: PlannedModel, seen: dict[str, PlannedModel]) -> None:
+    name = model.name
+    if name in seen:
+        model.diagnostics.append(Diagnostic(
+            Severity.ERROR, "E0610", f"model definitions '{seen[name].written}' and '{model.written}' "
+            f"both build model '{name}'", model.span, notes=((seen[name].span, "the other one"),),
+            hint="give each definition its own modelname"))
+        model.name = f"{name} ({model.written})"  # kept apart so its status can be reported
+    elif name in (".", "..") or "/" in name or "\\" in name or name.startswith("."):
+        model.diagnostics.append(Diagnostic(
+            Severity.ERROR, "E0612", f"modelname '{name}' cannot name an output folder", model.span,
+            hint="a modelname is a folder name: no '/', and not starting with '.'"))
+
+
+def _break_cycles(models: dict[str, PlannedModel]) -> None:
+    """Fail every model on a derived_base cycle, naming the loop; the edges stay, so the
+    models that depend on the cycle are skipped."""
+    for loop in dag.cycles({n: m.parents for n, m in models.items()}):
+        text = " → ".join(models[n].written for n in loop)
+        for name, parent in itertools.pairwise(loop):
+            model = models[name]
+            model.diagnostics.append(Diagnostic(
+                Severity.ERROR, "E0611", f"derived_base cycle: {text}",
+                model.parent_spans.get(parent, model.span)))

@@ -1,0 +1,445 @@
+"""A plan and run options → every selected model built (or found cached), in DAG order, in
+parallel worker processes; the run's status.
+
+A model starts when its parents in the selection have finished. A model whose parent
+failed (or was skipped) is skipped with that reason; the others go on. Before starting a
+model the runner compares its fingerprint with the state of its last build and skips the
+stages that are unchanged. A worker builds into a staging folder; the runner moves the
+result into place only after the worker succeeded, so a failed, killed or interrupted
+build leaves the previous output as it was.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import shutil
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from functools import cached_property
+from multiprocessing.connection import Connection, wait
+from multiprocessing.process import BaseProcess
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+from mpc.compiler.diagnostics import Diagnostic, Severity
+from mpc.compiler.pipeline import dag
+from mpc.compiler.pipeline.fingerprint import data_digest, deps_current, digest, mpc_version, with_deps
+from mpc.compiler.pipeline.plan import Plan, PlannedModel
+from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome
+from mpc.compiler.pipeline.status import (
+    ModelRecord,
+    RunStatus,
+    StageRecord,
+    diagnostics_from_json,
+    diagnostics_json,
+)
+from mpc.compiler.pipeline.store import Store
+from mpc.ir.span import Span
+
+if TYPE_CHECKING:
+    from mpc.compiler.driver import Options
+
+
+@dataclass
+class RunOptions:
+    """What to run: the stages (each with the stages it needs), the models (`only`; empty:
+    all), how many workers, whether to ignore the cache, the build folder (None:
+    `<root>/build`), package folders, and whether warnings fail a stage."""
+
+    stages: tuple[str, ...] = ("compile",)
+    only: tuple[str, ...] = ()
+    jobs: int = field(default_factory=lambda: os.cpu_count() or 1)
+    force: bool = False
+    build: Path | None = None
+    package_map: dict[str, Path] = field(default_factory=dict)
+    werror: bool = False
+
+
+class Reporter(Protocol):
+    """Progress of a run (compiler/pipeline/progress.py)."""
+
+    def planned(self, status: RunStatus, models: list[str]) -> None: ...
+    def started(self, model: str, pid: int) -> None: ...
+    def finished(self, model: str, record: ModelRecord) -> None: ...
+    def tick(self) -> None: ...
+    def close(self) -> None: ...
+
+
+@dataclass
+class _Running:
+    model: str
+    process: BaseProcess
+    conn: Connection
+    pre: str
+    run: list[str]
+    cached: list[str]
+    started: float
+    message: dict[str, Any] | None = None
+
+
+class Runner:
+    """Runs one plan once (see the module docstring)."""
+
+    def __init__(self, plan: Plan, opts: RunOptions, reporter: Reporter) -> None:
+        self.plan, self.opts, self.reporter = plan, opts, reporter
+        self.store = Store(opts.build or plan.root / "build")
+        self.parents = plan.parents()
+        self.selected = [n for n in plan.models if not opts.only or n in opts.only]
+        self.status = RunStatus(str(plan.file), opts.stages, opts.jobs)
+        self.fingerprints: dict[str, str | None] = {}  # compile fingerprints of finished models
+        self.done: set[str] = set()
+        self.running: dict[str, _Running] = {}
+
+    # -- the loop ----------------------------------------------------------------------------
+
+    def run(self) -> RunStatus:
+        start = time.perf_counter()
+        self.store.lock()
+        try:
+            weight = dag.weights(self.parents)
+            waiting = sorted(self.selected, key=lambda n: -weight[n])
+            self.reporter.planned(self.status, waiting)
+            queue: list[tuple[str, str, list[str]]] = []
+            try:
+                while waiting or queue or self.running:
+                    progressed = False
+                    for name in list(waiting):
+                        if self._ready(name):
+                            waiting.remove(name)
+                            decided = self._decide(name)
+                            if decided is not None:
+                                queue.append(decided)
+                            progressed = True
+                    while queue and len(self.running) < max(1, self.opts.jobs):
+                        with _uninterrupted():  # a started worker is always in self.running
+                            self._start(*queue.pop(0))
+                        progressed = True
+                    if self.running:
+                        self._wait()
+                    elif not progressed and waiting:  # cannot happen: parents always finish
+                        for name in waiting:
+                            self._finish_all(name, "skipped", "its parents never finished", blocked=True)
+                        waiting.clear()
+                    self.reporter.tick()
+            except KeyboardInterrupt:
+                self._interrupt()
+        finally:
+            self.status.seconds = time.perf_counter() - start
+            self.store.save_status(self.status.to_json())
+            self.store.unlock()
+        return self.status
+
+    def _ready(self, name: str) -> bool:
+        model = self.plan.models[name]
+        return model.failed or all(p not in self.selected or p in self.done for p in model.parents)
+
+    # -- deciding: fail, skip, cached, or build ---------------------------------------------
+
+    def _decide(self, name: str) -> tuple[str, str, list[str]] | None:
+        """Finish the model now (failed in planning, blocked, cached) or return what to build."""
+        model = self.plan.models[name]
+        record = self._record(model)
+        if model.failed:
+            errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
+            self._finish_all(name, "failed", _first(errors), diagnostics=errors)
+            return None
+        for parent in model.parents:
+            if parent in self.selected and self.fingerprints.get(parent) is None:
+                state = self.status.models[parent].stages[self.opts.stages[0]].state
+                self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
+                return None
+        packages = repr(sorted((k, str(v)) for k, v in self.opts.package_map.items()))
+        pre = digest(mpc_version(), data_digest(model.data), packages, str(self.opts.werror),
+                     *(f"{p}={self._fingerprint_of(p)}" for p in sorted(model.parents)))
+        failure = self._cached_failure(name, pre)
+        if failure is not None:
+            self._finish_all(name, "failed", "unchanged since it failed: " + failure["summary"],
+                             diagnostics_from_json(failure["diagnostics"]), details={"cached": True})
+            return None
+        cached = self._cached(name, pre)
+        if len(cached) == len(self.opts.stages):
+            state = self.store.state(name)
+            for stage in self.opts.stages:
+                record.stages[stage] = StageRecord("cached",
+                                                   fingerprint=state["stages"][stage]["fingerprint"])
+            self.fingerprints[name] = state["fingerprint"]
+            self._done(name)
+            return None
+        return name, pre, cached
+
+    def _cached_failure(self, name: str, pre: str) -> dict[str, Any] | None:
+        """The model's last compile failure, when nothing it depends on changed since: compiling
+        is deterministic, so it would fail again the same way."""
+        failure = self.store.state(name).get("failure")
+        if self.opts.force or not isinstance(failure, dict) or failure.get("pre") != pre:
+            return None
+        return failure if deps_current(failure.get("deps", [])) is not None else None
+
+    def _cached(self, name: str, pre: str) -> list[str]:
+        """The selected stages whose result from an earlier run still holds."""
+        state = self.store.state(name)
+        stages = state.get("stages", {})
+        if self.opts.force or state.get("pre") != pre or "compile" not in stages:
+            return []
+        if not self.store.output(name).is_dir():
+            return []
+        deps = deps_current(state.get("deps", []))
+        if deps is None:
+            return []
+        if deps != state["deps"]:  # only times changed: remember them, so the next run stats only
+            self.store.save_state(name, {**state, "deps": deps})
+        fp = state["fingerprint"]
+        return [s for s in self.opts.stages
+                if s == "compile" or stages.get(s, {}).get("fingerprint") == self._stage_fingerprint(fp, s)]
+
+    def _stage_fingerprint(self, compile_fp: str, stage: str) -> str:
+        if stage == "compile":
+            return compile_fp
+        return digest(compile_fp, stage, data_digest(self.plan.settings))
+
+    def _fingerprint_of(self, parent: str) -> str:
+        """A parent's compile fingerprint: from this run, else from its last build."""
+        if parent in self.fingerprints and self.fingerprints[parent] is not None:
+            return str(self.fingerprints[parent])
+        state = self.store.state(parent)
+        if isinstance(state.get("fingerprint"), str):
+            return state["fingerprint"]
+        return "unbuilt:" + data_digest(self.plan.models[parent].data)
+
+    # -- workers -----------------------------------------------------------------------------
+
+    @cached_property
+    def options(self) -> Options:
+        """Compile options of every worker (made when the first one starts: a run where all
+        is cached never imports the compiler)."""
+        from mpc.backends.packages import PackageResolver
+        from mpc.compiler.driver import Options
+
+        return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
+                       defaults=self.plan.defaults)
+
+    def _start(self, name: str, pre: str, cached: list[str]) -> None:
+        from mpc.compiler.cache import cache_dir
+        from mpc.compiler.pipeline import worker
+
+        _preload()
+        model = self.plan.models[name]
+        shutil.rmtree(self.store.staging(name), ignore_errors=True)
+        self.store.staging(name).mkdir(parents=True)
+        self.store.workdir(name).mkdir(parents=True, exist_ok=True)
+        job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
+                       staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
+                       pipeline=self.plan.settings, root=self.plan.root, options=self.options)
+        done = self.store.state(name).get("stages", {})
+        for stage in cached:
+            kept = done.get(stage, {})
+            job.results[stage] = StageOutcome("ok", kept.get("summary", ""), details=kept.get("details", {}),
+                                              cached=True)
+        run = [s for s in self.opts.stages if s not in cached]
+        sys.stdout.flush()  # a forked worker must not write out what the runner had buffered
+        sys.stderr.flush()
+        ctx = multiprocessing.get_context("fork")
+        receive, send = ctx.Pipe(duplex=False)
+        ignore = [self.store.build.resolve(), cache_dir("x").parent]
+        process = ctx.Process(target=worker.main, name=f"mpc {name}",
+                              args=(job, run, cached, send, ignore, self.opts.werror))
+        process.start()
+        send.close()
+        self.running[name] = _Running(name, process, receive, pre, run, cached, time.perf_counter())
+        self.reporter.started(name, process.pid or 0)
+
+    def _wait(self) -> None:
+        handles: dict[Any, _Running] = {}
+        for r in self.running.values():
+            handles[r.conn] = r
+            handles[r.process.sentinel] = r
+        for ready in wait(list(handles), timeout=0.1):
+            r = handles[ready]
+            if r.model not in self.running:
+                continue
+            if ready is r.conn:
+                try:
+                    r.message = r.conn.recv()
+                except (EOFError, OSError):
+                    pass  # the worker died before it could tell; its exit status says how
+                else:
+                    continue  # the worker exits right after sending
+            r.process.join()
+            r.conn.close()
+            del self.running[r.model]
+            # Moving the output into place and saving its state happen together or not at
+            # all: an interruption waits until both are done.
+            with _uninterrupted():
+                self._collect(r)
+
+    def _collect(self, r: _Running) -> None:
+        """Record what a finished worker did; move its output into place when compile succeeded."""
+        self._end_group(r.process.pid)
+        name, model = r.model, self.plan.models[r.model]
+        record = self.status.models[name]
+        message = r.message
+        if message is None or "internal_error" in message:
+            if message is None:
+                code = r.process.exitcode or 0
+                why = (f"was stopped by signal {signal.Signals(-code).name}" if code < 0
+                       else f"ended with exit status {code} without a result")
+                diag = Diagnostic(Severity.ERROR, "E0613", f"the build of model '{name}' {why}; "
+                                  "its previous output is unchanged", Span.of_file(str(model.definition)))
+            else:
+                self.status.internal_error = True
+                diag = Diagnostic(Severity.ERROR, "E0614", f"mpc failed while building model '{name}' "
+                                  f"(a bug in mpc, please report it): {message['internal_error']}",
+                                  Span.of_file(str(model.definition)), notes=((None, message["traceback"]),))
+            for stage in r.cached:
+                record.stages[stage] = StageRecord("cached")
+            record.stages[r.run[0]] = StageRecord("failed", diag.message, [diag],
+                                                  seconds=time.perf_counter() - r.started)
+            for stage in r.run[1:]:
+                record.stages[stage] = StageRecord("skipped", f"{r.run[0]} did not finish", blocked=True)
+            cached_fp = self.store.state(name).get("fingerprint")
+            self.fingerprints[name] = cached_fp if "compile" in r.cached else None
+            self._discard(name)
+            self._done(name)
+            return
+        self._record_outcomes(r, message)
+        self._discard(name)
+        self._done(name)
+
+    def _record_outcomes(self, r: _Running, message: dict[str, Any]) -> None:
+        from mpc.compiler.driver import _replace  # the same swap `mpc compile` does
+
+        name = r.model
+        record = self.status.models[name]
+        outcomes: dict[str, dict[str, Any]] = message["outcomes"]
+        state = self.store.state(name) if "compile" in r.cached else {}
+        compiled = outcomes.get("compile", {}).get("state") == "ok"
+        if compiled:
+            _replace(self.store.staging(name) / "out", self.store.output(name))
+            state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
+                     "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
+                     "mpc": mpc_version(), "stages": {}}
+        fp = state.get("fingerprint") if (compiled or "compile" in r.cached) else None
+        self.fingerprints[name] = fp
+        stages = dict(state.get("stages", {}))
+        for stage in self.opts.stages:
+            if stage in r.cached:
+                record.stages[stage] = StageRecord("cached",
+                                                   fingerprint=stages.get(stage, {}).get("fingerprint"))
+                continue
+            o = outcomes[stage]
+            if o["details"].get("internal_error"):
+                self.status.internal_error = True
+            sfp = self._stage_fingerprint(fp, stage) if fp else None
+            record.stages[stage] = StageRecord(
+                o["state"], o["summary"], o["diagnostics"], o["seconds"],
+                sfp if o["state"] == "ok" else None, o["details"], o["blocked"])
+            if o["state"] == "ok" and sfp:
+                stages[stage] = {"fingerprint": sfp, "seconds": round(o["seconds"], 3),
+                                 "summary": o["summary"], "details": o["details"]}
+            else:
+                stages.pop(stage, None)
+        if fp is not None:
+            self.store.save_state(name, {**state, "stages": stages})
+        elif "compile" in outcomes:
+            # A failed compile keeps the state of the last success: that output is still there
+            # and still matches it, so undoing the change makes the model cached again.
+            o = outcomes["compile"]
+            self.store.save_state(name, {**self.store.state(name), "failure": {
+                "pre": r.pre, "deps": message["deps"] or [], "summary": o["summary"],
+                "diagnostics": diagnostics_json(o["diagnostics"])}})
+
+    def _discard(self, name: str) -> None:
+        shutil.rmtree(self.store.staging(name), ignore_errors=True)
+
+    def _end_group(self, pid: int | None) -> None:
+        """End what the worker's build started and left behind (its process group)."""
+        if pid:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(pid, signal.SIGKILL)
+
+    def _interrupt(self) -> None:
+        """Stop every worker (the run was interrupted); their outputs stay as they were."""
+        self.status.interrupted = True
+        for r in list(self.running.values()):
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(r.process.pid or 0, signal.SIGTERM)
+        for r in list(self.running.values()):
+            r.process.join(5)
+            self._end_group(r.process.pid)
+            record = self.status.models[r.model]
+            for stage in self.opts.stages:
+                record.stages[stage] = StageRecord("cached" if stage in r.cached else "interrupted",
+                                                   "the run was interrupted" if stage not in r.cached else "")
+            self._discard(r.model)
+        self.running.clear()
+
+    # -- records -----------------------------------------------------------------------------
+
+    def _record(self, model: PlannedModel) -> ModelRecord:
+        record = ModelRecord(model.name, model.written, model.parents,
+                             warnings=[d for d in model.diagnostics if d.severity is not Severity.ERROR])
+        self.status.models[model.name] = record
+        return record
+
+    def _finish_all(self, name: str, state: str, summary: str, diagnostics: list[Diagnostic] | None = None,
+                    blocked: bool = False, details: dict[str, Any] | None = None) -> None:
+        """The first stage gets `state`; the later ones are skipped because of it."""
+        record = self.status.models.get(name) or self._record(self.plan.models[name])
+        first, *rest = self.opts.stages
+        record.stages[first] = StageRecord(state, summary, diagnostics or [], blocked=blocked,
+                                           details=details or {})
+        for stage in rest:
+            record.stages[stage] = StageRecord("skipped", summary if state == "skipped" else
+                                               f"{first} {_past(state)}", blocked=True)
+        self.fingerprints[name] = None
+        self._done(name)
+
+    def _done(self, name: str) -> None:
+        self.done.add(name)
+        self.reporter.finished(name, self.status.models[name])
+
+
+@contextmanager
+def _uninterrupted() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM until the block is done (they are delivered after it)."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+def _past(state: str) -> str:
+    return {"failed": "failed", "skipped": "was skipped", "interrupted": "was interrupted"}.get(state, state)
+
+
+def _first(diagnostics: list[Diagnostic]) -> str:
+    return f"{diagnostics[0].code} {diagnostics[0].message}" if diagnostics else ""
+
+
+def _preload() -> None:
+    """Import what every build uses before forking, so workers share it instead of importing it."""
+    from mpc.backends import BACKENDS
+    from mpc.compiler import driver  # noqa: F401
+
+    BACKENDS["urdf"]()
+
+
+def stages_with_needs(selected: tuple[str, ...]) -> tuple[str, ...]:
+    """The selected stages and every stage they need, in the order stages run."""
+    from mpc.compiler.pipeline.stages import KNOWN
+
+    wanted = set(selected)
+    todo = list(selected)
+    while todo:
+        for need in STAGES[todo.pop()].needs:
+            if need not in wanted:
+                wanted.add(need)
+                todo.append(need)
+    return tuple(s for s in KNOWN if s in wanted)

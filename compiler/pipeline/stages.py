@@ -1,0 +1,144 @@
+"""The stages a pipeline runs for each model (compile, test, deploy) → a registry of functions.
+
+A stage is a function `(job: StageJob) -> StageOutcome`, registered under its name with
+the stages of the same model it needs. The runner calls the selected stages in the
+order of `KNOWN` inside one worker process per model; status, skipping and caching are
+the runner's, the same for every stage. Only `compile` is registered so far. Another stage
+is an adapter here that imports its package when it runs (so `mpc check` never does):
+
+    def test_stage(job: StageJob) -> StageOutcome:
+        from mpc.checks import run_model_tests
+        protocol = run_model_tests(job.program, job.built, job.sink, workdir=job.workdir)
+        ...  # StageOutcome("ok" or "failed", summary, details={...}, data=protocol)
+
+    register(Stage("test", test_stage, needs=("compile",)))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
+
+if TYPE_CHECKING:
+    from mpc.compiler.driver import Options
+    from mpc.ir.program import Program
+    from mpc.ir.robot import Robot
+
+KNOWN = ("compile", "test", "deploy")  # every stage name, in the order they run
+
+
+@dataclass
+class StageOutcome:
+    """What a stage did for one model.
+
+    state: ok, failed, or skipped (the stage had nothing to do, e.g. `do_not_deploy`; it is
+        never cached, and `--verify` counts it as not done unless `--allow-na`).
+    summary: one line for the status table. diagnostics: what it reported (besides `job.sink`).
+    details: JSON data for status.json (figures, a protocol, a pushed commit); kept in the
+        model's state when the stage succeeded, so later stages see it also in a run where
+        this stage is cached.
+    data: any value for the later stages of the same model in this run; stays in the
+        worker, not recorded.
+    cached: set by the runner on the outcome of a stage that did not run because its
+        result from an earlier run still holds (then state "ok", summary, details; no data).
+    """
+
+    state: Literal["ok", "failed", "skipped"]
+    summary: str = ""
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    details: dict[str, Any] = field(default_factory=dict)
+    data: Any = None
+    cached: bool = False
+
+
+@dataclass
+class StageJob:
+    """Everything a stage gets for one model (one job per model, shared by its stages).
+
+    model: the modelname. definition: the definition file.
+    out: the model's output folder (`<build>/<modelname>`); until the run ends it holds the
+        previous output (what tests compare against).
+    built: the folder with this run's model files: a staging folder when compile ran in
+        this run (moved to `out` by the runner once the worker succeeded), `out` when
+        compile was cached. None until compile succeeded or was found cached.
+    staging: where compile writes. workdir: a scratch folder of this model (kept until the
+        next run of the model, e.g. for logs and clones).
+    pipeline: the `pipeline` mapping of pipeline.yml as written (validated); root: its
+        workspace root, resolved.
+    options: compile options (packages, the pipeline's defaults hook).
+    sink: where the running stage reports (a fresh one per stage).
+    program, robot: set by compile (or, when compile is cached, program by `ensure_program`).
+    results: outcomes of the earlier stages, by name (cached ones with `cached` set).
+    """
+
+    model: str
+    definition: Path
+    out: Path
+    staging: Path
+    workdir: Path
+    pipeline: dict[str, Any]
+    root: Path
+    options: Options
+    sink: Sink = field(default_factory=Sink)
+    built: Path | None = None
+    program: Program | None = None
+    robot: Robot | None = None
+    results: dict[str, StageOutcome] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A registered stage: its name, its function, and the stages it needs to have
+    succeeded (or been cached) for the same model; otherwise it is skipped."""
+
+    name: str
+    run: Callable[[StageJob], StageOutcome]
+    needs: tuple[str, ...] = ()
+
+
+STAGES: dict[str, Stage] = {}
+
+
+def register(stage: Stage) -> None:
+    if stage.name not in KNOWN:
+        raise ValueError(f"unknown stage name '{stage.name}'; known: {', '.join(KNOWN)}")
+    STAGES[stage.name] = stage
+
+
+def ensure_program(job: StageJob) -> bool:
+    """Give a job whose compile was cached its program (the front end only); False on errors."""
+    if job.program is not None:
+        return True
+    from mpc.compiler.driver import load_program
+
+    job.program = load_program(job.definition, job.sink, job.options)
+    job.built = job.out if job.program is not None else None
+    return job.program is not None
+
+
+def first_error(diagnostics: list[Diagnostic]) -> str:
+    error = next((d for d in diagnostics if d.severity is Severity.ERROR), None)
+    return f"{error.code} {error.message}" if error else ""
+
+
+def compile_stage(job: StageJob) -> StageOutcome:
+    """Compile the model into `job.staging` (compiler/driver.py)."""
+    from mpc.compiler.driver import compile_model
+
+    result = compile_model(job.definition, job.sink, replace(job.options, out=job.staging, target=job.out))
+    job.program, job.robot = result.program, result.robot
+    if result.out is None:
+        return StageOutcome("failed", first_error(job.sink.diagnostics))
+    job.built = result.out
+    files = [p for p in result.out.rglob("*") if p.is_file()]
+    meshes = sum("meshes" in p.relative_to(result.out).parts for p in files)
+    n = len(files) - meshes
+    return StageOutcome("ok", f"{n} file{'s' * (n != 1)}, {meshes} mesh{'es' * (meshes != 1)}",
+                        details={"files": len(files), "meshes": meshes})
+
+
+register(Stage("compile", compile_stage))
