@@ -235,7 +235,8 @@ class Runner:
         self.store.workdir(name).mkdir(parents=True, exist_ok=True)
         job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
-                       pipeline=self.plan.settings, root=self.plan.root, options=self.options)
+                       pipeline=self.plan.settings, root=self.plan.root, options=self.options,
+                       pipeline_file=self.plan.file)
         done = self.store.state(name).get("stages", {})
         for stage in cached:
             kept = done.get(stage, {})

@@ -3,15 +3,12 @@
 A stage is a function `(job: StageJob) -> StageOutcome`, registered under its name with
 the stages of the same model it needs. The runner calls the selected stages in the
 order of `KNOWN` inside one worker process per model; status, skipping and caching are
-the runner's, the same for every stage. Only `compile` is registered so far. Another stage
-is an adapter here that imports its package when it runs (so `mpc check` never does):
+the runner's, the same for every stage. `test` and `deploy` are adapters that import their
+packages (checks/, deploy/) when they run, so `mpc check` never does.
 
-    def test_stage(job: StageJob) -> StageOutcome:
-        from mpc.checks import run_model_tests
-        protocol = run_model_tests(job.program, job.built, job.sink, workdir=job.workdir)
-        ...  # StageOutcome("ok" or "failed", summary, details={...}, data=protocol)
-
-    register(Stage("test", test_stage, needs=("compile",)))
+`deploy` needs only `compile`: a model whose tests failed is deployed too, to the failure
+branch, with the protocol in its merge request (kept in the test stage's details, so it
+is there also when the test stage is cached).
 """
 
 from __future__ import annotations
@@ -68,7 +65,7 @@ class StageJob:
     staging: where compile writes. workdir: a scratch folder of this model (kept until the
         next run of the model, e.g. for logs and clones).
     pipeline: the `pipeline` mapping of pipeline.yml as written (validated); root: its
-        workspace root, resolved.
+        workspace root, resolved; pipeline_file: that file.
     options: compile options (packages, the pipeline's defaults hook).
     sink: where the running stage reports (a fresh one per stage).
     program, robot: set by compile (or, when compile is cached, program by `ensure_program`).
@@ -83,6 +80,7 @@ class StageJob:
     pipeline: dict[str, Any]
     root: Path
     options: Options
+    pipeline_file: Path | None = None
     sink: Sink = field(default_factory=Sink)
     built: Path | None = None
     program: Program | None = None
@@ -142,3 +140,49 @@ def compile_stage(job: StageJob) -> StageOutcome:
 
 
 register(Stage("compile", compile_stage))
+
+
+def test_stage(job: StageJob) -> StageOutcome:
+    """Run the model tests (checks/) on this run's build; the protocol goes to the workdir."""
+    from mpc.checks import run_model_tests
+
+    if not ensure_program(job):
+        return StageOutcome("failed", first_error(job.sink.diagnostics))
+    assert job.program is not None and job.built is not None
+    protocol = run_model_tests(job.program, job.built, job.sink, workdir=job.workdir, robot=job.robot)
+    protocol.write(job.workdir)
+    return StageOutcome("failed" if protocol.failed else "ok", protocol.summary(),
+                        details={"protocol": str(job.workdir / "test_protocol.md"),
+                                 "markdown": protocol.markdown(), "failed": protocol.failed},
+                        data=protocol)
+
+
+def deploy_stage(job: StageJob) -> StageOutcome:
+    """Deploy this run's build (deploy/) with the pipeline's settings and the test protocol."""
+    from mpc.compiler import schema, source
+    from mpc.deploy import DeploySettings, deploy_model
+
+    if not ensure_program(job) or job.pipeline_file is None:
+        return StageOutcome("failed", first_error(job.sink.diagnostics))
+    assert job.program is not None and job.built is not None
+    doc = source.load(job.pipeline_file, job.sink)
+    pipeline = schema.validate_pipeline(doc, job.sink) if doc is not None else None
+    if pipeline is None:
+        return StageOutcome("failed", first_error(job.sink.diagnostics))
+    settings = DeploySettings.from_pipeline(pipeline.pipeline, job.pipeline_file.resolve().parent, job.sink)
+    tested = job.results.get("test")
+    tests = tested.details if tested is not None else {}
+    result = deploy_model(job.program, job.built, settings, job.sink,
+                          protocol_markdown=tests.get("markdown"), tests_failed=bool(tests.get("failed")))
+    if not result.ok:
+        return StageOutcome("failed", first_error(job.sink.diagnostics))
+    if result.skipped:
+        return StageOutcome("skipped", "do_not_deploy")
+    summary = (f"pushed {result.commit[:10]} to {result.branch}" if result.pushed and result.commit
+               else "nothing changed")
+    return StageOutcome("ok", summary, details={"remote": result.remote, "branch": result.branch,
+                                                "commit": result.commit, "pushed": result.pushed})
+
+
+register(Stage("test", test_stage, needs=("compile",)))
+register(Stage("deploy", deploy_stage, needs=("compile",)))
