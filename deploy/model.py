@@ -124,6 +124,8 @@ def fill_model(clone: Clone, built: Path, program: Program, plan: Plan, prov: Pr
     """The model repository's tree: the build, the kept files, README.md, LFS, submodules."""
     folder = clone.folder
     keep = content.kept_files(folder, plan.keep_files)
+    if (folder / "README.md").is_file() and not (built / "README.md").exists():
+        keep.add("README.md")  # the repository's own README stays; one is written only when missing
     targets = {p.target for p in pinned}
     for target in targets:  # submodules are never checked out here: their folders are empty
         path = folder / target

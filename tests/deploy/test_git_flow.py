@@ -86,6 +86,14 @@ def test_keep_files_survive_and_everything_else_is_replaced(model: Model, server
     assert server.log() == ["[mpc] Update arm-model", "hand-written files"]
 
 
+def test_a_readme_of_the_repository_stays_and_one_is_written_only_when_missing(
+        model: Model, server: Server) -> None:
+    server.commit_files({"README.md": "# The arm\n\nWritten by hand.\n"}, "readme")
+    deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    assert server.show("master", "README.md") == "# The arm\n\nWritten by hand."
+    assert "urdf/arm.urdf" in server.files()
+
+
 def test_failed_tests_go_to_the_failure_branch_only(model: Model, server: Server) -> None:
     settings = model.settings(remote=server.url)
     good = deploy_model(model.compile(), model.built, settings, Sink())
