@@ -22,17 +22,21 @@ def _package(text: str) -> tuple[str, Path]:
     return name, Path(folder).resolve()
 
 
+def _diagnostic_options(parser: argparse.ArgumentParser) -> None:
+    """--package, --format and --werror: the options of every command that reads definitions."""
+    parser.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                        help="where the ROS package NAME is (for package:// paths); repeatable")
+    parser.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                        help="how to print diagnostics (default: human)")
+    parser.add_argument("--werror", action="store_true", help="treat warnings as errors")
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     comp = sub.add_parser("compile", help="compile a model definition into model files")
     comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
-    comp.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
-                      help="where the ROS package NAME is (for package:// paths); repeatable")
-    comp.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                      help="how to print diagnostics (default: human)")
-    comp.add_argument("--werror", action="store_true", help="treat warnings as errors")
     comp.add_argument("--emit", choices=("files", "ir"), default="files",
                       help="what to produce: the model files (default) or the IR as text on stdout")
     check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
@@ -50,10 +54,6 @@ def _parser() -> argparse.ArgumentParser:
     test.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
-    test.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
-                      help="where the ROS package NAME is (for package:// paths); repeatable")
-    test.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                      help="how to print diagnostics (default: human)")
     # -- pipeline runs and CI generation (compiler/pipeline/) --
     run = sub.add_parser("run", help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
     run.add_argument("pipeline", type=Path, help="the pipeline file")
@@ -80,18 +80,8 @@ def _parser() -> argparse.ArgumentParser:
     ci.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container)")
     ci.add_argument("--setup", default="pip install model-pipeline-compiler",
                     help="command that installs mpc in a job (default: %(default)s)")
-    for p in (run,):
-        p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
-                       help="where the ROS package NAME is (for package:// paths); repeatable")
-        p.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                       help="how to print diagnostics (default: human)")
-        p.add_argument("--werror", action="store_true", help="treat warnings as errors")
-    for p in (check,):
-        p.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
-                       help="where the ROS package NAME is (for package:// paths); repeatable")
-        p.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                       help="how to print diagnostics (default: human)")
-        p.add_argument("--werror", action="store_true", help="treat warnings as errors")
+    for p in (comp, check, test, run):
+        _diagnostic_options(p)
     return parser
 
 
@@ -175,7 +165,7 @@ def _test(args: argparse.Namespace) -> int:
     from mpc.checks import run_model_tests
     from mpc.compiler.driver import InputLoader, Options, apply, compile_model, load_program
 
-    sink = Sink()
+    sink = Sink(werror=args.werror)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
     if args.built is not None:
         loader = InputLoader(sink, options, (args.definition.resolve(),))

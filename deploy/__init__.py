@@ -2,9 +2,24 @@
 
 The entry point is `deploy_model(program, built, settings, sink, *, protocol_markdown,
 tests_failed) -> DeployResult`; `DeploySettings` holds the pipeline-level settings.
+Its names are imported when first used, so that `mpc`'s argument parser (which reads
+deploy/command.py) does not load git and the schema on every start.
 """
 
-from mpc.deploy.model import DeployResult, deploy_model
-from mpc.deploy.settings import DeploySettings
+from __future__ import annotations
+
+from typing import Any
 
 __all__ = ["DeployResult", "DeploySettings", "deploy_model"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in ("DeployResult", "deploy_model"):
+        from mpc.deploy import model
+
+        return getattr(model, name)
+    if name == "DeploySettings":
+        from mpc.deploy.settings import DeploySettings
+
+        return DeploySettings
+    raise AttributeError(f"module 'mpc.deploy' has no attribute '{name}'")

@@ -6,13 +6,17 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.compiler import render
 from mpc.compiler.diagnostics import Severity, Sink
+from mpc.deploy.forges import FORGES
 from mpc.deploy.gitcmd import scrub
-from mpc.deploy.model import DeployResult, deploy_model
-from mpc.deploy.settings import FORGES, DeploySettings
 from mpc.ir.span import Span
+
+if TYPE_CHECKING:
+    from mpc.deploy.model import DeployResult
+    from mpc.deploy.settings import DeploySettings
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,6 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from mpc.compiler.driver import Options, load_program
+    from mpc.deploy.model import deploy_model
 
     sink = Sink()
     # A build exists already: what `compile` does not support yet is no reason to refuse it.
@@ -69,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _settings(args: argparse.Namespace, sink: Sink) -> DeploySettings | None:
+    from mpc.deploy.settings import DeploySettings
+
     values = {"remote": args.remote, "forge": args.forge, "dry_run": args.dry_run or None,
               "success_branch": args.success_branch, "failure_branch": args.failure_branch,
               "workdir": args.workdir}

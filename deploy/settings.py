@@ -18,7 +18,6 @@ from mpc.compiler.schema.definition import PipelineSection
 from mpc.ir.program import Deployment
 
 DEFAULT_FAILURE_BRANCH = "tests-failed"
-FORGES = ("gitlab", "github", "none")
 
 
 @dataclass
