@@ -249,3 +249,23 @@ def test_a_closure_open_at_q0_closes_where_pinocchio_closes_it(tmp_path: Path) -
     assert np.abs(equality_rows(model, model.qpos0)[0]).max() == pytest.approx(0.2)
     q = dyn.configuration({"crank_joint": 0.5})
     assert_closes_as_pinocchio(model, dyn, q)
+
+
+def test_a_fixed_closure_is_a_weld_of_the_two_frames(tmp_path: Path) -> None:
+    """A fixed cut joint whose origin is the coupler-to-rocker pose at θ = 0.5 (not at q = 0):
+    the weld holds position and orientation exactly where Pinocchio's 6D constraint does."""
+    from mpc.ir.kinematics import matrix_pose
+
+    ball = fourbar(tmp_path, "ball")
+    q = build(ball).configuration({"crank_joint": 0.5})
+    X = build(ball).link_placements(q)
+    cut = replace(ball.cut_joints["loop"], type="fixed",
+                  origin=matrix_pose(np.linalg.inv(X["coupler"]) @ X["rocker"]))
+    robot = replace(ball, cut_joints={"loop": cut})
+    dyn = build(robot)
+    model = mujoco.MjModel.from_xml_string(mjcf.to_string(robot, str))
+    assert list(model.eq_type) == [mujoco.mjtEq.mjEQ_WELD]
+    assert np.linalg.norm(dyn.residual(q)[0]) < 1e-12
+    assert np.abs(equality_rows(model, mujoco_qpos(model, dyn, q))[0]).max() < 1e-12
+    open_at_q0 = equality_rows(model, model.qpos0)[0]
+    assert np.abs(open_at_q0[3:]).max() > 0.1  # the rotation part: the coupler is turned by 0.5
