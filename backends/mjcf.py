@@ -9,7 +9,12 @@ its joint's origin, the joint at the body's origin, the axis as in URDF. revolut
 range, continuous → hinge, prismatic → slide, fixed → no joint (a welded body), floating →
 freejoint (its body hoisted to the world; deeper down: three slides and a ball), planar → two
 slides and a hinge. Mimic → `<equality><joint>` with joint1 = offset + multiplier·joint2 (polycoef);
-cut joints → `<connect>` at their origin (`<weld>` for fixed ones); motors → `<motor>`.
+motors → `<motor>`. Cut joints (loop closures) → equalities between two sites, one on each side
+(see `cut_sites`): `<weld>` for fixed ones, `<connect>` for ball ones, two `<connect>`s along
+the axis for a revolute or continuous one whose axis is known, one `<connect>` (a ball joint)
+for other rotational ones; translational ones are left out (W0500). Sites, not `anchor`: with
+body1/body2/anchor MuJoCo takes body2's point from qpos0, so a closure whose two sides do not
+coincide at q = 0 (or that sits off its child's origin) would close elsewhere than the source's.
 
 Inertia: `diaginertia` in the principal frame (`quat`), diagonalised here, so that MuJoCo
 checks exactly the numbers written (eigenvalues within 1e-12 of the largest are round-off,
@@ -39,13 +44,15 @@ from mpc.backends import meshes
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir import transforms as tf
+from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
+from mpc.ir.kinematics import matrix_pose, pose_matrix
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.span import Span
 from mpc.ir.tree import child_joints, depth_first
 
-__all__ = ["check", "emit", "left_out", "to_string"]
+__all__ = ["check", "cut_sites", "emit", "left_out", "to_string"]
 
 Quat = tuple[float, float, float, float]
 Pairs = list[tuple[str, str | None]]
@@ -152,6 +159,42 @@ def _limits(joint: Joint) -> tuple[float, float] | None:
     return (lim.lower or 0.0, lim.upper or 0.0)
 
 
+# Cut joint types MJCF closes: a weld, connects (points) for the rotational ones.
+_POINT_CUTS = ("ball", "revolute", "continuous", "universal", "revolute2")
+_HINGE_CUTS = ("revolute", "continuous")
+AXIS_POINT = 0.1  # m along a hinge closure's axis: its second connect's point
+
+
+def _cut_axis(cut: CutJoint) -> np.ndarray | None:
+    """A revolute closure's axis in the child link's frame (`axis`, as an SDF input gives it)."""
+    axis = cut.annotations.get("axis") if cut.type in _HINGE_CUTS else None
+    if not isinstance(axis, list | tuple) or len(axis) != 3:
+        return None
+    a = np.asarray(axis, dtype=float)
+    return a / np.linalg.norm(a) if np.all(np.isfinite(a)) and np.linalg.norm(a) > 0 else None
+
+
+def cut_sites(cut: CutJoint) -> list[tuple[str, Pose, Pose]]:
+    """The points where a cut joint closes its loop: (suffix, pose on the parent, pose on the
+    child). The joint frame sits on the child at `joint_origin` (an SDF input's), else at the
+    child's origin; on the parent it is the same frame at the zero configuration (origin ∘
+    joint frame), as in Pinocchio's constraint model (checks/dynamics_model.py). A hinge
+    closure with a known axis has a second point, AXIS_POINT along the axis."""
+    jo = cut.annotations.get("joint_origin")
+    X_CJ = np.eye(4)
+    if isinstance(jo, dict):
+        X_CJ = pose_matrix(Pose(tuple(jo.get("xyz", (0.0, 0.0, 0.0))),  # type: ignore[arg-type]
+                                tuple(jo.get("rpy", (0.0, 0.0, 0.0)))))  # type: ignore[arg-type]
+    X_PJ = pose_matrix(cut.origin) @ X_CJ
+    out = [("", matrix_pose(X_PJ), matrix_pose(X_CJ))]
+    axis = _cut_axis(cut)
+    if axis is not None:
+        shift = np.eye(4)
+        shift[:3, 3] = AXIS_POINT * (X_CJ[:3, :3].T @ axis)  # the axis, in the joint frame
+        out.append(("_axis", matrix_pose(X_PJ @ shift), matrix_pose(X_CJ @ shift)))
+    return out
+
+
 def _one_dof(joint: Joint | None) -> bool:
     return joint is not None and joint.type in ("revolute", "continuous", "prismatic")
 
@@ -194,11 +237,15 @@ def left_out(robot: Robot) -> list[str]:
         ("motor setting", "motor settings"): sum(len(m.settings) for m in robot.motors.values()),
         ("cut joint constraint axis", "cut joint constraint axes"):
             sum(len(c.constraint_axes) for c in robot.cut_joints.values()),
-        ("non-fixed cut joint's rotation (a connect is a ball joint)",
-         "non-fixed cut joints' rotations (a connect is a ball joint)"):
-            sum(c.type != "fixed" for c in robot.cut_joints.values()),
+        ("rotational cut joint's axis (without one, a connect is a ball joint)",
+         "rotational cut joints' axes (without one, a connect is a ball joint)"):
+            sum(c.type in _POINT_CUTS and c.type != "ball" and _cut_axis(c) is None
+                for c in robot.cut_joints.values()),
     }
     out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
+    out += [f"{c.type} cut joint '{c.name}' (MJCF has no equality for it)"
+            for c in sorted(robot.cut_joints.values(), key=lambda c: c.name)
+            if c.type != "fixed" and c.type not in _POINT_CUTS]
     tags = Counter(f.tag for f in (*robot.fragments, *inner))
     out += [f"{n} <{tag}> element{'s' * (n != 1)}" for tag, n in sorted(tags.items())]
     root = robot.links[robot.root]
@@ -222,6 +269,17 @@ class _Writer:
         # body sits at the identity, so the joint origin stays right).
         self.hoisted = {j.name for j in self.children.get(robot.root, [])
                         if j.type == "floating" and robot.root != "world"}
+        # The sites the loop closures join, by link: (name, pose in the link). Names end in
+        # _parent, _child, _parent_axis, _child_axis, so two cut joints' sites never clash.
+        self.sites: dict[str, list[tuple[str, Pose]]] = {}
+        for cut in self._written_cuts():
+            for suffix, on_parent, on_child in cut_sites(cut):
+                self.sites.setdefault(cut.parent, []).append((f"{cut.name}_parent{suffix}", on_parent))
+                self.sites.setdefault(cut.child, []).append((f"{cut.name}_child{suffix}", on_child))
+
+    def _written_cuts(self) -> list[CutJoint]:
+        cuts = [self.robot.cut_joints[n] for n in sorted(self.robot.cut_joints)]
+        return [c for c in cuts if c.type == "fixed" or c.type in _POINT_CUTS]
 
     def leaf(self, depth: int, tag: str, pairs: Pairs) -> None:
         self.out.append(f"{IND * depth}<{tag}{_attrs(pairs)}/>")
@@ -311,6 +369,8 @@ class _Writer:
         """Geoms, then child bodies; `top`: the children are bodies of the world."""
         for shape in (*link.visuals, *link.collisions):
             self._emit_geom(depth, shape)
+        for name, pose in self.sites.get(link.name, []):
+            self.leaf(depth, "site", [("name", name), *_pose_pairs(pose), ("group", "5")])
         for j in self.children.get(link.name, []):
             if j.name not in self.hoisted:
                 self._emit_body(depth, j, self.robot.links[j.child], top)
@@ -335,15 +395,13 @@ class _Writer:
                 poly = [m.offset or 0.0, 1.0 if m.multiplier is None else m.multiplier, 0.0, 0.0, 0.0]
                 self.leaf(depth, "joint", [("joint1", name), ("joint2", m.joint),
                                            ("polycoef", fmt_floats(poly))])
-        for name in sorted(self.robot.cut_joints):
-            c = self.robot.cut_joints[name]
-            if c.type == "fixed":
-                relpose = fmt_floats([*c.origin.xyz, *_quat_rpy(c.origin.rpy)])
-                self.leaf(depth, "weld", [("name", name), ("body1", c.parent), ("body2", c.child),
-                                          ("relpose", relpose)])
-            else:
-                self.leaf(depth, "connect", [("name", name), ("body1", c.parent), ("body2", c.child),
-                                             ("anchor", fmt_floats(c.origin.xyz))])
+        for c in self._written_cuts():  # site1 on the parent, site2 on the child
+            for suffix, _, _ in cut_sites(c):
+                # `<cut>_axis` unless another cut joint has that name (then unnamed)
+                name = c.name + suffix if not suffix or c.name + suffix not in self.robot.cut_joints else None
+                self.leaf(depth, "weld" if c.type == "fixed" else "connect", [
+                    ("name", name), ("site1", f"{c.name}_parent{suffix}"),
+                    ("site2", f"{c.name}_child{suffix}")])
 
     def _emit_actuators(self, depth: int = 2) -> None:
         for name in sorted(self.robot.motors):

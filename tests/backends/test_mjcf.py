@@ -318,6 +318,10 @@ def _toy(**links: Link) -> Robot:
     return Robot(name="toy", root="base", links={**default, **links}, joints=joints)
 
 
+def _quat(yaw: float) -> list[float]:
+    return [np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]
+
+
 def test_joint_types_cut_joints_and_motors() -> None:
     robot = replace(_toy(), motors={"shoulder_motor": Motor(name="shoulder_motor", joint="shoulder")},
                     cut_joints={"loop": CutJoint(name="loop", type="revolute", parent="base", child="wheel",
@@ -326,7 +330,7 @@ def test_joint_types_cut_joints_and_motors() -> None:
                                                  origin=Pose((0.0, 0.1, 0.0), (0.0, 0.0, 0.5)))})
     sink = Diags()
     model = mujoco.MjModel.from_xml_string(mjcf.to_string(robot, str, sink))
-    assert "1 non-fixed cut joint's rotation (a connect is a ball joint)" in sink.take(
+    assert "1 rotational cut joint's axis (without one, a connect is a ball joint)" in sink.take(
         "W0500", Severity.WARNING).message
     kinds = {model.joint(j).name: int(model.jnt_type[j]) for j in range(model.njnt)}
     T = mujoco.mjtJoint
@@ -339,7 +343,13 @@ def test_joint_types_cut_joints_and_motors() -> None:
     assert model.nq == 1 + 1 + 3 + 1 + (3 + 4) + 7
     assert {model.joint(j).name for j in range(model.njnt) if model.jnt_limited[j]} == {"slide", "shoulder"}
     assert list(model.eq_type) == [mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD]
-    np.testing.assert_allclose(model.eq_data[0][:3], [0.3, 0, 0])  # the anchor, in body1
+    # between sites: the closure's frame on the parent (its origin) and on the child (identity)
+    assert list(model.eq_objtype) == [mujoco.mjtObj.mjOBJ_SITE] * 2
+    assert [model.site(int(i)).name for i in (*model.eq_obj1id, *model.eq_obj2id)] == \
+        ["loop_parent", "weld_parent", "loop_child", "weld_child"]
+    np.testing.assert_allclose(model.site("loop_parent").pos, [0.3, 0, 0])
+    np.testing.assert_allclose(model.site("loop_child").pos, [0, 0, 0])
+    np.testing.assert_allclose(model.site("weld_parent").quat, _quat(0.5), atol=1e-15)
     np.testing.assert_allclose(model.actuator_ctrlrange[0], [-5, 5])
     arm = model.body("arm").id
     sizes = [model.geom_size[g] for g in range(model.ngeom) if model.geom_bodyid[g] == arm]
