@@ -16,6 +16,7 @@ from pathlib import Path
 from xml.sax.saxutils import escape
 
 from mpc.backends import meshes
+from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
@@ -370,11 +371,14 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
 
-    def mesh_name(mesh: Mesh) -> str:
-        # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
-        # file's folder; model:// would need the meshes inside the model folder (out/sdf).
-        return "../" + files[meshes.key(mesh)]
+    # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
+    # file's folder; model:// would need the meshes inside the model folder (out/sdf).
+    # Or package:// paths (ros_pathes), which ROS's Gazebo resolves (backends/mesh_paths.py).
+    for suffix, prefix in variants(export):
 
-    text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints)
-    write_path(out / "sdf" / f"{export.filename or robot.name}.sdf", text)
+        def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
+            return prefix + files[meshes.key(mesh)]
+
+        text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints)
+        write_path(out / "sdf" / f"{export.filename or robot.name}{suffix}.sdf", text)
     write_path(out / "sdf" / "model.config", model_config(robot, export.version))

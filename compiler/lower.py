@@ -56,7 +56,7 @@ from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
-LATER_SECTIONS = ("append_export_config", "swing_my_robot")
+LATER_SECTIONS = ("swing_my_robot",)
 
 
 def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
@@ -276,12 +276,19 @@ class _Lowering:
                                 "'reduce_meshes' is a ratio of faces to keep (between 0 and 1) or a "
                                 f"number of faces (4 or more), got {value:g}")
 
+    def entries(self) -> list[Any]:
+        """The model's export entries: `export_config` (inherited through `defaults` or the
+        pipeline's `default_export_config`, or none: the default URDF), then the
+        `append_export_config` entries. A new list each time: appending never changes the
+        list it extends (Phobos appended in place, to every later model's default too)."""
+        return [*(self.model.export_config or ()), *self.model.append_export_config]
+
     def exports(self) -> tuple[Export, ...]:
         out: list[Export] = []
         if self.model.export_config is None:
             out.append(UrdfExport(mesh_format="input_type", span=self.model.span))
         written: dict[str, Export] = {}
-        for entry in self.model.export_config or ():
+        for entry in self.entries():
             if entry.type == "submodel":
                 out.extend(self.submodel(entry, written))
             else:
@@ -290,7 +297,9 @@ class _Lowering:
         out = [e for e in out if not _lists_a_submodel(e)] + [e for e in out if _lists_a_submodel(e)]
         out.extend(self.smurf.exports(out))
         out.extend(self.commands())
-        package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
+        # A file with package:// paths (ros_pathes, or its copy) makes the output a ROS package.
+        package = next((e.ros_package or e.copy_package for e in out if isinstance(e, UrdfExport | SdfExport)
+                        and (e.ros_package or e.copy_package)), None)
         if package is not None:
             out.append(self.ros_package(package))
         return tuple(out)
@@ -325,13 +334,12 @@ class _Lowering:
             return []
         later = dict(_KINEMATIC_LATER)
         if entry.type != "urdf":
-            later.update(additional_meshes=None, ros_pathes=False, enforce_zero=False)
-        elif submodel:
-            later.update(ros_pathes=False)
+            later.update(additional_meshes=None, enforce_zero=False)
+        if entry.type == "mjcf":
+            later.update(ros_pathes=False, copy_with_other_pathes=False)
         for key, default in later.items():
             if getattr(entry, key) != default:
-                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'"
-                             + (" in a submodel" if submodel and key == "ros_pathes" else ""))
+                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in written:
@@ -345,6 +353,11 @@ class _Lowering:
         export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                            add_floating_base=entry.add_floating_base, submodel=submodel,
                                            filename=filename if filename != (submodel or robotname) else "")
+        package = self.model.ros_pkg_name or self.model.modelname
+        if entry.type in ("urdf", "sdf"):
+            export = replace(export, ros_package=package if entry.ros_pathes else None,
+                             copy_package=package if entry.copy_with_other_pathes else "")
+        export = replace(export, correct_inertials=entry.correct_inertials)
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
@@ -354,9 +367,8 @@ class _Lowering:
                                else "MJCF always closes loops with equality constraints"))
         if entry.type == "urdf":
             extra = entry.additional_meshes
-            package = (self.model.ros_pkg_name or self.model.modelname) if entry.ros_pathes else None
             export = replace(
-                export, enforce_zero=entry.enforce_zero, ros_package=package,
+                export, enforce_zero=entry.enforce_zero,
                 additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
         export = self.smurf.link(entry, export, submodel)
         written[target] = export
@@ -404,7 +416,7 @@ class _Lowering:
         out: list[Export] = [cut]
         nested = entry.export_config
         if nested is None:
-            nested = [e for e in self.model.export_config or () if e.type != "submodel"]
+            nested = [e for e in self.entries() if e.type != "submodel"]
             if self.model.export_config is None:
                 out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name,
                                       filename=entry.filename or ""))
@@ -468,7 +480,7 @@ class _Lowering:
         from mpc.backends.joint_limits import SELECTIONS
 
         # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
-        submodels = {e.name for e in self.model.export_config or () if e.type == "submodel"}
+        submodels = {e.name for e in self.entries() if e.type == "submodel"}
         as_string = isinstance(entry._doc.data_at((*entry._path, "joints")), str)
         if len(joints) == 1 and as_string and joints[0] in submodels:
             return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
@@ -517,10 +529,7 @@ _SUBMODEL_LATER: dict[str, Any] = {
     "include_human_in_abstract": False, "remove_links": []}
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 # Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
-_KINEMATIC_LATER: dict[str, Any] = {
-    "copy_with_other_pathes": False, "correct_inertials": False,
-    "float_fmt_dict": None,
-}
+_KINEMATIC_LATER: dict[str, Any] = {"float_fmt_dict": None}
 
 
 

@@ -60,6 +60,10 @@ class UrdfExport:
     ros_package: when given, meshes are referenced as `package://<ros_package>/meshes/…`.
     enforce_zero: numbers closer to zero than 1e-12 are written as 0.
     link_in_smurf: the SMURF of its folder links this file (else lists it in additional_files).
+    copy_package: when set (`copy_with_other_pathes`), also write the file with the other kind
+        of mesh paths: `<filename>_ros.urdf` with `package://<copy_package>/…` paths, or, when
+        the file has package paths, `<filename>_relpath.urdf` with relative ones.
+    correct_inertials: non-physical inertials are made physical first (ir/physical.py).
     span: the export_config entry.
     """
 
@@ -72,13 +76,16 @@ class UrdfExport:
     enforce_zero: bool = False
     submodel: str = ""
     link_in_smurf: bool = False
+    copy_package: str = ""
+    correct_inertials: bool = False
     type: Literal["urdf"] = "urdf"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SdfExport:
-    """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`, `link_in_smurf`
-    (as for URDF)."""
+    """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`; `link_in_smurf`,
+    `ros_package`, `copy_package` (`_ros.sdf`, `_relpath.sdf`) and
+    `correct_inertials` as for URDF."""
 
     mesh_format: str
     span: Span
@@ -88,6 +95,9 @@ class SdfExport:
     version: Literal["1.6", "1.7", "1.9"] = "1.9"
     submodel: str = ""
     link_in_smurf: bool = False
+    ros_package: str | None = None
+    copy_package: str = ""
+    correct_inertials: bool = False
     type: Literal["sdf"] = "sdf"
 
 
@@ -101,6 +111,7 @@ class MjcfExport:
     filename: str = ""
     add_floating_base: bool = False
     submodel: str = ""
+    correct_inertials: bool = False
     type: Literal["mjcf"] = "mjcf"
 
 
