@@ -10,8 +10,9 @@ triangle inequality broken; mpc changes only what is not physical:
 - no `<inertial>`, or mass 0 with a zero tensor: a massless frame, left as it is
   (Phobos gives such links 1e-5 kg);
 - a mass that is not positive, with a tensor: 1e-5 kg, Phobos's floor;
-- a tensor that is not positive-definite or breaks the triangle inequality (beyond
-  rounding: 1e-9 of its trace): the same amount d is added to each principal moment,
+- a tensor that is not positive-definite or breaks the triangle inequality beyond
+  rounding (1e-6 of its largest moment, what six written digits carry; the rule of
+  `mpc test`'s physical_validity, checks/validity.py): the same amount d is added to each principal moment,
   I + d·1 (principal axes kept), the least d that makes it physical plus a margin of
   1e-3 of its largest moment (1e-5 kg·m² for a zero tensor, Phobos's floor).
 """
@@ -26,7 +27,7 @@ from mpc.ir.robot import Inertia, Inertial, Robot
 
 FLOOR = 1e-5  # Phobos's limit: kg for a mass, kg·m² for a zero tensor
 MARGIN = 1e-3  # of the largest principal moment, beyond the least correction
-ROUNDING = 1e-9  # of the trace: a triangle inequality broken by less is rounding
+ROUNDING = 1e-6  # of the largest moment: a triangle inequality broken by less is rounding
 
 
 def _matrix(i: Inertia) -> np.ndarray:
@@ -35,13 +36,13 @@ def _matrix(i: Inertia) -> np.ndarray:
 
 def lift(i: Inertia) -> float:
     """The amount to add to each principal moment of `i` (0 when it is physical)."""
-    moments = np.linalg.eigvalsh(_matrix(i))
-    total = float(moments.sum())
-    broken = max(float(moments[k] - moments[(k + 1) % 3] - moments[(k + 2) % 3]) for k in range(3))
-    if moments.min() > 0 and broken <= ROUNDING * total:
+    moments = np.linalg.eigvalsh(_matrix(i))  # ascending: only a + b >= c can fail
+    a, b, c = (float(m) for m in moments)
+    broken = c - a - b
+    if a > 0 and broken <= ROUNDING * max(abs(a), abs(c)):
         return 0.0
-    largest = float(moments.max())
-    return max(0.0, -float(moments.min()), broken) + (MARGIN * largest if largest > 0 else FLOOR)
+    largest = c
+    return max(0.0, -a, broken) + (MARGIN * largest if largest > 0 else FLOOR)
 
 
 def corrected(inertial: Inertial) -> Inertial | None:

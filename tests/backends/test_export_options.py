@@ -1,0 +1,242 @@
+"""The urdf/sdf export options of issue 7: correct_inertials, copy_with_other_pathes,
+ros_pathes in sdf and submodel exports, append_export_config — on example-robot-data models."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lxml import etree
+
+from tests.conftest import ERD, Diags, compile_file, write
+
+
+def _spec(tmp_path: Path, source: Path, exports: str, extra: str = "", name: str = "m.yml") -> Path:
+    return write(tmp_path / name, f"""
+        model:
+          robotname: robot
+          modelname: robot_model
+          input_models: {{base: {{basefile: "{source}"}}}}
+          assemble: {{model: base}}
+        {extra}
+          export_config:
+        {exports}
+        """)
+
+
+def _inertials(urdf: Path) -> dict[str, bytes]:
+    """Each link's <inertial> element, as written."""
+    root = etree.parse(str(urdf)).getroot()
+    return {link.get("name"): etree.tostring(link.find("inertial")) for link in root.iter("link")
+            if link.find("inertial") is not None}
+
+
+def _pin_inertias(urdf: Path) -> dict[str, object]:
+    """Each link's inertial as a Pinocchio Inertia (mass, COM, tensor about the COM)."""
+    import pinocchio as pin
+
+    out = {}
+    for link in etree.parse(str(urdf)).getroot().iter("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
+        tensor = np.array([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
+                           [i["ixz"], i["iyz"], i["izz"]]])
+        origin = inertial.find("origin")
+        com = np.array([float(x) for x in origin.get("xyz", "0 0 0").split()]) if origin is not None \
+            else np.zeros(3)
+        out[link.get("name")] = pin.Inertia(float(inertial.find("mass").get("value")), com, tensor)
+    return out
+
+
+def _physical(inertia: object) -> bool:
+    """Pinocchio's pseudo-inertia is positive-definite exactly when the body is physically
+    consistent: positive mass, a positive-definite tensor, the triangle inequality."""
+    return bool(np.linalg.eigvalsh(inertia.toPseudoInertia().toMatrix()).min() > 0)  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(("source", "fixed"), [
+    ("talos_data/robots/talos_left_arm.urdf", ["wrist_left_ft_link", "wrist_left_ft_tool_link"]),
+    ("allegro_hand_description/urdf/allegro_right_hand.urdf",
+     ["link_3.0", "link_7.0", "link_11.0", "link_15.0"]),
+    ("pr2_description/urdf/pr2.urdf", ["sensor_mount_link", "double_stereo_link"]),
+])
+def test_correct_inertials_fixes_the_offenders_and_nothing_else(tmp_path: Path, source: str,
+                                                                 fixed: list[str]) -> None:
+    """talos: a link with mass and a zero tensor; allegro, pr2: tensors that violate the
+    triangle inequality. Each becomes physical (checked with Pinocchio); every other
+    link's inertial is written byte for byte as without the option."""
+    spec = _spec(tmp_path, ERD / source, """
+            - {type: urdf, correct_inertials: true}
+            - {type: urdf, filename_suffix: _as_given}
+        """)
+    diags = Diags()
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    warning = diags.take("W0530", severity=diags.diagnostics[0].severity)
+    assert warning.message == (f"correct_inertials made the inertials of {len(fixed)} link"
+                               f"{'s' if len(fixed) > 1 else ''} physical: "
+                               + ", ".join(f"'{n}'" for n in fixed))
+    corrected, given = out / "urdf/robot.urdf", out / "urdf/robot_as_given.urdf"
+    before, after = _pin_inertias(given), _pin_inertias(corrected)
+    assert not any(_physical(before[n]) for n in fixed)
+    for name, inertia in after.items():
+        if inertia.mass > 0 or name in fixed:  # type: ignore[attr-defined]
+            assert _physical(inertia), name
+    written, original = _inertials(corrected), _inertials(given)
+    assert sorted(n for n in written if written[n] != original[n]) == sorted(fixed)
+    for name in fixed:  # masses and COM kept; the tensor's principal axes kept
+        assert after[name].mass == before[name].mass  # type: ignore[attr-defined]
+        assert np.array_equal(after[name].lever, before[name].lever)  # type: ignore[attr-defined]
+        difference = after[name].inertia - before[name].inertia  # type: ignore[attr-defined]
+        assert np.allclose(difference, difference[0, 0] * np.eye(3), rtol=0, atol=1e-15)
+
+
+def test_correct_inertials_changes_no_physical_model(tmp_path: Path, diags: Diags) -> None:
+    """ur5: every link physical, so the corrected URDF is the same file, and no warning."""
+    spec = _spec(tmp_path, ERD / "ur_description/urdf/ur5_robot.urdf", """
+            - {type: urdf, correct_inertials: true}
+            - {type: urdf, filename_suffix: _as_given}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    assert (out / "urdf/robot.urdf").read_bytes() == (out / "urdf/robot_as_given.urdf").read_bytes()
+
+
+def test_a_massless_frame_stays_massless(tmp_path: Path) -> None:
+    """Mass 0 with a zero tensor is a frame (Phobos gives it 1e-5 kg); mass 0 with a
+    tensor gets Phobos's 1e-5 kg; a negative principal moment is lifted."""
+    from mpc.ir.physical import corrected
+    from mpc.ir.robot import Inertia, Inertial
+
+    zero = Inertia(ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.0, iyz=0.0, izz=0.0)
+    assert corrected(Inertial(mass=0.0, inertia=zero)) is None
+    massless = corrected(Inertial(mass=0.0, inertia=Inertia(ixx=1.0, ixy=0.0, ixz=0.0, iyy=1.0,
+                                                            iyz=0.0, izz=1.0)))
+    assert massless is not None and massless.mass == 1e-5 and massless.inertia.ixx == 1.0
+    point = corrected(Inertial(mass=0.1, inertia=zero))
+    assert point is not None and (point.inertia.ixx, point.inertia.iyy, point.inertia.izz) == (1e-5,) * 3
+    negative = corrected(Inertial(mass=1.0, inertia=Inertia(ixx=-0.1, ixy=0.0, ixz=0.0, iyy=1.0,
+                                                            iyz=0.0, izz=1.0)))
+    assert negative is not None
+    assert (negative.inertia.ixx, negative.inertia.iyy) == pytest.approx((0.001, 1.101))
+
+
+def test_copy_with_other_pathes_writes_phobos_files(tmp_path: Path, diags: Diags) -> None:
+    """A relative-path URDF gets `<name>_ros.urdf`, a ros_pathes SDF gets `<name>_relpath.sdf`;
+    the copies differ from their file only in the mesh paths, and the package:// paths
+    name the package that the written package.xml declares."""
+    spec = _spec(tmp_path, ERD / "talos_data/robots/talos_left_arm.urdf", """
+            - {type: urdf, mesh_format: stl, copy_with_other_pathes: true}
+            - {type: sdf, mesh_format: stl, ros_pathes: true, copy_with_other_pathes: true}
+        """, extra="  ros_pkg_name: talos_arm")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert out is not None
+    assert sorted(p.name for p in (out / "urdf").iterdir()) == ["robot.urdf", "robot_ros.urdf"]
+    assert sorted(p.name for p in (out / "sdf").iterdir()) == [
+        "model.config", "robot.sdf", "robot_relpath.sdf"]
+    urdf, ros = (out / "urdf/robot.urdf").read_text(), (out / "urdf/robot_ros.urdf").read_text()
+    assert 'filename="../meshes/stl/' in urdf and "package://" not in urdf
+    assert ros == urdf.replace('filename="../meshes/', 'filename="package://talos_arm/meshes/')
+    sdf, rel = (out / "sdf/robot.sdf").read_text(), (out / "sdf/robot_relpath.sdf").read_text()
+    assert "<uri>package://talos_arm/meshes/stl/" in sdf and "<uri>../" not in sdf
+    assert rel == sdf.replace("<uri>package://talos_arm/meshes/", "<uri>../meshes/")
+    assert "<name>talos_arm</name>" in (out / "package.xml").read_text()
+    # Every package:// path points at a file of the package.
+    for uri in etree.parse(str(out / "sdf/robot.sdf")).getroot().iter("uri"):
+        assert (out / uri.text.removeprefix("package://talos_arm/")).is_file()
+    # The linked URDF is still the relative one; the copies are beside it.
+    assert "../urdf/robot.urdf" in (out / "smurf/robot.smurf").read_text()
+
+
+def test_the_ros_copy_loads_in_pinocchio_through_the_package(tmp_path: Path, diags: Diags) -> None:
+    import pinocchio as pin
+
+    spec = _spec(tmp_path, ERD / "ur_description/urdf/ur5_robot.urdf", """
+            - {type: urdf, mesh_format: stl, copy_with_other_pathes: true}
+        """)
+    out = compile_file(spec, tmp_path / "pkg" / "robot_model", diags).out
+    assert out is not None
+    ros = str(out / "urdf/robot_ros.urdf")
+    model = pin.buildModelFromUrdf(ros)
+    visual = pin.buildGeomFromUrdf(model, ros, pin.GeometryType.VISUAL, package_dirs=[str(tmp_path / "pkg")])
+    assert visual.ngeoms > 0
+    assert all(Path(g.meshPath).is_file() and str(out) in g.meshPath for g in visual.geometryObjects)
+
+
+def test_ros_pathes_in_a_submodel_point_into_its_folder(tmp_path: Path, diags: Diags) -> None:
+    spec = _spec(tmp_path, ERD / "ur_description/urdf/ur5_robot.urdf", """
+            - {type: urdf, mesh_format: stl}
+            - type: submodel
+              name: forearm
+              start: forearm_link
+              export_config:
+                - {type: urdf, mesh_format: stl, ros_pathes: true, copy_with_other_pathes: true}
+                - {type: sdf, mesh_format: stl, ros_pathes: true}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert out is not None
+    sub = out / "submodels/forearm"
+    files = ((sub / "urdf/forearm.urdf", "mesh", "filename"), (sub / "sdf/forearm.sdf", "uri", None))
+    for path, tag, attr in files:
+        names = [e.get(attr) if attr else e.text for e in etree.parse(str(path)).getroot().iter(tag)]
+        prefix = "package://robot_model/submodels/forearm/meshes/stl/"
+        assert names and all(n.startswith(prefix) for n in names)
+        assert all((out / n.removeprefix("package://robot_model/")).is_file() for n in names)
+    rel = (sub / "urdf/forearm_relpath.urdf").read_text()
+    assert 'filename="../meshes/stl/' in rel and "package://" not in rel
+    assert (out / "package.xml").is_file()
+
+
+def test_append_export_config_extends_the_inherited_list(tmp_path: Path, diags: Diags) -> None:
+    """The defaults file's export_config, then the model's append_export_config; a second
+    model with the same defaults does not see the first one's additions (Phobos's
+    append changed the shared default list in place)."""
+    source = ERD / "ur_description/urdf/ur5_robot.urdf"
+    write(tmp_path / "base.yml", f"""
+        default_model:
+          input_models: {{base: {{basefile: "{source}"}}}}
+          assemble: {{model: base}}
+          export_config:
+            - {{type: urdf, mesh_format: stl}}
+        """)
+    first = write(tmp_path / "first.yml", """
+        defaults: base.yml
+        model:
+          robotname: ur5
+          modelname: first
+          append_export_config:
+            - {type: urdf, mesh_format: obj, filename_suffix: _obj}
+            - {type: joint_limits}
+        """)
+    second = write(tmp_path / "second.yml",
+                   "defaults: base.yml\nmodel: {robotname: ur5, modelname: second}\n")
+    out = compile_file(first, tmp_path / "first", diags).out
+    assert out is not None
+    assert sorted(p.name for p in (out / "urdf").iterdir()) == ["ur5.urdf", "ur5_obj.urdf"]
+    assert (out / "joint_limits.yml").is_file()
+    out2 = compile_file(second, tmp_path / "second", diags).out
+    assert out2 is not None
+    assert sorted(p.name for p in (out2 / "urdf").iterdir()) == ["ur5.urdf"]
+    assert not (out2 / "joint_limits.yml").exists()
+
+
+def test_append_export_config_without_export_config_adds_to_the_default_urdf(tmp_path: Path,
+                                                                            diags: Diags) -> None:
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: ur5
+          modelname: ur5_model
+          input_models: {{base: {{basefile: "{ERD / 'ur_description/urdf/ur5_robot.urdf'}"}}}}
+          assemble: {{model: base}}
+          append_export_config:
+            - {{type: sdf, mesh_format: stl}}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert out is not None
+    assert (out / "urdf/ur5.urdf").is_file() and (out / "sdf/ur5.sdf").is_file()
