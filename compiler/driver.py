@@ -111,9 +111,14 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
     originals: dict[str, Robot] = {}
     for op in program.ops:
         if isinstance(op, LoadModel):
-            robot = loader.robot(program.inputs[op.input])
+            inp = program.inputs[op.input]
+            robot = loader.robot(inp)
             if robot is None:
                 return None
+            if not inp.smurf_data:
+                from mpc.ir.smurf_data import without_smurf_data
+
+                robot = without_smurf_data(robot)
             parts[op.part] = originals[op.part] = robot
         elif isinstance(op, Attach):
             if op.r2r is not None:

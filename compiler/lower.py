@@ -140,7 +140,8 @@ class _Lowering:
             elif entry.derived_base is not None:
                 out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
                                   path=(self.folder_of(entry, "derived_base") / entry.derived_base).resolve(),
-                                  is_human=entry.is_human)
+                                  is_human=entry.is_human,
+                                  smurf_data=self.model.inherit_smurf_properties)
             elif entry.repo is not None:
                 r = entry.repo
                 out[name] = Input(name=name, kind="repo", path=None, span=entry.value_span("repo"),
@@ -505,8 +506,11 @@ class _Lowering:
             value = getattr(self.model, key)
             if value:
                 self.not_yet(self.model.key_span(key), f"'{key}'")
-        if not self.model.inherit_smurf_properties:
-            self.not_yet(self.model.key_span("inherit_smurf_properties"), "'inherit_smurf_properties: false'")
+        if not self.model.inherit_smurf_properties and not any(
+                i.kind == "derived_base" for i in inputs.values()):
+            self.sink.warning(self.model.key_span("inherit_smurf_properties"), "W0531",
+                              "'inherit_smurf_properties: false' has no effect: no input model is a "
+                              "derived_base", hint="it drops the SMURF data of derived_base inputs")
         for name, entry in self.model.input_models.items():
             if entry.is_human:
                 self.not_yet(entry.key_span("is_human"), f"'is_human' (input model '{name}')")

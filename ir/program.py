@@ -36,6 +36,8 @@ class Input:
     path: the model file (basefile) or the other definition (derived_base); None for repo.
     repo: where a `repo` input comes from.
     is_human: whether every link is marked as human (exoskeleton models).
+    smurf_data: whether the input keeps its SMURF data (motors, sensors, poses, annotations…);
+        False for a derived_base under `inherit_smurf_properties: false` (ir/smurf_data.py).
     span: the YAML value that names the source.
     """
 
@@ -45,6 +47,7 @@ class Input:
     span: Span
     repo: RepoRef | None = None
     is_human: bool = False
+    smurf_data: bool = True
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -240,3 +240,39 @@ def test_append_export_config_without_export_config_adds_to_the_default_urdf(tmp
     diags.take("W0500", severity=diags.diagnostics[0].severity)
     assert out is not None
     assert (out / "urdf/ur5.urdf").is_file() and (out / "sdf/ur5.sdf").is_file()
+
+
+def test_inherit_smurf_properties_false_drops_the_derived_inputs_smurf_data(tmp_path: Path,
+                                                                             diags: Diags) -> None:
+    """The ur5 with motors, sensors, poses, submechanisms, annotations and bitmasks, taken
+    as a derived_base: with `inherit_smurf_properties: false` the SMURF of the new model
+    links its URDF and nothing else, and the URDF is the parent's, byte for byte; the new
+    model's own annotations are kept."""
+    from tests.backends.test_smurf import UR5, child
+
+    write(tmp_path / "ur5.yml", UR5)
+    write(tmp_path / "plain.yml", child("derived_base", "ur5.yml").replace(
+        "  version: 1.2.0\n", "  version: 1.2.0\n  inherit_smurf_properties: false\n"))
+    write(tmp_path / "own.yml", child("derived_base", "ur5.yml").replace(
+        "  version: 1.2.0\n", "  version: 1.2.0\n  inherit_smurf_properties: false\n"
+        "  poses:\n    rest: {elbow_joint: 0.5}\n"))
+    outs = {}
+    for name in ("ur5", "plain", "own"):
+        outs[name] = compile_file(tmp_path / f"{name}.yml", tmp_path / "out" / name, diags).out
+        assert outs[name] is not None
+        diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert sorted(p.name for p in (outs["plain"] / "smurf").iterdir()) == ["ur5.smurf"]
+    assert (outs["plain"] / "urdf/ur5.urdf").read_bytes() == (outs["ur5"] / "urdf/ur5.urdf").read_bytes()
+    assert sorted(p.name for p in (outs["own"] / "smurf").iterdir()) == ["ur5.smurf", "ur5_poses.yml"]
+    assert "rest" in (outs["own"] / "smurf/ur5_poses.yml").read_text()
+    assert "home" not in (outs["own"] / "smurf/ur5_poses.yml").read_text()
+
+
+def test_inherit_smurf_properties_false_without_a_derived_input(tmp_path: Path, diags: Diags) -> None:
+    spec = _spec(tmp_path, ERD / "ur_description/urdf/ur5_robot.urdf", "    - {type: urdf}",
+                 extra="  inherit_smurf_properties: false")
+    assert compile_file(spec, tmp_path / "out", diags).out is not None
+    warning = diags.take("W0531", severity=diags.diagnostics[0].severity)
+    assert warning.message == ("'inherit_smurf_properties: false' has no effect: no input model is a "
+                               "derived_base")
+    assert (warning.span.line, warning.span.col) == (6, 3)
