@@ -25,6 +25,7 @@ def without_smurf_data(robot: Robot) -> Robot:
     """`robot` with no SMURF data (the module docstring lists it)."""
     return replace(
         robot, motors={}, sensors={}, poses={}, submechanisms=(), submechanisms_file=None, annotations={},
+        submodel_definitions={},
         links={name: _link(link) for name, link in robot.links.items()},
         joints={name: replace(joint, annotations={}) for name, joint in robot.joints.items()},
         materials={name: replace(m, annotations={}) for name, m in robot.materials.items()})

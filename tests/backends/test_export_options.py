@@ -276,3 +276,48 @@ def test_inherit_smurf_properties_false_without_a_derived_input(tmp_path: Path, 
     assert warning.message == ("'inherit_smurf_properties: false' has no effect: no input model is a "
                                "derived_base")
     assert (warning.span.line, warning.span.col) == (6, 3)
+
+
+def test_the_smurf_lists_the_submodels_and_reads_them_back(tmp_path: Path, diags: Diags) -> None:
+    """`smurf/<name>_submodels.yml` holds each submodel's definition with Phobos's keys and
+    its folder relative to smurf/; a model read from that SMURF writes the same files."""
+    import yaml
+
+    source = ERD / "ur_description/urdf/ur5_robot.urdf"
+    spec = write(tmp_path / "s.yml", f"""
+        model:
+          robotname: ur5
+          modelname: ur5_model
+          input_models: {{ur5: {{basefile: "{source}"}}}}
+          assemble: {{model: ur5}}
+          export_config:
+            - {{type: urdf, mesh_format: stl}}
+            - {{type: submodel, name: forearm, start: forearm_link, remove_fixed: true}}
+            - {{type: submodel, name: arm, stop: [wrist_1_link]}}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    index = yaml.safe_load((out / "smurf/ur5.smurf").read_text())
+    assert index["files"] == ["../urdf/ur5.urdf", "ur5_submodels.yml"]
+    submodels = yaml.safe_load((out / "smurf/ur5_submodels.yml").read_text())["submodels"]
+    assert submodels["arm"] == {
+        "name": "arm", "robotname": "arm", "start": None, "stop": ["wrist_1_link"], "abstract_model": False,
+        "remove_joints": [], "move_joint_axis_to_intersection": None, "include_unstopped_branches": False,
+        "no_submechanisms": False, "include_human_in_abstract": False, "export_dir": "../submodels/arm"}
+    assert submodels["forearm"]["start"] == "forearm_link" and submodels["forearm"]["remove_fixed"] is True
+    for name, definition in submodels.items():
+        assert (out / "smurf" / definition["export_dir"] / "urdf" / f"{name}.urdf").is_file()
+    assert not (out / "submodels/arm/smurf/arm_submodels.yml").exists()
+    again = write(tmp_path / "r.yml", f"""
+        model:
+          robotname: ur5
+          modelname: ur5_model
+          input_models: {{ur5: {{basefile: "{out / 'smurf/ur5.smurf'}"}}}}
+          assemble: {{model: ur5}}
+          export_config:
+            - {{type: urdf, mesh_format: stl}}
+        """)
+    out2 = compile_file(again, tmp_path / "again", diags).out
+    assert out2 is not None
+    for name in ("ur5.smurf", "ur5_submodels.yml"):
+        assert (out2 / "smurf" / name).read_bytes() == (out / "smurf" / name).read_bytes()
