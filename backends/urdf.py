@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mpc.backends import meshes
+from mpc.backends.float_formats import URDF_KEYS, Formats
 from mpc.backends.mesh_paths import variants
 from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
@@ -54,5 +55,6 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
         def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
             return prefix + files[meshes.key(mesh)]
 
+        formats = Formats(export.float_formats, URDF_KEYS) if export.float_formats else None
         write_path(out / "urdf" / f"{export.filename or robot.name}{suffix}.urdf",
-                   to_string(robot, mesh_name))
+                   to_string(robot, mesh_name, formats))

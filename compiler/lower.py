@@ -333,11 +333,11 @@ class _Lowering:
             self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
                          + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
-        later = dict(_KINEMATIC_LATER)
+        later: dict[str, Any] = {}
         if entry.type != "urdf":
             later.update(additional_meshes=None, enforce_zero=False)
         if entry.type == "mjcf":
-            later.update(ros_pathes=False, copy_with_other_pathes=False)
+            later.update(ros_pathes=False, copy_with_other_pathes=False, float_fmt_dict=None)
         for key, default in later.items():
             if getattr(entry, key) != default:
                 self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
@@ -359,6 +359,8 @@ class _Lowering:
             export = replace(export, ros_package=package if entry.ros_pathes else None,
                              copy_package=package if entry.copy_with_other_pathes else "")
         export = replace(export, correct_inertials=entry.correct_inertials)
+        if entry.type in ("urdf", "sdf") and entry.float_fmt_dict:
+            export = replace(export, float_formats=self.float_formats(entry))
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
@@ -374,6 +376,29 @@ class _Lowering:
         export = self.smurf.link(entry, export, submodel)
         written[target] = export
         return [export]
+
+    def float_formats(self, entry: Any) -> tuple[tuple[str, str], ...]:
+        """`float_fmt_dict` of a urdf or sdf entry, checked (backends/float_formats.py); sorted."""
+        from mpc.backends.float_formats import DEFAULT, KEYS, bad_format
+
+        keys = KEYS[entry.type]
+        out = []
+        for key, fmt in sorted(entry.float_fmt_dict.items()):
+            path = (*entry._path, "float_fmt_dict", key)
+            span = entry._doc.value_span(path)
+            if key != DEFAULT and key not in keys:
+                what = "attribute of a URDF" if entry.type == "urdf" else "element of an SDF"
+                self.sink.error(entry._doc.keys.get(path, span), "E0530",
+                                f"float_fmt_dict: '{key}' is no number {what} file"
+                                f"{did_you_mean(key, set(keys) | {DEFAULT})}",
+                                hint="'default' formats every number; the others are "
+                                + ", ".join(sorted(keys)))
+            elif bad_format(fmt):
+                self.sink.error(span, "E0530", f"float_fmt_dict: '{fmt}' is not a format of one number; "
+                                "write it as printf does, e.g. '%.6f', '%.8g' or '%e'")
+            else:
+                out.append((key, fmt))
+        return tuple(out)
 
     def submodel(self, entry: Any, written: dict[str, Export]) -> list[Export]:
         """A `submodel` entry: the part of the robot it cuts out, then its exports (its own
@@ -532,8 +557,6 @@ _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 _SUBMODEL_LATER: dict[str, Any] = {
     "include_human_in_abstract": False, "remove_links": []}
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
-# Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
-_KINEMATIC_LATER: dict[str, Any] = {"float_fmt_dict": None}
 
 
 

@@ -67,6 +67,8 @@ class UrdfExport:
         of mesh paths: `<filename>_ros.urdf` with `package://<copy_package>/…` paths, or, when
         the file has package paths, `<filename>_relpath.urdf` with relative ones.
     correct_inertials: non-physical inertials are made physical first (ir/physical.py).
+    float_formats: (attribute or `default`, printf format) of `float_fmt_dict`
+        (backends/float_formats.py); none: every number in its shortest exact form.
     span: the export_config entry.
     """
 
@@ -81,14 +83,15 @@ class UrdfExport:
     link_in_smurf: bool = False
     copy_package: str = ""
     correct_inertials: bool = False
+    float_formats: tuple[tuple[str, str], ...] = ()
     type: Literal["urdf"] = "urdf"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SdfExport:
     """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`; `link_in_smurf`,
-    `ros_package`, `copy_package` (`_ros.sdf`, `_relpath.sdf`) and
-    `correct_inertials` as for URDF."""
+    `ros_package`, `copy_package` (`_ros.sdf`, `_relpath.sdf`), `correct_inertials` and
+    `float_formats` (keyed by element) as for URDF."""
 
     mesh_format: str
     span: Span
@@ -101,6 +104,7 @@ class SdfExport:
     ros_package: str | None = None
     copy_package: str = ""
     correct_inertials: bool = False
+    float_formats: tuple[tuple[str, str], ...] = ()
     type: Literal["sdf"] = "sdf"
 
 

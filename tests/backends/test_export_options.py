@@ -3,6 +3,7 @@ ros_pathes in sdf and submodel exports, append_export_config — on example-robo
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -321,3 +322,45 @@ def test_the_smurf_lists_the_submodels_and_reads_them_back(tmp_path: Path, diags
     assert out2 is not None
     for name in ("ur5.smurf", "ur5_submodels.yml"):
         assert (out2 / "smurf" / name).read_bytes() == (out / "smurf" / name).read_bytes()
+
+
+def test_float_fmt_dict_formats_the_named_numbers(tmp_path: Path, diags: Diags) -> None:
+    """talos's arm with `%.6f` for every number and `%.3e` for ixx in the URDF, `%.4f` for
+    poses in the SDF: those numbers are written so, the others exactly; a second build gives
+    the same bytes; Pinocchio reads the same model to the formats' precision."""
+    import pinocchio as pin
+
+    spec = _spec(tmp_path, ERD / "talos_data/robots/talos_left_arm.urdf", """
+            - {type: urdf, mesh_format: stl, float_fmt_dict: {default: "%.6f", ixx: "%.3e"}}
+            - {type: urdf, mesh_format: stl, filename_suffix: _exact}
+            - {type: sdf, mesh_format: stl, float_fmt_dict: {pose: "%.4f"}}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert out is not None
+    root = etree.parse(str(out / "urdf/robot.urdf")).getroot()
+    for tag, attr in (("origin", "xyz"), ("origin", "rpy"), ("mass", "value"), ("limit", "effort"),
+                      ("inertia", "iyy"), ("axis", "xyz")):
+        for element in root.iter(tag):
+            if element.get(attr) is not None:
+                numbers = element.get(attr).split()
+                assert all(re.fullmatch(r"-?\d+\.\d{6}", x) for x in numbers), element.get(attr)
+    assert all(re.fullmatch(r"-?\d\.\d{3}e[-+]\d\d", e.get("ixx")) for e in root.iter("inertia"))
+    assert {e.get("link") for e in root.iter("parent")} <= {link.get("name") for link in root.iter("link")}
+    sdf = etree.parse(str(out / "sdf/robot.sdf")).getroot()
+    assert all(re.fullmatch(r"(-?\d+\.\d{4} ){5}-?\d+\.\d{4}", p.text) for p in sdf.iter("pose"))
+    assert [m.text for m in sdf.iter("mass")] == [  # exact: no format for them
+        m.get("value") for m in etree.parse(str(out / "urdf/robot_exact.urdf")).getroot().iter("mass")]
+    first = {p: p.read_bytes() for p in sorted(out.rglob("*.*df"))}
+    again = compile_file(spec, tmp_path / "again", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert again is not None
+    assert {p.relative_to(out): b for p, b in first.items()} == {
+        p.relative_to(again): p.read_bytes() for p in sorted(again.rglob("*.*df"))}
+    formatted = pin.buildModelFromUrdf(str(out / "urdf/robot.urdf"))
+    exact = pin.buildModelFromUrdf(str(out / "urdf/robot_exact.urdf"))
+    placements = [(a, b) for a, b in zip(formatted.jointPlacements, exact.jointPlacements, strict=True)]
+    assert all(np.allclose(a.homogeneous, b.homogeneous, atol=1e-6) for a, b in placements)
+    assert all(abs(a.mass - b.mass) <= 5e-7 for a, b in zip(formatted.inertias, exact.inertias, strict=True))
+    assert any(a.mass != b.mass or not np.array_equal(a.inertia, b.inertia)
+               for a, b in zip(formatted.inertias, exact.inertias, strict=True))
