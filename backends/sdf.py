@@ -24,6 +24,7 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import link_in_root, matrix_pose
+from mpc.ir.numbers import zero_small
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -373,6 +374,12 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
+    for fmt in export.additional_meshes:  # written beside, referenced by nothing
+        extra = meshes.plan(robot, fmt, sink, export.span)
+        if extra is None or not meshes.copy(extra, out, sink, export.span, robot):
+            return
+    if export.enforce_zero:
+        robot = zero_small(robot)
 
     # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
     # file's folder; model:// would need the meshes inside the model folder (out/sdf).

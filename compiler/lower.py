@@ -334,10 +334,9 @@ class _Lowering:
                          + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
         later: dict[str, Any] = {}
-        if entry.type != "urdf":
-            later.update(additional_meshes=None, enforce_zero=False)
         if entry.type == "mjcf":
-            later.update(ros_pathes=False, copy_with_other_pathes=False, float_fmt_dict=None)
+            later.update(additional_meshes=None, enforce_zero=False, ros_pathes=False,
+                         copy_with_other_pathes=False, float_fmt_dict=None)
         for key, default in later.items():
             if getattr(entry, key) != default:
                 self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
@@ -368,7 +367,7 @@ class _Lowering:
                             f"no meaning in a {entry.type} export: "
                             + ("URDF cannot hold loops" if entry.type == "urdf"
                                else "MJCF always closes loops with equality constraints"))
-        if entry.type == "urdf":
+        if entry.type in ("urdf", "sdf"):
             extra = entry.additional_meshes
             export = replace(
                 export, enforce_zero=entry.enforce_zero,

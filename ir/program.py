@@ -90,8 +90,8 @@ class UrdfExport:
 @dataclass(frozen=True, slots=True, kw_only=True)
 class SdfExport:
     """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`; `link_in_smurf`,
-    `ros_package`, `copy_package` (`_ros.sdf`, `_relpath.sdf`), `correct_inertials` and
-    `float_formats` (keyed by element) as for URDF."""
+    `ros_package`, `additional_meshes`, `enforce_zero`, `copy_package` (`_ros.sdf`,
+    `_relpath.sdf`), `correct_inertials` and `float_formats` (keyed by element) as for URDF."""
 
     mesh_format: str
     span: Span
@@ -102,6 +102,8 @@ class SdfExport:
     submodel: str = ""
     link_in_smurf: bool = False
     ros_package: str | None = None
+    additional_meshes: tuple[str, ...] = ()
+    enforce_zero: bool = False
     copy_package: str = ""
     correct_inertials: bool = False
     float_formats: tuple[tuple[str, str], ...] = ()

@@ -364,3 +364,19 @@ def test_float_fmt_dict_formats_the_named_numbers(tmp_path: Path, diags: Diags) 
     assert all(abs(a.mass - b.mass) <= 5e-7 for a, b in zip(formatted.inertias, exact.inertias, strict=True))
     assert any(a.mass != b.mass or not np.array_equal(a.inertia, b.inertia)
                for a, b in zip(formatted.inertias, exact.inertias, strict=True))
+
+
+def test_sdf_additional_meshes_and_enforce_zero(tmp_path: Path, diags: Diags) -> None:
+    """As for URDF: the meshes also in OBJ, referenced by nothing; 1e-17 written as 0."""
+    spec = _spec(tmp_path, ERD / "talos_data/robots/talos_left_arm.urdf", """
+            - {type: sdf, mesh_format: stl, additional_meshes: [obj], enforce_zero: true}
+            - {type: sdf, mesh_format: stl, filename_suffix: _as_is}
+        """, extra="  frames:\n            arm_left_2_link: {transform_frame: {xyz: [0, 0, 1e-17]}}")
+    out = compile_file(spec, tmp_path / "out", diags).out
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    diags.take("W0500", severity=diags.diagnostics[0].severity)
+    assert out is not None
+    assert sorted(p.stem for p in (out / "meshes/obj").iterdir()) == sorted(
+        p.stem for p in (out / "meshes/stl").iterdir())
+    zeroed, as_is = (out / "sdf/robot.sdf").read_text(), (out / "sdf/robot_as_is.sdf").read_text()
+    assert "1e-17" in as_is and "1e-17" not in zeroed and "/obj/" not in zeroed
