@@ -380,3 +380,25 @@ def test_sdf_additional_meshes_and_enforce_zero(tmp_path: Path, diags: Diags) ->
         p.stem for p in (out / "meshes/stl").iterdir())
     zeroed, as_is = (out / "sdf/robot.sdf").read_text(), (out / "sdf/robot_as_is.sdf").read_text()
     assert "1e-17" in as_is and "1e-17" not in zeroed and "/obj/" not in zeroed
+
+
+def test_from_the_command_line(tmp_path: Path) -> None:
+    """pr2: `mpc check` is clean, `mpc compile` writes both files of each export and names
+    the corrected links in gcc format."""
+    from tests.compiler.test_cli import mpc
+
+    spec = _spec(tmp_path, ERD / "pr2_description/urdf/pr2.urdf", """
+            - type: urdf
+              correct_inertials: true
+              copy_with_other_pathes: true
+              float_fmt_dict: {default: "%.8g"}
+        """, extra="  append_export_config:\n            - {type: joint_limits}")
+    check = mpc("check", spec)
+    assert (check.returncode, check.stderr) == (0, "")
+    run = mpc("compile", "--format", "gcc", spec, "-o", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == (f"{spec}:10:7: warning: correct_inertials made the inertials of 2 links physical: "
+                          "'sensor_mount_link', 'double_stereo_link' [W0530]\n")
+    assert run.stdout.startswith(f"compiled '{spec}' into '{tmp_path}/out': CMakeLists.txt, "
+                                 "joint_limits.yml, package.xml, smurf/robot.smurf, urdf/robot.urdf, "
+                                 "urdf/robot_ros.urdf and ")
