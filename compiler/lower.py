@@ -307,11 +307,8 @@ class _Lowering:
 
     def export(self, entry: Any, written: dict[str, Export], robotname: str,
                submodel: str = "", inherited: bool = False) -> list[Export]:
-        """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/).
-        An entry a submodel inherits from the model writes relative mesh paths: its meshes are
-        in the submodel's folder, not where the package's `package://` paths point."""
-        if inherited and getattr(entry, "ros_pathes", False):
-            entry = entry.model_copy(update={"ros_pathes": False})
+        """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/,
+        where its meshes are too: its `package://` paths point there)."""
         if entry.type == "kccd":
             from mpc.compiler.lower_kccd import lower_kccd
 

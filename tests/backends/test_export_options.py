@@ -402,3 +402,17 @@ def test_from_the_command_line(tmp_path: Path) -> None:
     assert run.stdout.startswith(f"compiled '{spec}' into '{tmp_path}/out': CMakeLists.txt, "
                                  "joint_limits.yml, package.xml, smurf/robot.smurf, urdf/robot.urdf, "
                                  "urdf/robot_ros.urdf and ")
+
+
+def test_a_submodel_inherits_ros_pathes(tmp_path: Path, diags: Diags) -> None:
+    """The model's ros_pathes entry, inherited by a submodel: its paths point into its folder."""
+    spec = _spec(tmp_path, ERD / "ur_description/urdf/ur5_robot.urdf", """
+            - {type: urdf, mesh_format: stl, ros_pathes: true}
+            - {type: submodel, name: wrist, start: wrist_1_link}
+        """)
+    out = compile_file(spec, tmp_path / "out", diags).out
+    assert out is not None
+    urdf = etree.parse(str(out / "submodels/wrist/urdf/wrist.urdf"))
+    names = [m.get("filename") for m in urdf.iter("mesh")]
+    assert names and all(n.startswith("package://robot_model/submodels/wrist/meshes/stl/") for n in names)
+    assert all((out / n.removeprefix("package://robot_model/")).is_file() for n in names)
