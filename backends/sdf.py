@@ -16,12 +16,15 @@ from pathlib import Path
 from xml.sax.saxutils import escape
 
 from mpc.backends import meshes
+from mpc.backends.float_formats import SDF_KEYS, Formats
+from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import link_in_root, matrix_pose
+from mpc.ir.numbers import zero_small
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -151,8 +154,8 @@ def warn(robot: Robot, span: Span, sink: Sink, version: str = "1.9", cut_joints:
 
 
 class _Writer:
-    def __init__(self, robot: Robot, mesh_name: MeshNamer) -> None:
-        self.robot, self.mesh_name = robot, mesh_name
+    def __init__(self, robot: Robot, mesh_name: MeshNamer, formats: Formats | None = None) -> None:
+        self.robot, self.mesh_name, self.formats = robot, mesh_name, formats
         self.links, self.joints = sdf_names(robot)
         self.out: list[str] = []
 
@@ -164,6 +167,8 @@ class _Writer:
             self.line(depth, f"<!--{c}-->")
 
     def leaf(self, depth: int, tag: str, value: str) -> None:
+        if self.formats is not None:  # float_fmt_dict (backends/float_formats.py)
+            value = self.formats(tag, value) or value
         self.line(depth, f"<{tag}>{escape(value)}</{tag}>")
 
     def pose(self, depth: int, pose: Pose | None, always: bool = False) -> None:
@@ -327,7 +332,7 @@ class _Writer:
 
 
 def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
-              sink: Sink | None = None, cut_joints: bool = False) -> str:
+              sink: Sink | None = None, cut_joints: bool = False, formats: Formats | None = None) -> str:
     """The canonical SDF text of `robot`; `mesh_name` gives each mesh's uri.
 
     With a sink, what the SDF leaves out or renames is reported there (W0500).
@@ -335,7 +340,7 @@ def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
     """
     if sink is not None:
         warn(robot, robot.span or Span.of_file(robot.name), sink, version, cut_joints)
-    w = _Writer(robot, mesh_name)
+    w = _Writer(robot, mesh_name, formats)
     w.line(0, '<?xml version="1.0" encoding="utf-8"?>')
     w.comments(0, robot.header_comments)
     w.line(0, f'<sdf version="{version}">')
@@ -369,12 +374,23 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     files = meshes.plan(robot, export.mesh_format, sink, export.span)
     if files is None or not meshes.copy(files, out, sink, export.span, robot):
         return
+    for fmt in export.additional_meshes:  # written beside, referenced by nothing
+        extra = meshes.plan(robot, fmt, sink, export.span)
+        if extra is None or not meshes.copy(extra, out, sink, export.span, robot):
+            return
+    if export.enforce_zero:
+        robot = zero_small(robot)
 
-    def mesh_name(mesh: Mesh) -> str:
-        # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
-        # file's folder; model:// would need the meshes inside the model folder (out/sdf).
-        return "../" + files[meshes.key(mesh)]
+    # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
+    # file's folder; model:// would need the meshes inside the model folder (out/sdf).
+    # Or package:// paths (ros_pathes), which ROS's Gazebo resolves (backends/mesh_paths.py).
+    for suffix, prefix in variants(export):
 
-    text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints)
-    write_path(out / "sdf" / f"{export.filename or robot.name}.sdf", text)
+        def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
+            return prefix + files[meshes.key(mesh)]
+
+        formats = Formats(export.float_formats, SDF_KEYS) if export.float_formats else None
+        text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints,
+                         formats=formats)
+        write_path(out / "sdf" / f"{export.filename or robot.name}{suffix}.sdf", text)
     write_path(out / "sdf" / "model.config", model_config(robot, export.version))

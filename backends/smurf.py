@@ -28,10 +28,10 @@ from mpc.backends.smurf_reader import read
 from mpc.backends.xml import fmt_float, write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Motor, Sensor
-from mpc.ir.program import SmurfExport
+from mpc.ir.program import SmurfExport, SubmodelExport
 from mpc.ir.robot import Material, Robot
 
-__all__ = ["CATEGORIES", "annotation_files", "dumps", "emit", "motor_limits", "read"]
+__all__ = ["CATEGORIES", "annotation_files", "dumps", "emit", "motor_limits", "read", "submodel_definition"]
 
 # The categories SMURF gives a meaning (Phobos's `smurf_annotation_keys`, plus submodels);
 # a free annotation category of one of these names would overwrite its file.
@@ -184,8 +184,10 @@ def _submechanisms(robot: Robot, sink: Sink, span: Any) -> dict[str, Any]:
     return out
 
 
-def annotation_files(robot: Robot, sink: Sink, span: Any = None) -> dict[str, dict[str, Any]]:
-    """The content of each `<name>_<category>.yml`, by category; empty categories left out."""
+def annotation_files(robot: Robot, sink: Sink, span: Any = None,
+                     submodels: tuple[SubmodelExport, ...] = ()) -> dict[str, dict[str, Any]]:
+    """The content of each `<name>_<category>.yml`, by category; empty categories left out.
+    `submodels`: the submodels cut from this robot (with those of a SMURF it was read from)."""
     joints = [{**j.annotations, "name": n} for n, j in robot.joints.items() if j.annotations]
     joints += [_cut_joint(c) for c in robot.cut_joints.values()]
     links = [{**lk.annotations, "name": n} for n, lk in robot.links.items() if lk.annotations]
@@ -204,7 +206,25 @@ def annotation_files(robot: Robot, sink: Sink, span: Any = None) -> dict[str, di
     for category, content in robot.annotations.items():
         name = category if category not in CATEGORIES else f"generic_annotation_{category}"
         files[name] = {name: content}
+    definitions = {**robot.submodel_definitions, **{s.name: submodel_definition(s) for s in submodels}}
+    if definitions:
+        files["submodels"] = {"submodels": definitions}
     return files
+
+
+def submodel_definition(s: SubmodelExport) -> dict[str, Any]:
+    """A submodel's entry in `<name>_submodels.yml`: Phobos's keys (`start`, `stop` null when
+    not given; `export_dir` relative to smurf/), then the options only mpc has, when set."""
+    out: dict[str, Any] = {
+        "name": s.name, "robotname": s.name, "start": s.start or None, "stop": list(s.stop) or None,
+        "abstract_model": s.abstract_model, "remove_joints": list(s.remove_joints),
+        "move_joint_axis_to_intersection": ({k: list(v) for k, v in s.move_joint_axis_to_intersection.items()}
+                                            or None),
+        "include_unstopped_branches": s.include_unstopped_branches, "no_submechanisms": s.no_submechanisms,
+        "include_human_in_abstract": False, "export_dir": f"../submodels/{s.name}"}
+    extra = {"remove_fixed": s.remove_fixed, "add_floating_base": s.add_floating_base,
+             "name_replacements": dict(s.name_replacements)}
+    return out | {k: v for k, v in extra.items() if v}
 
 
 # -- files -----------------------------------------------------------------------------------
@@ -213,7 +233,7 @@ def emit(robot: Robot, export: SmurfExport, out: Path, sink: Sink) -> None:
     """Write `out/smurf/<name>.smurf` and its annotation files."""
     name = export.filename or robot.name
     folder = out / "smurf"
-    files = annotation_files(robot, sink, export.span)
+    files = annotation_files(robot, sink, export.span, export.submodels)
     bad = [f"'{n}'" for n in (name, *(f"{name}_{c}" for c in files)) if not _FILE_PART.fullmatch(n)]
     if bad:
         sink.error(export.span, "E0515", f"the SMURF cannot write {', '.join(bad)} as file names in "

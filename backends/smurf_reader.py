@@ -113,7 +113,9 @@ class _Reader:
             return
         for category, content in doc.data.items():
             handler = getattr(self, f"_{category}", None)
-            if category in _LISTS and handler is not None:
+            if category == "submodels" and isinstance(content, dict):
+                self.state.submodels.update(content)  # definitions, by name (Phobos's keys)
+            elif category in _LISTS and handler is not None:
                 for i, entry in self.entries(category, content):
                     handler(entry, (category, i))
             elif isinstance(content, dict):
@@ -313,12 +315,13 @@ class _State:
         self.cut_joints, self.poses = dict(robot.cut_joints), dict(robot.poses)
         self.submechanisms: list[Submechanism] = list(robot.submechanisms)
         self.annotations = dict(robot.annotations)
+        self.submodels: dict[str, Any] = dict(robot.submodel_definitions)
 
     def robot(self) -> Robot:
         return replace(self.base, links=self.links, joints=self.joints, materials=self.materials,
                        motors=self.motors, sensors=self.sensors, cut_joints=self.cut_joints,
                        poses=self.poses, submechanisms=tuple(self.submechanisms),
-                       annotations=self.annotations)
+                       annotations=self.annotations, submodel_definitions=self.submodels)
 
 
 __all__ = ["MODEL_SUFFIXES", "read"]

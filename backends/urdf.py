@@ -10,6 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from mpc.backends import meshes
+from mpc.backends.float_formats import URDF_KEYS, Formats
+from mpc.backends.mesh_paths import variants
 from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
@@ -48,9 +50,11 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
             return
     if export.enforce_zero:
         robot = zero_small(robot)
-    prefix = f"package://{export.ros_package}/" if export.ros_package else "../"
+    for suffix, prefix in variants(export):
 
-    def mesh_name(mesh: Mesh) -> str:
-        return prefix + files[meshes.key(mesh)]
+        def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
+            return prefix + files[meshes.key(mesh)]
 
-    write_path(out / "urdf" / f"{export.filename or robot.name}.urdf", to_string(robot, mesh_name))
+        formats = Formats(export.float_formats, URDF_KEYS) if export.float_formats else None
+        write_path(out / "urdf" / f"{export.filename or robot.name}{suffix}.urdf",
+                   to_string(robot, mesh_name, formats))

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from xml.sax.saxutils import escape
 
+from mpc.backends.float_formats import Formats
 from mpc.backends.xml import fmt_float, fmt_floats
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
@@ -32,8 +33,8 @@ def _num(x: float | None) -> str | None:
 
 
 class _Writer:
-    def __init__(self, mesh_name: MeshNamer) -> None:
-        self.mesh_name = mesh_name
+    def __init__(self, mesh_name: MeshNamer, formats: Formats | None = None) -> None:
+        self.mesh_name, self.formats = mesh_name, formats
         self.out: list[str] = []
 
     def line(self, depth: int, text: str) -> None:
@@ -44,6 +45,8 @@ class _Writer:
             self.line(depth, f"<!--{c}-->")
 
     def leaf(self, depth: int, tag: str, pairs: list[tuple[str, str | None]] | Attrs) -> None:
+        if self.formats is not None:  # float_fmt_dict (backends/float_formats.py)
+            pairs = [(k, self.formats(k, v)) for k, v in pairs]
         self.line(depth, f"<{tag}{_attrs(pairs)}/>")
 
     def fragment(self, depth: int, frag: Fragment) -> None:
@@ -171,9 +174,10 @@ class _Writer:
         self.line(depth, "</joint>")
 
 
-def to_string(robot: Robot, mesh_name: MeshNamer) -> str:
-    """The canonical URDF text of `robot`; `mesh_name` gives each mesh's filename."""
-    w = _Writer(mesh_name)
+def to_string(robot: Robot, mesh_name: MeshNamer, formats: Formats | None = None) -> str:
+    """The canonical URDF text of `robot`; `mesh_name` gives each mesh's filename; `formats`
+    the number formats of `float_fmt_dict`, when given."""
+    w = _Writer(mesh_name, formats)
     w.line(0, '<?xml version="1.0" encoding="utf-8"?>')
     w.comments(0, robot.header_comments)
     w.line(0, f"<robot{_attrs([('name', robot.name), *robot.extra_attrs])}>")

@@ -111,9 +111,14 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
     originals: dict[str, Robot] = {}
     for op in program.ops:
         if isinstance(op, LoadModel):
-            robot = loader.robot(program.inputs[op.input])
+            inp = program.inputs[op.input]
+            robot = loader.robot(inp)
             if robot is None:
                 return None
+            if not inp.smurf_data:
+                from mpc.ir.smurf_data import without_smurf_data
+
+                robot = without_smurf_data(robot)
             parts[op.part] = originals[op.part] = robot
         elif isinstance(op, Attach):
             if op.r2r is not None:
@@ -193,6 +198,8 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | N
                     model = submodels[export.joints_of]  # its joints, written where the entry is
                 if model is not None and export.add_floating_base:
                     model = _floating(model, export, sink)
+                if model is not None and getattr(export, "correct_inertials", False):
+                    model = _physical(model, export, sink)
                 if model is None:
                     continue
             folder.mkdir(parents=True, exist_ok=True)
@@ -215,6 +222,19 @@ def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
         sink.error(export.span, "E0505", "add_floating_base needs the names 'world' and "
                    "'floating_base', which the robot uses already")
     return floating
+
+
+def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
+    """`robot` with its non-physical inertials made physical (ir/physical.py); W0530 names them."""
+    from mpc.ir.physical import correct_inertials
+
+    robot, changed = correct_inertials(robot)
+    if changed:
+        more = f" and {len(changed) - 8} more" if len(changed) > 8 else ""
+        shown = ", ".join(f"'{n}'" for n in changed[:8]) + more
+        sink.warning(export.span, "W0530", f"correct_inertials made the inertials of {len(changed)} "
+                     f"link{'s' if len(changed) > 1 else ''} physical: {shown}")
+    return robot
 
 
 def _replace(new: Path, out: Path) -> None:

@@ -56,7 +56,7 @@ from mpc.ir.robot import Limit, Pose
 from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
-LATER_SECTIONS = ("append_export_config", "swing_my_robot")
+LATER_SECTIONS = ("swing_my_robot",)
 
 
 def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
@@ -140,7 +140,8 @@ class _Lowering:
             elif entry.derived_base is not None:
                 out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
                                   path=(self.folder_of(entry, "derived_base") / entry.derived_base).resolve(),
-                                  is_human=entry.is_human)
+                                  is_human=entry.is_human,
+                                  smurf_data=self.model.inherit_smurf_properties)
             elif entry.repo is not None:
                 r = entry.repo
                 out[name] = Input(name=name, kind="repo", path=None, span=entry.value_span("repo"),
@@ -276,12 +277,19 @@ class _Lowering:
                                 "'reduce_meshes' is a ratio of faces to keep (between 0 and 1) or a "
                                 f"number of faces (4 or more), got {value:g}")
 
+    def entries(self) -> list[Any]:
+        """The model's export entries: `export_config` (inherited through `defaults` or the
+        pipeline's `default_export_config`, or none: the default URDF), then the
+        `append_export_config` entries. A new list each time: appending never changes the
+        list it extends (Phobos appended in place, to every later model's default too)."""
+        return [*(self.model.export_config or ()), *self.model.append_export_config]
+
     def exports(self) -> tuple[Export, ...]:
         out: list[Export] = []
         if self.model.export_config is None:
             out.append(UrdfExport(mesh_format="input_type", span=self.model.span))
         written: dict[str, Export] = {}
-        for entry in self.model.export_config or ():
+        for entry in self.entries():
             if entry.type == "submodel":
                 out.extend(self.submodel(entry, written))
             else:
@@ -290,18 +298,17 @@ class _Lowering:
         out = [e for e in out if not _lists_a_submodel(e)] + [e for e in out if _lists_a_submodel(e)]
         out.extend(self.smurf.exports(out))
         out.extend(self.commands())
-        package = next((e.ros_package for e in out if isinstance(e, UrdfExport) and e.ros_package), None)
+        # A file with package:// paths (ros_pathes, or its copy) makes the output a ROS package.
+        package = next((e.ros_package or e.copy_package for e in out if isinstance(e, UrdfExport | SdfExport)
+                        and (e.ros_package or e.copy_package)), None)
         if package is not None:
             out.append(self.ros_package(package))
         return tuple(out)
 
     def export(self, entry: Any, written: dict[str, Export], robotname: str,
                submodel: str = "", inherited: bool = False) -> list[Export]:
-        """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/).
-        An entry a submodel inherits from the model writes relative mesh paths: its meshes are
-        in the submodel's folder, not where the package's `package://` paths point."""
-        if inherited and getattr(entry, "ros_pathes", False):
-            entry = entry.model_copy(update={"ros_pathes": False})
+        """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/,
+        where its meshes are too: its `package://` paths point there)."""
         if entry.type == "kccd":
             from mpc.compiler.lower_kccd import lower_kccd
 
@@ -323,15 +330,13 @@ class _Lowering:
             self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
                          + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
-        later = dict(_KINEMATIC_LATER)
-        if entry.type != "urdf":
-            later.update(additional_meshes=None, ros_pathes=False, enforce_zero=False)
-        elif submodel:
-            later.update(ros_pathes=False)
+        later: dict[str, Any] = {}
+        if entry.type == "mjcf":
+            later.update(additional_meshes=None, enforce_zero=False, ros_pathes=False,
+                         copy_with_other_pathes=False, float_fmt_dict=None)
         for key, default in later.items():
             if getattr(entry, key) != default:
-                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'"
-                             + (" in a submodel" if submodel and key == "ros_pathes" else ""))
+                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in written:
@@ -345,6 +350,13 @@ class _Lowering:
         export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                            add_floating_base=entry.add_floating_base, submodel=submodel,
                                            filename=filename if filename != (submodel or robotname) else "")
+        package = self.model.ros_pkg_name or self.model.modelname
+        if entry.type in ("urdf", "sdf"):
+            export = replace(export, ros_package=package if entry.ros_pathes else None,
+                             copy_package=package if entry.copy_with_other_pathes else "")
+        export = replace(export, correct_inertials=entry.correct_inertials)
+        if entry.type in ("urdf", "sdf") and entry.float_fmt_dict:
+            export = replace(export, float_formats=self.float_formats(entry))
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
@@ -352,15 +364,37 @@ class _Lowering:
                             f"no meaning in a {entry.type} export: "
                             + ("URDF cannot hold loops" if entry.type == "urdf"
                                else "MJCF always closes loops with equality constraints"))
-        if entry.type == "urdf":
+        if entry.type in ("urdf", "sdf"):
             extra = entry.additional_meshes
-            package = (self.model.ros_pkg_name or self.model.modelname) if entry.ros_pathes else None
             export = replace(
-                export, enforce_zero=entry.enforce_zero, ros_package=package,
+                export, enforce_zero=entry.enforce_zero,
                 additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
         export = self.smurf.link(entry, export, submodel)
         written[target] = export
         return [export]
+
+    def float_formats(self, entry: Any) -> tuple[tuple[str, str], ...]:
+        """`float_fmt_dict` of a urdf or sdf entry, checked (backends/float_formats.py); sorted."""
+        from mpc.backends.float_formats import DEFAULT, KEYS, bad_format
+
+        keys = KEYS[entry.type]
+        out = []
+        for key, fmt in sorted(entry.float_fmt_dict.items()):
+            path = (*entry._path, "float_fmt_dict", key)
+            span = entry._doc.value_span(path)
+            if key != DEFAULT and key not in keys:
+                what = "attribute of a URDF" if entry.type == "urdf" else "element of an SDF"
+                self.sink.error(entry._doc.keys.get(path, span), "E0530",
+                                f"float_fmt_dict: '{key}' is no number {what} file"
+                                f"{did_you_mean(key, set(keys) | {DEFAULT})}",
+                                hint="'default' formats every number; the others are "
+                                + ", ".join(sorted(keys)))
+            elif bad_format(fmt):
+                self.sink.error(span, "E0530", f"float_fmt_dict: '{fmt}' is not a format of one number; "
+                                "write it as printf does, e.g. '%.6f', '%.8g' or '%e'")
+            else:
+                out.append((key, fmt))
+        return tuple(out)
 
     def submodel(self, entry: Any, written: dict[str, Export]) -> list[Export]:
         """A `submodel` entry: the part of the robot it cuts out, then its exports (its own
@@ -404,7 +438,7 @@ class _Lowering:
         out: list[Export] = [cut]
         nested = entry.export_config
         if nested is None:
-            nested = [e for e in self.model.export_config or () if e.type != "submodel"]
+            nested = [e for e in self.entries() if e.type != "submodel"]
             if self.model.export_config is None:
                 out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name,
                                       filename=entry.filename or ""))
@@ -468,7 +502,7 @@ class _Lowering:
         from mpc.backends.joint_limits import SELECTIONS
 
         # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
-        submodels = {e.name for e in self.model.export_config or () if e.type == "submodel"}
+        submodels = {e.name for e in self.entries() if e.type == "submodel"}
         as_string = isinstance(entry._doc.data_at((*entry._path, "joints")), str)
         if len(joints) == 1 and as_string and joints[0] in submodels:
             return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
@@ -493,8 +527,11 @@ class _Lowering:
             value = getattr(self.model, key)
             if value:
                 self.not_yet(self.model.key_span(key), f"'{key}'")
-        if not self.model.inherit_smurf_properties:
-            self.not_yet(self.model.key_span("inherit_smurf_properties"), "'inherit_smurf_properties: false'")
+        if not self.model.inherit_smurf_properties and not any(
+                i.kind == "derived_base" for i in inputs.values()):
+            self.sink.warning(self.model.key_span("inherit_smurf_properties"), "W0531",
+                              "'inherit_smurf_properties: false' has no effect: no input model is a "
+                              "derived_base", hint="it drops the SMURF data of derived_base inputs")
         for name, entry in self.model.input_models.items():
             if entry.is_human:
                 self.not_yet(entry.key_span("is_human"), f"'is_human' (input model '{name}')")
@@ -516,11 +553,6 @@ _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 _SUBMODEL_LATER: dict[str, Any] = {
     "include_human_in_abstract": False, "remove_links": []}
 BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
-# Options of urdf/sdf/mjcf exports that later versions implement (with their defaults).
-_KINEMATIC_LATER: dict[str, Any] = {
-    "copy_with_other_pathes": False, "correct_inertials": False,
-    "float_fmt_dict": None,
-}
 
 
 

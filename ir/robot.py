@@ -223,6 +223,7 @@ class Robot:
     motors, sensors, cut_joints: by name (ir/extras.py). poses: named joint configurations.
     submechanisms: in definition order; submechanisms_file: used as it is, when given.
     annotations: named annotation categories.
+    submodel_definitions: the `<name>_submodels.yml` of a SMURF it was read from, by submodel.
     extra_attrs: attributes of `<robot>` other than name (namespaces, version).
     header_comments: comments before `<robot>`; trailing_comments: at its end.
     """
@@ -244,3 +245,4 @@ class Robot:
     submechanisms_file: str | None = None
     annotations: Mapping[str, Mapping[str, object]] = field(default_factory=dict)
     span: Span | None = None
+    submodel_definitions: Mapping[str, object] = field(default_factory=dict)

@@ -1,0 +1,69 @@
+"""`correct_inertials`: make non-physical inertials physical, leave physical ones alone.
+
+A rigid body's inertial is physical when its mass is positive and its inertia about the
+COM is positive-definite and satisfies the triangle inequality (each principal moment is
+at most the sum of the other two). Phobos's `Robot.correct_inertials` sets every mass
+below 1e-5 kg to 1e-5 and lifts every principal moment below 1e-5 kg·m² to 1e-5, which also
+changes small physical bodies (a finger segment) and leaves a tensor that breaks the
+triangle inequality broken; mpc changes only what is not physical:
+
+- no `<inertial>`, or mass 0 with a zero tensor: a massless frame, left as it is
+  (Phobos gives such links 1e-5 kg);
+- a mass that is not positive, with a tensor: 1e-5 kg, Phobos's floor;
+- a tensor that is not positive-definite or breaks the triangle inequality beyond
+  rounding (1e-6 of its largest moment, what six written digits carry; the rule of
+  `mpc test`'s physical_validity, checks/validity.py): the same amount d is added to each principal moment,
+  I + d·1 (principal axes kept), the least d that makes it physical plus a margin of
+  1e-3 of its largest moment (1e-5 kg·m² for a zero tensor, Phobos's floor).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from mpc.ir.robot import Inertia, Inertial, Robot
+
+FLOOR = 1e-5  # Phobos's limit: kg for a mass, kg·m² for a zero tensor
+MARGIN = 1e-3  # of the largest principal moment, beyond the least correction
+ROUNDING = 1e-6  # of the largest moment: a triangle inequality broken by less is rounding
+
+
+def _matrix(i: Inertia) -> np.ndarray:
+    return np.array([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]])
+
+
+def lift(i: Inertia) -> float:
+    """The amount to add to each principal moment of `i` (0 when it is physical)."""
+    moments = np.linalg.eigvalsh(_matrix(i))  # ascending: only a + b >= c can fail
+    a, b, c = (float(m) for m in moments)
+    broken = c - a - b
+    if a > 0 and broken <= ROUNDING * max(abs(a), abs(c)):
+        return 0.0
+    largest = c
+    return max(0.0, -a, broken) + (MARGIN * largest if largest > 0 else FLOOR)
+
+
+def corrected(inertial: Inertial) -> Inertial | None:
+    """The physical version of `inertial`, or None when it is physical (or a massless frame)."""
+    i = inertial.inertia
+    zero_tensor = not any((i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz))
+    if inertial.mass == 0 and zero_tensor:
+        return None
+    mass = inertial.mass if inertial.mass > 0 else FLOOR
+    d = lift(i)
+    if d == 0 and mass == inertial.mass:
+        return None
+    return replace(inertial, mass=mass, inertia=replace(i, ixx=i.ixx + d, iyy=i.iyy + d, izz=i.izz + d))
+
+
+def correct_inertials(robot: Robot) -> tuple[Robot, tuple[str, ...]]:
+    """`robot` with every non-physical inertial made physical, and the links that changed."""
+    links, changed = dict(robot.links), []
+    for name, link in robot.links.items():
+        new = corrected(link.inertial) if link.inertial is not None else None
+        if new is not None:
+            links[name] = replace(link, inertial=new)
+            changed.append(name)
+    return (replace(robot, links=links) if changed else robot), tuple(changed)
