@@ -2,7 +2,8 @@
 
 Without it (or for a key it does not name) mpc writes each number in its shortest exact
 form (backends/xml.py `fmt_float`). With it, as in Phobos, a key names a URDF attribute
-(`xyz`, `ixx`, `value`, …) or an SDF element (`pose`, `mass`, `ixx`, …), and `default`
+(`xyz`, `ixx`, `value`, …), an SDF element (`pose`, `mass`, `ixx`, …) or an MJCF attribute
+(`pos`, `quat`, `diaginertia`, …; MuJoCo's compiler settings are not numbers of the robot), and `default`
 every number the writer writes; each number of that value is written with the format
 (`%.6f`: Phobos's style). A format that rounds to zero writes `0`, never `-0`; the
 output stays byte-stable (the same model and formats give the same bytes). Names, file
@@ -24,7 +25,10 @@ SDF_KEYS = frozenset({
     "pose", "mass", "ixx", "ixy", "ixz", "iyy", "iyz", "izz", "size", "radius", "length", "scale",
     "ambient", "diffuse", "specular", "emissive", "transparency", "xyz", "lower", "upper", "effort",
     "velocity", "damping", "friction"})
-KEYS = {"urdf": URDF_KEYS, "sdf": SDF_KEYS}
+MJCF_KEYS = frozenset({
+    "pos", "quat", "mass", "diaginertia", "size", "axis", "range", "rgba", "scale", "polycoef",
+    "damping", "frictionloss", "actuatorfrcrange", "ctrlrange"})
+KEYS = {"urdf": URDF_KEYS, "sdf": SDF_KEYS, "mjcf": MJCF_KEYS}
 DEFAULT = "default"
 _FORMAT = re.compile(r"%[-+ 0#]*[0-9]{0,2}(\.[0-9]{1,2})?[eEfFgG]")
 

@@ -233,3 +233,18 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
     partial.write_bytes(data if isinstance(data, bytes) else data.encode())
     os.replace(partial, dest)
     return None
+
+
+def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,
+          export_span: Span) -> dict[MeshKey, str] | None:
+    """The meshes of an export (urdf, sdf, mjcf): those its file references, in `mesh_format`
+    (their plan, or None after an error), then the same in each `additional` format
+    (`additional_meshes`: written beside, referenced by nothing)."""
+    files = plan(robot, mesh_format, sink, export_span)
+    if files is None or not copy(files, out, sink, export_span, robot):
+        return None
+    for fmt in additional:
+        extra = plan(robot, fmt, sink, export_span)
+        if extra is None or not copy(extra, out, sink, export_span, robot):
+            return None
+    return files

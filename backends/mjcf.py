@@ -41,12 +41,14 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from mpc.backends import meshes
+from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import matrix_pose, pose_matrix
+from mpc.ir.numbers import EPSILON, zero_small
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -257,8 +259,10 @@ def left_out(robot: Robot) -> list[str]:
 
 
 class _Writer:
-    def __init__(self, robot: Robot, mesh_name: Callable[[Mesh], str]) -> None:
-        self.robot, self.mesh_name = robot, mesh_name
+    def __init__(self, robot: Robot, mesh_name: Callable[[Mesh], str], formats: Formats | None = None,
+                 enforce_zero: bool = False) -> None:
+        self.robot, self.mesh_name, self.formats = robot, mesh_name, formats
+        self.enforce_zero = enforce_zero
         self.out: list[str] = []
         self.children = child_joints(robot)
         self.assets: dict[tuple[str, str | None], str] = {}  # (file, scale) → asset name
@@ -281,8 +285,15 @@ class _Writer:
         cuts = [self.robot.cut_joints[n] for n in sorted(self.robot.cut_joints)]
         return [c for c in cuts if c.type == "fixed" or c.type in _POINT_CUTS]
 
+    def attrs(self, pairs: Pairs) -> str:
+        if self.enforce_zero:  # also the numbers computed here (quaternions, principal frames)
+            pairs = [(k, _zeroed(v) if k in MJCF_KEYS else v) for k, v in pairs]
+        if self.formats is not None:  # float_fmt_dict (backends/float_formats.py)
+            pairs = [(k, self.formats(k, v)) for k, v in pairs]
+        return _attrs(pairs)
+
     def leaf(self, depth: int, tag: str, pairs: Pairs) -> None:
-        self.out.append(f"{IND * depth}<{tag}{_attrs(pairs)}/>")
+        self.out.append(f"{IND * depth}<{tag}{self.attrs(pairs)}/>")
 
     def asset(self, mesh: Mesh) -> str:
         key = (self.mesh_name(mesh), fmt_floats(mesh.scale) if mesh.scale is not None else None)
@@ -356,7 +367,7 @@ class _Writer:
     def _emit_body(self, depth: int, joint: Joint | None, link: Link, top: bool) -> None:
         """The link's body at `joint`'s origin: inertial, joint, geoms, then child bodies."""
         pose = _pose_pairs(joint.origin if joint is not None else None)
-        self.out.append(f"{IND * depth}<body{_attrs([('name', link.name), *pose])}>")
+        self.out.append(f"{IND * depth}<body{self.attrs([('name', link.name), *pose])}>")
         d = depth + 1
         if link.inertial is not None:
             self._emit_inertial(d, link.inertial)
@@ -431,12 +442,21 @@ class _Writer:
         return "\n".join([*self.out, "</mujoco>"]) + "\n"
 
 
-def to_string(robot: Robot, mesh_name: Callable[[Mesh], str], sink: Sink | None = None) -> str:
-    """The canonical MJCF text of `robot`; `mesh_name` gives each mesh's file relative to it.
-    With a sink, also reports what MuJoCo would refuse (E0504) and what is left out (W0500)."""
+def _zeroed(text: str | None) -> str | None:
+    """`text` (numbers) with those closer to zero than 1e-12 written as 0 (`enforce_zero`)."""
+    if text is None:
+        return None
+    return " ".join("0" if abs(float(t)) < EPSILON else t for t in text.split())
+
+
+def to_string(robot: Robot, mesh_name: Callable[[Mesh], str], sink: Sink | None = None,
+              formats: Formats | None = None, enforce_zero: bool = False) -> str:
+    """The canonical MJCF text of `robot`; `mesh_name` gives each mesh's file relative to it;
+    `formats`: the number formats of `float_fmt_dict`, when given. With a sink, also reports
+    what MuJoCo would refuse (E0504) and what is left out (W0500)."""
     if sink is not None:
         _diagnose(robot, sink, robot.span or Span.of_file(robot.name))
-    return _Writer(robot, mesh_name).document()
+    return _Writer(robot, mesh_name, formats, enforce_zero).document()
 
 
 def _diagnose(robot: Robot, sink: Sink, span: Span) -> None:
@@ -453,8 +473,12 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
                    hint="use mesh_format stl or obj for an mjcf export")
         return
     _diagnose(robot, sink, export.span)
-    files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None or not meshes.copy(files, out, sink, export.span, robot):
+    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
+    if files is None:
         return
-    text = to_string(robot, lambda mesh: "../" + files[meshes.key(mesh)])
+    if export.enforce_zero:
+        robot = zero_small(robot)
+    formats = Formats(export.float_formats, MJCF_KEYS) if export.float_formats else None
+    text = to_string(robot, lambda mesh: "../" + files[meshes.key(mesh)], formats=formats,
+                     enforce_zero=export.enforce_zero)
     write_path(out / "mjcf" / f"{export.filename or robot.name}.xml", text)

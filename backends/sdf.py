@@ -371,13 +371,9 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     """Write `out/sdf/<filename or robot.name>.sdf` and `out/sdf/model.config`, meshes under
     `out/meshes/`."""
     warn(robot, export.span, sink, export.version, export.include_cut_joints)
-    files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None or not meshes.copy(files, out, sink, export.span, robot):
+    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
+    if files is None:
         return
-    for fmt in export.additional_meshes:  # written beside, referenced by nothing
-        extra = meshes.plan(robot, fmt, sink, export.span)
-        if extra is None or not meshes.copy(extra, out, sink, export.span, robot):
-            return
     if export.enforce_zero:
         robot = zero_small(robot)
 

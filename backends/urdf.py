@@ -41,13 +41,9 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
     if not check(robot, export, sink):
         return
-    files = meshes.plan(robot, export.mesh_format, sink, export.span)
-    if files is None or not meshes.copy(files, out, sink, export.span, robot):
+    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
+    if files is None:
         return
-    for fmt in export.additional_meshes:  # written beside, referenced by nothing
-        extra = meshes.plan(robot, fmt, sink, export.span)
-        if extra is None or not meshes.copy(extra, out, sink, export.span, robot):
-            return
     if export.enforce_zero:
         robot = zero_small(robot)
     for suffix, prefix in variants(export):

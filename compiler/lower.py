@@ -330,13 +330,8 @@ class _Lowering:
             self.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
                          + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
-        later: dict[str, Any] = {}
-        if entry.type == "mjcf":
-            later.update(additional_meshes=None, enforce_zero=False, ros_pathes=False,
-                         copy_with_other_pathes=False, float_fmt_dict=None)
-        for key, default in later.items():
-            if getattr(entry, key) != default:
-                self.not_yet(entry.key_span(key), f"{entry.type} export option '{key}'")
+        if entry.type == "mjcf" and not inherited:  # the model's own use of the entry reported
+            self.no_package_paths(entry)
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in written:
@@ -355,7 +350,7 @@ class _Lowering:
             export = replace(export, ros_package=package if entry.ros_pathes else None,
                              copy_package=package if entry.copy_with_other_pathes else "")
         export = replace(export, correct_inertials=entry.correct_inertials)
-        if entry.type in ("urdf", "sdf") and entry.float_fmt_dict:
+        if entry.float_fmt_dict:
             export = replace(export, float_formats=self.float_formats(entry))
         if entry.type == "sdf":
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
@@ -364,17 +359,25 @@ class _Lowering:
                             f"no meaning in a {entry.type} export: "
                             + ("URDF cannot hold loops" if entry.type == "urdf"
                                else "MJCF always closes loops with equality constraints"))
-        if entry.type in ("urdf", "sdf"):
-            extra = entry.additional_meshes
-            export = replace(
-                export, enforce_zero=entry.enforce_zero,
-                additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
+        extra = entry.additional_meshes
+        export = replace(export, enforce_zero=entry.enforce_zero,
+                         additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
         export = self.smurf.link(entry, export, submodel)
         written[target] = export
         return [export]
 
+    def no_package_paths(self, entry: Any) -> None:
+        """`ros_pathes` and `copy_with_other_pathes` on an mjcf entry: MuJoCo cannot read them."""
+        for key in ("ros_pathes", "copy_with_other_pathes"):
+            if getattr(entry, key):
+                self.sink.error(entry.key_span(key), "E0550", f"'{key}' writes package:// mesh paths, "
+                                "which MuJoCo cannot resolve: it reads mesh files relative to the MJCF "
+                                "file (or its meshdir), and knows no ROS packages",
+                                hint="leave it out: the MJCF's relative paths work wherever the output "
+                                "folder is; a urdf or sdf entry can have package paths")
+
     def float_formats(self, entry: Any) -> tuple[tuple[str, str], ...]:
-        """`float_fmt_dict` of a urdf or sdf entry, checked (backends/float_formats.py); sorted."""
+        """`float_fmt_dict` of a urdf, sdf or mjcf entry, checked (backends/float_formats.py); sorted."""
         from mpc.backends.float_formats import DEFAULT, KEYS, bad_format
 
         keys = KEYS[entry.type]
@@ -383,7 +386,8 @@ class _Lowering:
             path = (*entry._path, "float_fmt_dict", key)
             span = entry._doc.value_span(path)
             if key != DEFAULT and key not in keys:
-                what = "attribute of a URDF" if entry.type == "urdf" else "element of an SDF"
+                what = {"urdf": "attribute of a URDF", "sdf": "element of an SDF",
+                        "mjcf": "attribute of an MJCF"}[entry.type]
                 self.sink.error(entry._doc.keys.get(path, span), "E0530",
                                 f"float_fmt_dict: '{key}' is no number {what} file"
                                 f"{did_you_mean(key, set(keys) | {DEFAULT})}",

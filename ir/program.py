@@ -113,7 +113,9 @@ class SdfExport:
 @dataclass(frozen=True, slots=True, kw_only=True)
 class MjcfExport:
     """A `type: mjcf` entry: MuJoCo's format; meshes in `mesh_format` (stl or obj: MuJoCo
-    reads no DAE)."""
+    reads no DAE); `additional_meshes`, `enforce_zero`, `correct_inertials` as for URDF, and
+    `float_formats` keyed by MJCF attribute (`pos`, `quat`, `mass`, …). No package paths:
+    MuJoCo cannot resolve them."""
 
     mesh_format: str
     span: Span
@@ -121,6 +123,9 @@ class MjcfExport:
     add_floating_base: bool = False
     submodel: str = ""
     correct_inertials: bool = False
+    additional_meshes: tuple[str, ...] = ()
+    enforce_zero: bool = False
+    float_formats: tuple[tuple[str, str], ...] = ()
     type: Literal["mjcf"] = "mjcf"
 
 
