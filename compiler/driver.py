@@ -121,6 +121,7 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
                 robot = without_smurf_data(robot)
             parts[op.part] = originals[op.part] = robot
         elif isinstance(op, Attach):
+            op = op.resolved(Names.of(parts[op.part]), Names.of(parts[op.child]))
             if op.r2r is not None:
                 op = replace(op, origin=r2r_origin(op, originals[op.part], originals[op.child]))
             parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))

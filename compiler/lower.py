@@ -24,7 +24,7 @@ from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import Definition
 from mpc.compiler.schema.assembly import AssembleChild, AttachJoint, NameEditing, _Part
 from mpc.compiler.schema.base import Node
-from mpc.ir.naming import SCOPES, NameRule, bad_pattern, edit_name
+from mpc.ir.naming import LINK_SUFFIX, SCOPES, NameRule, bad_pattern, edit_name, takes_link_suffix
 from mpc.ir.ops import (
     ROOT,
     ApplyScale,
@@ -75,6 +75,7 @@ class _Lowering:
         self.resolver, self.later = resolver, later
         self.ops: list[Op] = []
         self.rules: dict[str, tuple[NameRule, ...]] = {}
+        self.link_suffix: dict[str, str] = {}  # append_link_suffix of each part
         self.smurf = SmurfLowering(ast.model, sink)
 
     def not_yet(self, span: Span, what: str) -> None:
@@ -171,9 +172,6 @@ class _Lowering:
             if prefix or suffix or pairs:
                 rules.append(NameRule(scope=scope, prefix=prefix or "", suffix=suffix or "",
                                       replacements=tuple(pairs)))
-        for flag in ("joint_equals_link_name", "append_link_suffix"):
-            if getattr(editing, flag):
-                self.not_yet(editing.key_span(flag), f"name_editing '{flag}'")
         return tuple(rules)
 
     def part(self, node: _Part, part: str, inputs: dict[str, Input]) -> None:
@@ -184,11 +182,21 @@ class _Lowering:
             return
         self.ops.append(LoadModel(span=node.value_span("model"), part=part, input=node.model))
         rules: tuple[NameRule, ...] = ()
-        if node.name_editing is not None:
-            rules = self.name_rules(node.name_editing)
-            if rules:
-                self.ops.append(EditNames(span=node.name_editing.span, part=part, rules=rules))
+        editing = node.name_editing
+        if editing is not None:
+            rules = self.name_rules(editing)
+            if rules or editing.joint_equals_link_name or editing.append_link_suffix:
+                self.ops.append(EditNames(span=editing.span, part=part, rules=rules,
+                                          joint_equals_link_name=editing.joint_equals_link_name,
+                                          append_link_suffix=editing.append_link_suffix or ""))
+            if editing.joint_equals_link_name:
+                for key in ("joint_prefix", "joint_suffix", "joint_replacements"):
+                    if getattr(editing, key):
+                        self.sink.warning(editing.key_span(key), "W0550", f"'{key}' has no effect: "
+                                          "joint_equals_link_name names every joint after its child link",
+                                          hint="edit the link names instead; the joints follow them")
         self.rules[part] = rules
+        self.link_suffix[part] = (editing.append_link_suffix or "") if editing is not None else ""
         if node.remove_beyond is not None:
             written_as_list = isinstance(node._doc.data_at((*node._path, "remove_beyond")), list)  # type: ignore[union-attr]
             spans = {f"links/{i}": _item_span(node, "remove_beyond", i) if written_as_list
@@ -222,8 +230,10 @@ class _Lowering:
         j: AttachJoint = child.joint
         what = f"joint of '{child.model}'"
         # Names in `joint:` are written as they are before each model's name editing.
-        parent = edit_name(j.parent, "link", self.rules[part])
-        child_link = edit_name(j.child, "link", self.rules[child_part]) if j.child else None
+        parent = self.edited_link(j.parent, part)
+        child_link = self.edited_link(j.child, child_part) if j.child else None
+        suffixed = tuple(field for field, p in (("parent", part), ("child_link", child_part))
+                         if self.link_suffix[p] == "NAME_DUPLICATES")
         r2r = None
         if j.r2r_transform is not None:
             rows = [[evaluate(v, j.value_span("r2r_transform"), self.sink, what=f"{what} r2r_transform")
@@ -255,7 +265,16 @@ class _Lowering:
             child_written=j.child if j.child and child_link != j.child else "",
             origin=Pose(xyz, rpy), r2r=r2r,  # type: ignore[arg-type]
             axis=self.vec(j, "axis", f"{what} axis"), limit=limit,  # type: ignore[arg-type]
+            suffixed=suffixed,
         ))
+
+    def edited_link(self, written: str, part: str) -> str:
+        """A link name as written in `joint:`, after its part's name editing; NAME_DUPLICATES's
+        suffix depends on the tree: Attach.resolved adds it."""
+        name = edit_name(written, "link", self.rules[part])
+        if self.link_suffix[part] == "ALWAYS" and takes_link_suffix(name, "ALWAYS", None):
+            name += LINK_SUFFIX
+        return name
 
     # -- the rest --------------------------------------------------------------------------
 

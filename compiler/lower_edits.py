@@ -120,8 +120,13 @@ class EditLowering:
                 self.sink.error(d.key_span(key), "E0313", f"'{key}' has no meaning in {where}")
 
     def scoped(self, editing: Any, where: str, scope: str) -> None:
-        """Name editing of one kind of name: the keys of other kinds would do nothing."""
-        for key in editing.model_fields_set:
+        """Name editing of one kind of name: the keys of other kinds would do nothing, nor the
+        flags of an assembly entry's name_editing, which rename by the tree."""
+        flags = {"joint_equals_link_name", "append_link_suffix"}
+        for key in sorted(editing.model_fields_set & flags):
+            self.sink.error(editing.key_span(key), "E0313", f"'{key}' has no meaning in {where}; "
+                            "it is a key of an assemble entry's name_editing")
+        for key in editing.model_fields_set - flags:
             kind = key.split("_", 1)[0]
             if "_" in key and kind in ("link", "joint", "collision", "visual", "submechanism") \
                     and kind != scope:

@@ -46,6 +46,25 @@ def edit_name(name: str, kind: str, rules: tuple[NameRule, ...]) -> str:
     return name
 
 
+LINK_SUFFIX = "_Link"
+
+
+def without_link_suffix(link: str) -> str:
+    """`joint_equals_link_name`: a joint's name from its child link's, minus a `_link` ending
+    (in any case), as Phobos names it."""
+    return link[:-5] if link.upper().endswith("_LINK") else link
+
+
+def takes_link_suffix(link: str, mode: str, parent_joint: str | None) -> bool:
+    """Whether `append_link_suffix: mode` appends `_Link` to `link` (its name after the other
+    editing; `parent_joint`: the name of the joint above it, after editing). Never to a name
+    that ends in `link` (any case); ALWAYS to every other; NAME_DUPLICATES to one named as the
+    joint above it."""
+    if not mode or link.upper().endswith("LINK"):
+        return False
+    return mode == "ALWAYS" or link == parent_joint
+
+
 def bad_pattern(pattern: str) -> str | None:
     """Why `pattern` is not a regular expression, or None."""
     try:

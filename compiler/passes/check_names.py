@@ -34,6 +34,8 @@ def symbolic(program: Program, ctx: PassContext) -> Names | None:
             unsupported.setdefault(op.kind, []).append(op)
         if isinstance(op, Attach):
             child = parts.pop(op.child, None)
+            if names is not None and child is not None:
+                op = op.resolved(names, child)  # append_link_suffix: NAME_DUPLICATES
             if names is not None and child is not None and _reads_ok(op, names, ctx):
                 parts[op.part] = op.merge(names, child, effects,
                                           (origins[op.part], origins.pop(op.child, "?")))

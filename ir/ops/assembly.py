@@ -12,9 +12,9 @@ from typing import Any, Literal
 
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.names import Names
-from mpc.ir.naming import NameRule, edit_name
+from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
 from mpc.ir.ops import Effects, Op, Ref
-from mpc.ir.rename import rename_robot
+from mpc.ir.rename import rename_robot, rename_with
 from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot
 
 Vec3 = tuple[float, float, float]
@@ -33,6 +33,10 @@ class EditNames(Op):
 
     kinds: the kinds of names edited (all when empty): link, joint, collision, visual.
     only: the names edited (all when empty), of the one kind in `kinds`.
+    joint_equals_link_name: each joint is named after its child link (after `rules`), minus a
+        `_link` ending; the rules do not rename joints then.
+    append_link_suffix: "ALWAYS" or "NAME_DUPLICATES" (ir/naming.py `takes_link_suffix`),
+        after the rest, so NAME_DUPLICATES sees the joints' new names.
     """
 
     WHAT = "name_editing"
@@ -40,6 +44,8 @@ class EditNames(Op):
     rules: tuple[NameRule, ...]
     kinds: tuple[str, ...] = ()
     only: tuple[str, ...] = ()
+    joint_equals_link_name: bool = False
+    append_link_suffix: str = ""
 
     def _edit(self, kind: str):
         only = frozenset(self.only)
@@ -51,17 +57,33 @@ class EditNames(Op):
         kind = self.kinds[0] if len(self.kinds) == 1 else "link"
         return tuple(Ref(kind, n, "only") for n in self.only)  # type: ignore[arg-type]
 
-    def effect(self, names: Names, effects: Effects) -> Names:
+    def maps(self, names: Names) -> dict[str, dict[str, str]]:
+        """Old name → new name of every link and joint; the tree is needed by the flags."""
         link, joint = self._edit("link"), self._edit("joint")
-        maps = {"link": {n: link(n) for n in names.links},
-                "joint": {n: joint(n) for n in names.joints}}
+        links = {n: link(n) for n in names.links}
+        if self.joint_equals_link_name:
+            joints = {j: without_link_suffix(links.get(c, c)) for j, (_, c) in names.joints.items()}
+        else:
+            joints = {j: joint(j) for j in names.joints}
+        if self.append_link_suffix:
+            above = {c: joints[j] for j, (_, c) in names.joints.items()}
+            links = {old: new + LINK_SUFFIX if takes_link_suffix(new, self.append_link_suffix, above.get(old))
+                     else new for old, new in links.items()}
+        return {"link": links, "joint": joints}
+
+    def effect(self, names: Names, effects: Effects) -> Names:
+        maps = self.maps(names)
         for kind, mapping in maps.items():
             seen: dict[str, str] = {}
             for old, new in sorted(mapping.items()):
                 if new in seen:
+                    why = (f": joint_equals_link_name names them after their child links "
+                           f"'{names.joints[seen[new]][1]}' and '{names.joints[old][1]}'"
+                           if kind == "joint" and self.joint_equals_link_name else "")
                     effects.error("E0302", f"name editing gives two {kind}s the name '{new}' "
-                                  f"('{seen[new]}' and '{old}')")
+                                  f"('{seen[new]}' and '{old}'){why}")
                 seen[new] = old
+        link, joint = rename_with(maps["link"]), rename_with(maps["joint"])
         collision, visual = self._edit("collision"), self._edit("visual")
         return replace(
             names, links=frozenset(maps["link"].values()), root=link(names.root),
@@ -71,7 +93,11 @@ class EditNames(Op):
         )
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
-        return rename_robot(robot, self._edit("link"), self._edit("joint"),
+        if not self.joint_equals_link_name and not self.append_link_suffix:
+            return rename_robot(robot, self._edit("link"), self._edit("joint"),
+                                self._edit("collision"), self._edit("visual"))
+        maps = self.maps(Names.of(robot))
+        return rename_robot(robot, rename_with(maps["link"]), rename_with(maps["joint"]),
                             self._edit("collision"), self._edit("visual"))
 
 
@@ -197,6 +223,9 @@ class Attach(Op):
     r2r: X_RpRc, the child model's root in the parent model's root (a 4×4 row list),
         computed from the input models as they were read (before any editing).
     parent_written, child_written: the link names as written, when name editing changed them.
+    suffixed: the fields ("parent", "child_link") whose link's part had `append_link_suffix:
+        NAME_DUPLICATES`, which may have appended `_Link` to it: which it did is known from the
+        part's tree only (`resolved`).
     """
 
     WHAT = "the attaching joint's parent"
@@ -212,9 +241,26 @@ class Attach(Op):
     r2r: tuple[tuple[float, ...], ...] | None = None
     axis: Vec3 | None = None
     limit: Limit | None = None
+    suffixed: tuple[str, ...] = ()
 
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("link", self.parent, "parent", self.parent_written),)
+
+    def resolved(self, parent: Names, child: Names) -> Attach:
+        """The op naming its links as NAME_DUPLICATES left them: `X_Link` for a link `X` that
+        is no more, when the joint above `X_Link` is `X` (exactly the links it renamed)."""
+        if not self.suffixed:
+            return self
+        changes: dict[str, str] = {}
+        for field, names in (("parent", parent), ("child_link", child)):
+            name = getattr(self, field) or (child.root if field == "child_link" else "")
+            written = "parent_written" if field == "parent" else "child_written"
+            above = {c: j for j, (_, c) in names.joints.items()}
+            if field in self.suffixed and name not in names.links \
+                    and above.get(name + LINK_SUFFIX) == name:
+                changes[field] = name + LINK_SUFFIX
+                changes[written] = getattr(self, written) or name
+        return replace(self, suffixed=(), **changes)
 
     def joint_name(self, child_root: str) -> str:
         return self.name or f"{self.parent}2{self.child_link or child_root}"
@@ -272,6 +318,7 @@ def r2r_origin(attach: Attach, parent_input: Robot, child_input: Robot) -> Pose:
 
     assert attach.r2r is not None
     X_RpRc = np.array(attach.r2r, dtype=float)
-    X_RpP = link_in_root(parent_input, attach.parent)
-    X_RcC = link_in_root(child_input, attach.child_link or child_input.root)
+    # The inputs as read have the names as written (before name editing).
+    X_RpP = link_in_root(parent_input, attach.parent_written or attach.parent)
+    X_RcC = link_in_root(child_input, attach.child_written or attach.child_link or child_input.root)
     return matrix_pose(tf.compose(tf.inverse(X_RpP), X_RpRc, X_RcC))
