@@ -124,7 +124,14 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
             op = op.resolved(Names.of(parts[op.part]), Names.of(parts[op.child]))
             if op.r2r is not None:
                 op = replace(op, origin=r2r_origin(op, originals[op.part], originals[op.child]))
-            parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))
+            from mpc.ir.reroot import RerootError
+
+            try:
+                parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))
+            except RerootError as error:
+                sink.error(op.span_of("child_link"), "E0551", f"cannot re-root the child model at "
+                           f"'{op.child_link}' to attach it there: {error}")
+                return None
         else:
             parts[op.part] = op.apply(parts[op.part], Effects(sink, op))
     return None if sink.has_errors() else parts[ROOT]

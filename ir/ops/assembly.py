@@ -272,9 +272,10 @@ class Attach(Op):
             shown = _as_written(child_link, self.child_written)
             effects.error("E0303", f"attach: the child model has no link {shown}"
                           f"{did_you_mean(child_link, child.links)}", "child_link")
-        elif child_link != child.root:
-            effects.unsupported(f"attaching at '{child_link}', which is not the child model's root "
-                                f"'{child.root}',", "child_link")
+        elif child_link != child.root:  # the child model is re-rooted there (ir/reroot.py)
+            from mpc.ir.reroot import reroot_names
+
+            child = reroot_names(child, child_link)
         joint = self.joint_name(child.root)
         for kind, a, b in (("link", parent.links, child.links),
                            ("joint", frozenset(parent.joints), frozenset(child.joints))):
@@ -294,8 +295,13 @@ class Attach(Op):
         )
 
     def attach(self, parent: Robot, child: Robot) -> Robot:
-        """The parent robot with the child robot hung below `parent` (origin already resolved)."""
+        """The parent robot with the child robot hung below `parent` (origin already resolved),
+        re-rooted at `child_link` first (RerootError when it cannot be)."""
         child_link = self.child_link or child.root
+        if child_link != child.root:
+            from mpc.ir.reroot import reroot
+
+            child = reroot(child, child_link)
         joint = Joint(name=self.joint_name(child.root), type=self.type,  # type: ignore[arg-type]
                       parent=self.parent, child=child_link, origin=self.origin, axis=self.axis,
                       limit=self.limit, span=self.span)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
-from mpc.ir.tree import joints_up, parent_joint
+from mpc.ir.tree import parent_joint
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
@@ -79,53 +79,19 @@ class MakeRoot(Op):
         return (Ref("link", self.link, "link"),)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
-        """Turn the joints from the root to `link` around (at q = 0).
+        """Turn the joints from the root to `link` around (at q = 0; ir/reroot.py)."""
+        from mpc.ir.reroot import RerootError, reroot
 
-        For a joint j from P to C with origin O, the reversed joint goes from C to P with
-        origin A_C⁻¹ and axis −a (so q keeps its meaning and its limits); P's frame moves
-        to the old joint frame (A_P = O), and everything given in P — visuals, collisions,
-        inertial, the joints to its other children — is re-expressed: X_F V = O⁻¹ · X_P V.
-        """
-        from mpc.ir.kinematics import compose_poses, inverse_pose
-
-        path = joints_up(robot, self.link)
-        if not path:
+        try:
+            return reroot(robot, self.link)
+        except RerootError as error:
+            effects.error("E0551", f"cannot make '{self.link}' the root: {error}", "link")
             return robot
-        joints, links = dict(robot.joints), dict(robot.links)
-        moved: dict[str, Pose] = {self.link: Pose()}  # A_P: each path link's new frame in its old one
-        for joint in path:  # from `link` up to the old root
-            moved[joint.parent] = joint.origin or Pose()
-        for joint in path:
-            axis = joint.axis
-            if joint.type not in ("fixed", "floating"):
-                axis = tuple(-x for x in (joint.axis or (1.0, 0.0, 0.0)))  # type: ignore[assignment]
-            joints[joint.name] = replace(joint, parent=joint.child, child=joint.parent, axis=axis,
-                                         origin=inverse_pose(moved[joint.child]))
-        on_path = {j.name for j in path}
-        for name, A in moved.items():
-            if name == self.link:
-                continue
-            A_inv = inverse_pose(A)
-            lk = links[name]
-            inertial = lk.inertial
-            links[name] = replace(
-                lk, inertial=inertial and replace(inertial, origin=compose_poses(A_inv, inertial.origin)),
-                visuals=tuple(replace(v, origin=compose_poses(A_inv, v.origin)) for v in lk.visuals),
-                collisions=tuple(replace(c, origin=compose_poses(A_inv, c.origin)) for c in lk.collisions))
-            for jname, j in robot.joints.items():
-                if j.parent == name and jname not in on_path:
-                    joints[jname] = replace(j, origin=compose_poses(A_inv, j.origin))
-        return replace(robot, root=self.link, joints=joints, links=links)
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        by_child = {c: (j, p) for j, (p, c) in names.joints.items()}
-        joints = dict(names.joints)
-        link = self.link
-        while link in by_child:
-            joint, parent = by_child[link]
-            joints[joint] = (link, parent)
-            link = parent
-        return replace(names, joints=joints, root=self.link)
+        from mpc.ir.reroot import reroot_names
+
+        return reroot_names(names, self.link)
 
 
 @dataclass(frozen=True, kw_only=True)
