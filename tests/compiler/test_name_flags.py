@@ -142,3 +142,37 @@ def test_the_flags_only_in_an_assembly_entry(tmp_path: Path) -> None:
     assert run.returncode == 1
     assert ("error[E0313]: 'append_link_suffix' has no meaning in frames.$name_editing; it is a key "
             "of an assemble entry's name_editing") in run.stderr
+
+
+def test_a_child_link_renamed_by_name_duplicates_and_re_rooted(tmp_path: Path) -> None:
+    """`child: tool0` of a UR5 whose NAME_DUPLICATES made it `u_tool0_Link`: found, and the UR5
+    re-rooted there (the joints above it reversed); Pinocchio weighs both models."""
+    import pinocchio as pin
+
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: two
+          modelname: two_model
+          input_models:
+            arm: {{basefile: "{ARM}"}}
+            ur5: {{basefile: "{UR5}"}}
+          assemble:
+            model: arm
+            children:
+              - model: ur5
+                name_editing: {{prefix: "u_", joint_equals_link_name: true,
+                                append_link_suffix: NAME_DUPLICATES,
+                                link_replacements: {{"^u_base$": "u_b"}}}}
+                joint: {{parent: arm_left_7_link, child: tool0, name: mount}}
+        """)
+    assert mpc("check", spec).returncode == 0
+    run = mpc("compile", spec, "-o", tmp_path / "out")
+    assert run.returncode == 0, run.stderr
+    tree = _tree(tmp_path / "out/urdf/two.urdf")
+    assert tree["mount"] == ("arm_left_7_link", "u_tool0_Link")
+    assert tree["u_tool0"] == ("u_tool0_Link", "u_wrist_3_link")
+    assert tree["u_wrist_3"] == ("u_wrist_3_link", "u_wrist_2_link")
+    free = pin.JointModelFreeFlyer()
+    masses = [pin.computeTotalMass(pin.buildModelFromUrdf(str(p), free))
+              for p in (tmp_path / "out/urdf/two.urdf", ARM, UR5)]
+    assert abs(masses[0] - masses[1] - masses[2]) <= 1e-12
