@@ -9,10 +9,14 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.compiler import render
 from mpc.compiler.diagnostics import Diagnostic, Severity, Sink, did_you_mean
 from mpc.compiler.pipeline.plan import Plan, load_plan
+
+if TYPE_CHECKING:
+    from mpc.compiler.pipeline.status import RunStatus
 
 
 class UsageError(Exception):
@@ -74,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from mpc.compiler.pipeline import progress
     from mpc.compiler.pipeline.runner import Runner, RunOptions
     from mpc.compiler.pipeline.status import plain_table
-    from mpc.compiler.pipeline.store import BuildFolderBusy
+    from mpc.compiler.pipeline.store import BuildFolderBusy, BuildFolderUnusable
 
     sink = Sink(werror=args.werror)
     plan = _load(args, sink)
@@ -100,29 +104,44 @@ def run(args: argparse.Namespace) -> int:
     except BuildFolderBusy as e:
         print(f"mpc run: error: another `mpc run` is using the build folder '{e}'", file=sys.stderr)
         return 1
+    except BuildFolderUnusable as e:
+        print(f"mpc run: error: cannot use the build folder '{runner.store.build}' ({e}); "
+              "nothing was built", file=sys.stderr)
+        return 1
     finally:
         signal.signal(signal.SIGTERM, previous)
         report.close()
     exit_status = status.exit_status(args.verify, args.allow_na)
     status_file = runner.store.meta / "status.json"
+    if runner.status_error is not None:
+        print(f"mpc run: error: cannot write the status file '{status_file}' ({runner.status_error})",
+              file=sys.stderr)
+        exit_status = max(exit_status, 1)
+    _print_model_diagnostics(status, args.format)  # on stderr: also with JSON lines on stdout
     if args.log_format == "json":
         assert isinstance(report, progress.JsonLog)
         report.emit("end", exit_status=exit_status, counts=status.counts(), seconds=round(status.seconds, 3),
                     status=str(status_file))
         return exit_status
-    if args.format == "json":  # one list for tools
-        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
-    for name in sorted(status.models) if args.format != "json" else ():
-        diagnostics = status.models[name].diagnostics()
-        if diagnostics and args.format == "human":
-            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
-        _print_diagnostics(diagnostics, args.format)
     if sys.stdout.isatty():
         progress.rich_table(status)
     else:
         print(plain_table(status))
-    print(f"status: {status_file}")
+    if runner.status_error is None:
+        print(f"status: {status_file}")
     return exit_status
+
+
+def _print_model_diagnostics(status: RunStatus, fmt: str) -> None:
+    """Each model's diagnostics under its name; with `--format json`, one list for tools."""
+    if fmt == "json":
+        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
+        return
+    for name in sorted(status.models):
+        diagnostics = status.models[name].diagnostics()
+        if diagnostics and fmt == "human":
+            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
+        _print_diagnostics(diagnostics, fmt)
 
 
 def _interrupt(signum: int, frame: object) -> None:

@@ -77,6 +77,11 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
     root = (path.resolve().parent / os.path.expandvars(settings.get("root", ".."))).resolve()
+    if not root.is_dir():
+        problem = "is not a folder" if root.exists() else "does not exist"
+        sink.error(doc.value_span(("pipeline", "root")), "E0640", f"the workspace root '{root}' {problem}",
+                   hint="`root` is relative to the folder of the pipeline file")
+        return None
     defaults = PipelineDefaults(doc)
     by_file: dict[Path, PlannedModel] = {}
     derived: dict[Path, list[tuple[Path, Span]]] = {}
@@ -87,7 +92,7 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
             sink.warning(span, "W0611", f"model definition '{written}' is listed twice; it is built once",
                          notes=((by_file[definition].span, "first listed here"),))
             continue
-        model, parents = _load_model(path, written, definition, span, defaults)
+        model, parents = _load_model(path, root, written, definition, span, defaults)
         by_file[definition] = model
         derived[definition] = parents
     _link(by_file, derived)
@@ -101,7 +106,7 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
 
 # What `mpc check pipeline.yml` adds to checking each definition: the problems of the
 # pipeline as a whole (checking the definitions reports the rest, cycles as E0308).
-_WHOLE_PIPELINE = ("E0610", "E0612", "W0610", "W0611")
+_WHOLE_PIPELINE = ("E0610", "E0612", "E0640", "E0641", "W0610", "W0611")
 
 
 def check_models(path: Path, sink: Sink) -> None:
@@ -118,14 +123,21 @@ def check_models(path: Path, sink: Sink) -> None:
                 sink.report(d)
 
 
-def _load_model(pipeline: Path, written: str, definition: Path, span: Span,
+def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span: Span,
                 defaults: PipelineDefaults) -> tuple[PlannedModel, list[tuple[Path, Span]]]:
     """One definition, with its defaults applied, and the derived_base files it names."""
     sink = Sink()
     model = PlannedModel(Path(written).stem, definition, written, span)
     display = os.path.normpath(os.path.join(os.path.dirname(str(pipeline)), written))
-    if not definition.is_file():
+    if not definition.is_relative_to(root):
+        # Its build could not be found again from a clone elsewhere, nor kept by CI.
+        sink.error(span, "E0641", f"model definition '{written}' is outside the workspace root '{root}'",
+                   hint="set the pipeline's `root` to a folder that holds every model definition")
+    elif definition.is_dir():
+        sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
+    elif not definition.is_file():
         sink.error(span, "E0601", f"model definition '{written}' does not exist")
+    if sink.diagnostics:
         model.diagnostics = sink.diagnostics
         return model, []
     doc = source.load(definition, sink, display=display, origin=span)

@@ -39,7 +39,7 @@ from mpc.compiler.pipeline.status import (
     diagnostics_from_json,
     diagnostics_json,
 )
-from mpc.compiler.pipeline.store import Store
+from mpc.compiler.pipeline.store import Store, describe
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
@@ -95,6 +95,7 @@ class Runner:
         self.fingerprints: dict[str, str | None] = {}  # compile fingerprints of finished models
         self.done: set[str] = set()
         self.running: dict[str, _Running] = {}
+        self.status_error: str | None = None  # why status.json could not be written
 
     # -- the loop ----------------------------------------------------------------------------
 
@@ -131,7 +132,10 @@ class Runner:
                 self._interrupt()
         finally:
             self.status.seconds = time.perf_counter() - start
-            self.store.save_status(self.status.to_json())
+            try:
+                self.store.save_status(self.status.to_json())
+            except OSError as e:
+                self.status_error = e.strerror or str(e)
             self.store.unlock()
         return self.status
 
@@ -145,6 +149,11 @@ class Runner:
         """Finish the model now (failed in planning, blocked, cached) or return what to build."""
         model = self.plan.models[name]
         record = self._record(model)
+        unusable = self.store.unusable_state(name)
+        if unusable is not None:
+            record.warnings.append(Diagnostic(
+                Severity.WARNING, "W0640", f"the state of model '{name}' from an earlier run is unusable "
+                f"({unusable}); the model is built again", Span.of_file(str(self.store.state_file(name)))))
         if model.failed:
             errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
             self._finish_all(name, "failed", _first(errors), diagnostics=errors)
@@ -167,7 +176,7 @@ class Runner:
             state = self.store.state(name)
             for stage in self.opts.stages:
                 record.stages[stage] = StageRecord("cached",
-                                                   fingerprint=state["stages"][stage]["fingerprint"])
+                                                   fingerprint=state["stages"][stage].get("fingerprint"))
             self.fingerprints[name] = state["fingerprint"]
             self._done(name)
             return None
@@ -179,7 +188,7 @@ class Runner:
         failure = self.store.state(name).get("failure")
         if self.opts.force or not isinstance(failure, dict) or failure.get("pre") != pre:
             return None
-        return failure if deps_current(failure.get("deps", [])) is not None else None
+        return failure if deps_current(failure["deps"], self.plan.root) is not None else None
 
     def _cached(self, name: str, pre: str) -> list[str]:
         """The selected stages whose result from an earlier run still holds."""
@@ -189,11 +198,12 @@ class Runner:
             return []
         if not self.store.output(name).is_dir():
             return []
-        deps = deps_current(state.get("deps", []))
+        deps = deps_current(state.get("deps", []), self.plan.root)
         if deps is None:
             return []
-        if deps != state["deps"]:  # only times changed: remember them, so the next run stats only
-            self.store.save_state(name, {**state, "deps": deps})
+        if deps != state.get("deps", []):  # only times changed: remember them, so the next run stats only
+            with contextlib.suppress(OSError):  # a state that cannot be written costs hashing, no more
+                self.store.save_state(name, {**state, "deps": deps})
         fp = state["fingerprint"]
         return [s for s in self.opts.stages
                 if s == "compile" or stages.get(s, {}).get("fingerprint") == self._stage_fingerprint(fp, s)]
@@ -230,9 +240,14 @@ class Runner:
 
         _preload()
         model = self.plan.models[name]
-        shutil.rmtree(self.store.staging(name), ignore_errors=True)
-        self.store.staging(name).mkdir(parents=True)
-        self.store.workdir(name).mkdir(parents=True, exist_ok=True)
+        try:
+            shutil.rmtree(self.store.staging(name), ignore_errors=True)
+            self.store.staging(name).mkdir(parents=True)
+            self.store.workdir(name).mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            diag = _unwritable(name, model, e)
+            self._finish_all(name, "failed", diag.message, diagnostics=[diag])
+            return
         job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
                        pipeline=self.plan.settings, root=self.plan.root, options=self.options,
@@ -277,7 +292,12 @@ class Runner:
             # Moving the output into place and saving its state happen together or not at
             # all: an interruption waits until both are done.
             with _uninterrupted():
-                self._collect(r)
+                try:
+                    self._collect(r)
+                except OSError as e:  # the output or state could not be written: the model failed
+                    diag = _unwritable(r.model, self.plan.models[r.model], e)
+                    self._finish_all(r.model, "failed", diag.message, [diag])
+                    self._discard(r.model)
 
     def _collect(self, r: _Running) -> None:
         """Record what a finished worker did; move its output into place when compile succeeded."""
@@ -321,6 +341,9 @@ class Runner:
         state = self.store.state(name) if "compile" in r.cached else {}
         compiled = outcomes.get("compile", {}).get("state") == "ok"
         if compiled:
+            # Without its state, a model is built again: so a state that could not be saved
+            # never describes an output it did not make.
+            self.store.forget_state(name)
             _replace(self.store.staging(name) / "out", self.store.output(name))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
@@ -414,6 +437,13 @@ def _uninterrupted() -> Iterator[None]:
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
+    """E0642: the build folder refused a model's output or state."""
+    return Diagnostic(Severity.ERROR, "E0642", f"cannot write the build of model '{name}' "
+                      f"({describe(error)}); its previous output is unchanged",
+                      model.span)
 
 
 def _past(state: str) -> str:

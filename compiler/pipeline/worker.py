@@ -72,5 +72,5 @@ def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadR
                           "details": outcome.details, "seconds": time.perf_counter() - started,
                           "blocked": bool(missing)}
         if name == "compile":
-            deps = [e for p in recorder.inputs() if (e := dep_entry(p)) is not None]
+            deps = [e for p in recorder.inputs() if (e := dep_entry(p, job.root)) is not None]
     return {"outcomes": outcomes, "deps": deps}
