@@ -29,7 +29,14 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.fingerprint import data_digest, deps_current, digest, mpc_version, with_deps
+from mpc.compiler.pipeline.fingerprint import (
+    data_digest,
+    dep_name,
+    deps_current,
+    digest,
+    mpc_version,
+    with_deps,
+)
 from mpc.compiler.pipeline.plan import Plan, PlannedModel
 from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome
 from mpc.compiler.pipeline.status import (
@@ -163,7 +170,7 @@ class Runner:
                 state = self.status.models[parent].stages[self.opts.stages[0]].state
                 self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
                 return None
-        packages = repr(sorted((k, str(v)) for k, v in self.opts.package_map.items()))
+        packages = repr(sorted((k, dep_name(v, self.plan.root)) for k, v in self.opts.package_map.items()))
         pre = digest(mpc_version(), data_digest(model.data), packages, str(self.opts.werror),
                      *(f"{p}={self._fingerprint_of(p)}" for p in sorted(model.parents)))
         failure = self._cached_failure(name, pre)
