@@ -34,8 +34,7 @@ def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
 
 def parse_stages(text: str) -> tuple[str, ...]:
     """The stages named on the command line, with the stages they need, in run order."""
-    from mpc.compiler.pipeline.runner import stages_with_needs
-    from mpc.compiler.pipeline.stages import KNOWN, STAGES
+    from mpc.compiler.pipeline.stages import KNOWN, STAGES, stages_with_needs
 
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:

@@ -54,22 +54,40 @@ def mpc_version() -> str:
     """mpc's version and a digest of its source files (compiler, ir, backends, grammar, …)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    import mpc.compiler
-
     try:
         ver = version("model-pipeline-compiler")
     except PackageNotFoundError:  # running from a checkout without installing
         ver = "unknown"
     h = hashlib.sha256(ver.encode())
-    top = Path(mpc.compiler.__file__).resolve().parent.parent
-    for folder in sorted(top.iterdir()):
-        if not (folder / "__init__.py").is_file() and folder.name != "grammar":
-            continue
-        for file in sorted(folder.rglob("*")):
-            if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts:
-                h.update(str(file.relative_to(top)).encode())
-                h.update(file.read_bytes())
+    for name, file in source_files():
+        h.update(name.encode())
+        h.update(file.read_bytes())
     return f"{ver}+{h.hexdigest()[:16]}"
+
+
+def source_files() -> list[tuple[str, Path]]:
+    """mpc's own source files (Python and grammars), each with its name inside `mpc`.
+
+    The packages are found through the `mpc` namespace, not as the folders next to
+    `compiler/`: in a checkout those include tests/, which are not part of mpc.
+    """
+    import importlib.util
+
+    import mpc.compiler
+
+    top = Path(mpc.compiler.__file__).resolve().parent.parent
+    out = []
+    for folder in sorted(top.iterdir()):
+        if not (folder.is_dir() and folder.name.isidentifier()):
+            continue
+        spec = importlib.util.find_spec(f"mpc.{folder.name}")
+        locations = spec.submodule_search_locations if spec is not None else None
+        if not locations or Path(next(iter(locations))).resolve() != folder:
+            continue
+        out += [(f"{folder.name}/{file.relative_to(folder).as_posix()}", file)
+                for file in sorted(folder.rglob("*"))
+                if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts]
+    return out
 
 
 MISSING = "missing"  # the digest of a file the build looked for and did not find

@@ -29,16 +29,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.fingerprint import (
-    data_digest,
-    dep_name,
-    deps_current,
-    digest,
-    mpc_version,
-    with_deps,
-)
+from mpc.compiler.pipeline.fingerprint import mpc_version, with_deps
+from mpc.compiler.pipeline.freshness import Freshness
 from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome
+from mpc.compiler.pipeline.stages import StageJob, StageOutcome
 from mpc.compiler.pipeline.status import (
     ModelRecord,
     RunStatus,
@@ -103,6 +97,7 @@ class Runner:
         self.done: set[str] = set()
         self.running: dict[str, _Running] = {}
         self.status_error: str | None = None  # why status.json could not be written
+        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force)
 
     # -- the loop ----------------------------------------------------------------------------
 
@@ -170,15 +165,13 @@ class Runner:
                 state = self.status.models[parent].stages[self.opts.stages[0]].state
                 self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
                 return None
-        packages = repr(sorted((k, dep_name(v, self.plan.root)) for k, v in self.opts.package_map.items()))
-        pre = digest(mpc_version(), data_digest(model.data), packages, str(self.opts.werror),
-                     *(f"{p}={self._fingerprint_of(p)}" for p in sorted(model.parents)))
-        failure = self._cached_failure(name, pre)
+        pre = self.freshness.before_build(model, self.fingerprints)
+        failure = self.freshness.last_failure(name, pre)
         if failure is not None:
             self._finish_all(name, "failed", "unchanged since it failed: " + failure["summary"],
                              diagnostics_from_json(failure["diagnostics"]), details={"cached": True})
             return None
-        cached = self._cached(name, pre)
+        cached = self.freshness.cached_stages(name, pre)
         if len(cached) == len(self.opts.stages):
             state = self.store.state(name)
             for stage in self.opts.stages:
@@ -188,46 +181,6 @@ class Runner:
             self._done(name)
             return None
         return name, pre, cached
-
-    def _cached_failure(self, name: str, pre: str) -> dict[str, Any] | None:
-        """The model's last compile failure, when nothing it depends on changed since: compiling
-        is deterministic, so it would fail again the same way."""
-        failure = self.store.state(name).get("failure")
-        if self.opts.force or not isinstance(failure, dict) or failure.get("pre") != pre:
-            return None
-        return failure if deps_current(failure["deps"], self.plan.root) is not None else None
-
-    def _cached(self, name: str, pre: str) -> list[str]:
-        """The selected stages whose result from an earlier run still holds."""
-        state = self.store.state(name)
-        stages = state.get("stages", {})
-        if self.opts.force or state.get("pre") != pre or "compile" not in stages:
-            return []
-        if not self.store.output(name).is_dir():
-            return []
-        deps = deps_current(state.get("deps", []), self.plan.root)
-        if deps is None:
-            return []
-        if deps != state.get("deps", []):  # only times changed: remember them, so the next run stats only
-            with contextlib.suppress(OSError):  # a state that cannot be written costs hashing, no more
-                self.store.save_state(name, {**state, "deps": deps})
-        fp = state["fingerprint"]
-        return [s for s in self.opts.stages
-                if s == "compile" or stages.get(s, {}).get("fingerprint") == self._stage_fingerprint(fp, s)]
-
-    def _stage_fingerprint(self, compile_fp: str, stage: str) -> str:
-        if stage == "compile":
-            return compile_fp
-        return digest(compile_fp, stage, data_digest(self.plan.settings))
-
-    def _fingerprint_of(self, parent: str) -> str:
-        """A parent's compile fingerprint: from this run, else from its last build."""
-        if parent in self.fingerprints and self.fingerprints[parent] is not None:
-            return str(self.fingerprints[parent])
-        state = self.store.state(parent)
-        if isinstance(state.get("fingerprint"), str):
-            return state["fingerprint"]
-        return "unbuilt:" + data_digest(self.plan.models[parent].data)
 
     # -- workers -----------------------------------------------------------------------------
 
@@ -321,9 +274,7 @@ class Runner:
                                   "its previous output is unchanged", Span.of_file(str(model.definition)))
             else:
                 self.status.internal_error = True
-                diag = Diagnostic(Severity.ERROR, "E0614", f"mpc failed while building model '{name}' "
-                                  f"(a bug in mpc, please report it): {message['internal_error']}",
-                                  Span.of_file(str(model.definition)), notes=((None, message["traceback"]),))
+                diag = message["internal_error"]  # worker.bug
             for stage in r.cached:
                 record.stages[stage] = StageRecord("cached")
             record.stages[r.run[0]] = StageRecord("failed", diag.message, [diag],
@@ -366,7 +317,7 @@ class Runner:
             o = outcomes[stage]
             if o["details"].get("internal_error"):
                 self.status.internal_error = True
-            sfp = self._stage_fingerprint(fp, stage) if fp else None
+            sfp = self.freshness.stage_fingerprint(fp, stage) if fp else None
             record.stages[stage] = StageRecord(
                 o["state"], o["summary"], o["diagnostics"], o["seconds"],
                 sfp if o["state"] == "ok" else None, o["details"], o["blocked"])
@@ -467,17 +418,3 @@ def _preload() -> None:
     from mpc.compiler import driver  # noqa: F401
 
     BACKENDS["urdf"]()
-
-
-def stages_with_needs(selected: tuple[str, ...]) -> tuple[str, ...]:
-    """The selected stages and every stage they need, in the order stages run."""
-    from mpc.compiler.pipeline.stages import KNOWN
-
-    wanted = set(selected)
-    todo = list(selected)
-    while todo:
-        for need in STAGES[todo.pop()].needs:
-            if need not in wanted:
-                wanted.add(need)
-                todo.append(need)
-    return tuple(s for s in KNOWN if s in wanted)

@@ -34,7 +34,7 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
     try:
         message: dict[str, Any] = run_stages(job, run, cached, recorder, werror)
     except Exception as e:  # a bug in mpc; the runner reports it as one
-        message = {"internal_error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}
+        message = {"internal_error": bug(job, e)}
     conn.send(message)
     conn.close()
 

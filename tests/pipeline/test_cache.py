@@ -164,7 +164,7 @@ def test_a_checkout_at_another_path_keeps_its_cache_and_sees_its_own_files(proje
 
 def test_a_new_mpc_version_rebuilds_everything(project: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from mpc.compiler.diagnostics import Sink
-    from mpc.compiler.pipeline import runner
+    from mpc.compiler.pipeline import freshness, runner
     from mpc.compiler.pipeline.plan import load_plan
     from mpc.compiler.pipeline.progress import Quiet
 
@@ -178,7 +178,7 @@ def test_a_new_mpc_version_rebuilds_everything(project: Path, monkeypatch: pytes
         return {name: m.stages["compile"].state for name, m in status.models.items()}
 
     assert _rebuilt(states()) == set()
-    monkeypatch.setattr(runner, "mpc_version", lambda: "99.0+0123456789abcdef")
+    monkeypatch.setattr(freshness, "mpc_version", lambda: "99.0+0123456789abcdef")
     assert _rebuilt(states()) == ALL
     assert _rebuilt(states()) == set()
 
@@ -191,3 +191,14 @@ def test_the_installed_package_is_named_absolutely(project: Path) -> None:
     names = [entry[0] for entry in state["deps"]]
     assert f"{ERD / DOUBLE_PENDULUM}/urdf/double_pendulum_simple.urdf" in names
     assert "models/other.yml" in names
+
+
+def test_mpc_version_hashes_the_sources_of_mpc_and_nothing_else() -> None:
+    """In a checkout, tests/ lies next to compiler/: editing a test must not rebuild models."""
+    from mpc.compiler.pipeline.fingerprint import source_files
+
+    names = {name for name, _ in source_files()}
+    assert {"compiler/driver.py", "compiler/pipeline/runner.py", "grammar/expr.lark", "ir/robot.py",
+            "backends/urdf.py"} <= names
+    packages = {name.split("/")[0] for name in names}
+    assert packages == {"backends", "checks", "compiler", "deploy", "grammar", "ir"}

@@ -177,3 +177,17 @@ def test_check_reports_what_only_the_whole_pipeline_shows(tmp_path: Path) -> Non
     assert done.returncode == 1
     assert done.stderr.splitlines()[0] == ("pipeline.yml:3:32: error[E0610]: model definitions 'one.yml' and "
                                            "'two.yml' both build model 'same'")
+
+
+def test_check_of_a_definition_imports_nothing_of_the_pipeline(tmp_path: Path) -> None:
+    """`mpc check` stays fast: the pipeline runner (multiprocessing, rich) loads only for pipelines."""
+    import subprocess
+    import sys
+
+    write(tmp_path / "m.yml", _model("m"))
+    code = ("import sys\nfrom mpc.compiler.cli import main\nstatus = main(['check', sys.argv[1]])\n"
+            "print(status, sorted(m for m in sys.modules if m.startswith('mpc.compiler.pipeline') "
+            "or m in ('multiprocessing', 'rich')))")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "m.yml")], capture_output=True,
+                          text=True, check=True)
+    assert done.stdout == "0 []\n"
