@@ -179,7 +179,12 @@ def ci(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(text)
     else:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        args.output.write_text(text, encoding="utf-8")
+        from mpc.compiler.pipeline.store import describe, write_text
+
+        try:
+            write_text(args.output, text)
+        except OSError as e:
+            print(f"mpc ci: error: cannot write '{args.output}' ({describe(e)})", file=sys.stderr)
+            return 1
         print(f"wrote {args.output}: {len(plan.models)} jobs")
     return 0

@@ -74,6 +74,10 @@ class Reporter(Protocol):
 
 @dataclass
 class _Running:
+    """A model whose worker runs: its process and the pipe it answers on; `pre`, its
+    fingerprint before building (freshness.before_build); the stages it runs and those that
+    were cached; when it started; and its message, once received."""
+
     model: str
     process: BaseProcess
     conn: Connection
