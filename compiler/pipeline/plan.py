@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -104,23 +105,24 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     return Plan(path, doc, settings, root, models)
 
 
-# What `mpc check pipeline.yml` adds to checking each definition: the problems of the
-# pipeline as a whole (checking the definitions reports the rest, cycles as E0308).
-_WHOLE_PIPELINE = ("E0610", "E0612", "E0640", "E0641", "W0610", "W0611")
+# What `mpc check pipeline.yml` reports of planning; checking each definition reports the
+# rest (its own errors, cycles as E0308).
+_WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "W0610")
 
 
-def check_models(path: Path, sink: Sink) -> None:
-    """Report what only the pipeline as a whole shows: clashing modelnames, names that
-    cannot be folders, derived_base parents outside the pipeline, definitions listed twice."""
-    quiet = Sink()
-    plan = load_plan(path, quiet)
-    for d in quiet.diagnostics:
-        if d.code in _WHOLE_PIPELINE:
-            sink.report(d)
+def check_pipeline(path: Path, sink: Sink,
+                   check_definition: Callable[[Path, PipelineDefaults], None]) -> None:
+    """`mpc check pipeline.yml`: the file itself, what only the whole pipeline shows (clashing
+    modelnames, names that cannot be folders, definitions that are missing, listed twice or
+    outside the root, derived_base parents outside the pipeline), and each definition that
+    can be read, through `check_definition` with the pipeline's defaults."""
+    plan = load_plan(path, sink)
     for model in plan.models.values() if plan else ():
         for d in model.diagnostics:
             if d.code in _WHOLE_PIPELINE:
                 sink.report(d)
+        if not any(d.code in ("E0601", "E0641") for d in model.diagnostics):
+            check_definition(model.definition, plan.defaults)  # type: ignore[union-attr]
 
 
 def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span: Span,
