@@ -94,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     opts = RunOptions(stages=stages, only=only, jobs=jobs, force=args.force,
                       build=args.out.resolve() if args.out else None,
-                      package_map={name: folder for name, folder in args.package}, werror=args.werror)
+                      package_map={name: folder for name, folder in args.package}, werror=args.werror,
+                      verify=args.verify, allow_na=args.allow_na)
     report = progress.reporter(args.log_format)
     runner = Runner(plan, opts, report)
     previous = signal.signal(signal.SIGTERM, _interrupt)  # a stopped run stops its workers first

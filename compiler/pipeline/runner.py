@@ -32,7 +32,7 @@ from mpc.compiler.pipeline import dag
 from mpc.compiler.pipeline.fingerprint import mpc_version, with_deps
 from mpc.compiler.pipeline.freshness import Freshness
 from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.stages import StageJob, StageOutcome
+from mpc.compiler.pipeline.stages import StageJob, StageOutcome, first_error
 from mpc.compiler.pipeline.status import (
     ModelRecord,
     RunStatus,
@@ -51,7 +51,8 @@ if TYPE_CHECKING:
 class RunOptions:
     """What to run: the stages (each with the stages it needs), the models (`only`; empty:
     all), how many workers, whether to ignore the cache, the build folder (None:
-    `<root>/build`), package folders, and whether warnings fail a stage."""
+    `<root>/build`), package folders, whether warnings fail a stage, and how the exit status
+    is counted (`--verify`, `--allow-na`; recorded in status.json)."""
 
     stages: tuple[str, ...] = ("compile",)
     only: tuple[str, ...] = ()
@@ -60,6 +61,8 @@ class RunOptions:
     build: Path | None = None
     package_map: dict[str, Path] = field(default_factory=dict)
     werror: bool = False
+    verify: bool = False
+    allow_na: bool = False
 
 
 class Reporter(Protocol):
@@ -139,7 +142,7 @@ class Runner:
         finally:
             self.status.seconds = time.perf_counter() - start
             try:
-                self.store.save_status(self.status.to_json())
+                self.store.save_status(self.status.to_json(self.opts.verify, self.opts.allow_na))
             except OSError as e:
                 self.status_error = e.strerror or str(e)
             self.store.unlock()
@@ -162,7 +165,7 @@ class Runner:
                 f"({unusable}); the model is built again", Span.of_file(str(self.store.state_file(name)))))
         if model.failed:
             errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
-            self._finish_all(name, "failed", _first(errors), diagnostics=errors)
+            self._finish_all(name, "failed", first_error(errors), diagnostics=errors)
             return None
         for parent in model.parents:
             if parent in self.selected and self.fingerprints.get(parent) is None:
@@ -410,10 +413,6 @@ def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
 
 def _past(state: str) -> str:
     return {"failed": "failed", "skipped": "was skipped", "interrupted": "was interrupted"}.get(state, state)
-
-
-def _first(diagnostics: list[Diagnostic]) -> str:
-    return f"{diagnostics[0].code} {diagnostics[0].message}" if diagnostics else ""
 
 
 def _preload() -> None:

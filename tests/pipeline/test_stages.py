@@ -116,6 +116,11 @@ def test_verify_counts_a_stage_that_skipped_by_its_own_choice_unless_allowed(pip
     assert status.exit_status() == 0
     assert status.exit_status(verify=True) == 1
     assert status.exit_status(verify=True, allow_na=True) == 0
+    recorded = json.loads((pipeline.parent / "build/.mpc/status.json").read_text())["exit_status"]
+    assert recorded == 0
+    _run(pipeline, verify=True)
+    recorded = json.loads((pipeline.parent / "build/.mpc/status.json").read_text())["exit_status"]
+    assert recorded == 1  # status.json says what `mpc run --verify` returned
 
 
 def failing_stage(job: StageJob) -> StageOutcome:
