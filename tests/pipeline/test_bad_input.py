@@ -54,6 +54,18 @@ PIPELINES = {
     "a root that does not exist": ("pipeline:\n  root: nowhere\n  model_definitions: [p.yml]\n",
                                    "pipeline.yml:2:9: error[E0640]: the workspace root '{folder}/nowhere' "
                                    "does not exist"),
+    "a root with an unset variable": ("pipeline:\n  root: ${MPC_NOT_SET}/x\n  model_definitions: [p.yml]\n",
+                                      "pipeline.yml:2:9: error[E0640]: the workspace root "
+                                      "'{folder}/${{MPC_NOT_SET}}/x' does not exist\n"
+                                      " 2 |   root: ${{MPC_NOT_SET}}/x\n"
+                                      "   |         ^^^^^^^^^^^^^^^^\n"
+                                      "  hint: the environment variable MPC_NOT_SET is not set"),
+    "a root that is not a path": ('pipeline:\n  root: "a\\0b"\n  model_definitions: [p.yml]\n',
+                                  "pipeline.yml:2:9: error[E0640]: the workspace root 'a\\x00b' "
+                                  "is not a path"),
+    "an entry that is not a path": ('pipeline:\n  root: .\n  model_definitions: [p.yml, "q\\0.yml"]\n',
+                                    "pipeline.yml:3:30: error[E0601]: model definition 'q\\x00.yml' "
+                                    "is not a path"),
     "a root that is a file": ("pipeline:\n  root: p.yml\n  model_definitions: [p.yml]\n",
                               "pipeline.yml:2:9: error[E0640]: the workspace root '{folder}/p.yml' "
                               "is not a folder"),
