@@ -48,6 +48,9 @@ def bug(job: StageJob, error: Exception) -> Diagnostic:
 
 def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadRecorder,
                werror: bool) -> dict[str, Any]:
+    """Each stage of `run` in order, skipping one whose needs did not succeed; the message
+    for the runner: each stage's outcome, and the files compile read (`deps`, None when
+    compile did not run here)."""
     outcomes: dict[str, dict[str, Any]] = {}
     deps = None
     for name in run:

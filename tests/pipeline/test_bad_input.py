@@ -156,14 +156,21 @@ def test_a_build_folder_that_is_a_file_is_an_error(built: Path, tmp_path: Path) 
                            f"'{tmp_path}/file/.mpc'); nothing was built\n")
 
 
-def test_a_build_folder_held_by_a_folder_named_lock_is_an_error(built: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize(("file", "message", "table"), [
+    ("lock", "cannot use the build folder '{build}' (Is a directory: '{build}/.mpc/lock'); "
+             "nothing was built", ""),
+    ("status.json", "cannot write the status file '{build}/.mpc/status.json' (Is a directory)",
+     "1 model: 1 cached"),
+])
+def test_a_folder_where_the_run_writes_a_file_is_an_error(built: Path, tmp_path: Path, file: str,
+                                                           message: str, table: str) -> None:
     folder = _copy(built, tmp_path / "p")
-    (folder / "build/.mpc/lock").unlink()
-    (folder / "build/.mpc/lock").mkdir()
+    (folder / "build/.mpc" / file).unlink()
+    (folder / "build/.mpc" / file).mkdir()
     done = mpc("run", "pipeline.yml", cwd=folder)
     assert done.returncode == 1
-    assert done.stderr == (f"mpc run: error: cannot use the build folder '{folder}/build' (Is a directory: "
-                           f"'{folder}/build/.mpc/lock'); nothing was built\n")
+    assert done.stderr == f"mpc run: error: {message.format(build=folder / 'build')}\n"
+    assert table in done.stdout
 
 
 # Tests run as root, where permissions do not stop writes; a folder where the state file
@@ -195,18 +202,6 @@ def test_a_staging_folder_that_cannot_be_made_fails_the_model(built: Path, tmp_p
     assert (f"error[E0642]: cannot write the build of model 'p' (Not a directory: "
             f"'{folder}/build/.mpc/staging/p')") in run.stderr
     assert _urdf(folder) == _urdf(built)
-
-
-def test_a_status_file_that_cannot_be_written_is_an_error_after_the_build(built: Path,
-                                                                          tmp_path: Path) -> None:
-    folder = _copy(built, tmp_path / "p")
-    (folder / "build/.mpc/status.json").unlink()
-    (folder / "build/.mpc/status.json").mkdir()
-    done = mpc("run", "pipeline.yml", cwd=folder)
-    assert done.returncode == 1
-    assert done.stderr == (f"mpc run: error: cannot write the status file '{folder}/build/.mpc/status.json' "
-                           "(Is a directory)\n")
-    assert "1 model: 1 cached" in done.stdout
 
 
 def _state(folder: Path) -> dict:
