@@ -157,21 +157,10 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
     if doc is None:
         return
     if isinstance(doc.data, dict) and "pipeline" in doc.data:
-        pipeline = schema.validate_pipeline(doc, sink)
-        if pipeline is not None:
-            from mpc.compiler.pipeline.defaults import PipelineDefaults
+        from mpc.compiler.pipeline.plan import check_pipeline
 
-            options = replace(options, defaults=PipelineDefaults(doc))
-            for i, name in enumerate(pipeline.pipeline.model_definitions):
-                model = (path.resolve().parent / name)
-                if not model.is_file():
-                    sink.error(doc.value_span(("pipeline", "model_definitions", i)), "E0601",
-                               f"model definition '{name}' does not exist")
-                else:
-                    front_end(model, sink, options, Severity.WARNING)
-            from mpc.compiler.pipeline.plan import check_models
-
-            check_models(path, sink)
+        check_pipeline(path, sink, lambda model, defaults: front_end(
+            model, sink, replace(options, defaults=defaults), Severity.WARNING))
         return
     front_end(path, sink, options, Severity.WARNING, doc=doc)
 

@@ -9,10 +9,14 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.compiler import render
 from mpc.compiler.diagnostics import Diagnostic, Severity, Sink, did_you_mean
 from mpc.compiler.pipeline.plan import Plan, load_plan
+
+if TYPE_CHECKING:
+    from mpc.compiler.pipeline.status import RunStatus
 
 
 class UsageError(Exception):
@@ -30,8 +34,7 @@ def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
 
 def parse_stages(text: str) -> tuple[str, ...]:
     """The stages named on the command line, with the stages they need, in run order."""
-    from mpc.compiler.pipeline.runner import stages_with_needs
-    from mpc.compiler.pipeline.stages import KNOWN, STAGES
+    from mpc.compiler.pipeline.stages import KNOWN, STAGES, stages_with_needs
 
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:
@@ -74,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     from mpc.compiler.pipeline import progress
     from mpc.compiler.pipeline.runner import Runner, RunOptions
     from mpc.compiler.pipeline.status import plain_table
-    from mpc.compiler.pipeline.store import BuildFolderBusy
+    from mpc.compiler.pipeline.store import BuildFolderBusy, BuildFolderUnusable
 
     sink = Sink(werror=args.werror)
     plan = _load(args, sink)
@@ -91,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     opts = RunOptions(stages=stages, only=only, jobs=jobs, force=args.force,
                       build=args.out.resolve() if args.out else None,
-                      package_map={name: folder for name, folder in args.package}, werror=args.werror)
+                      package_map={name: folder for name, folder in args.package}, werror=args.werror,
+                      verify=args.verify, allow_na=args.allow_na)
     report = progress.reporter(args.log_format)
     runner = Runner(plan, opts, report)
     previous = signal.signal(signal.SIGTERM, _interrupt)  # a stopped run stops its workers first
@@ -100,29 +104,44 @@ def run(args: argparse.Namespace) -> int:
     except BuildFolderBusy as e:
         print(f"mpc run: error: another `mpc run` is using the build folder '{e}'", file=sys.stderr)
         return 1
+    except BuildFolderUnusable as e:
+        print(f"mpc run: error: cannot use the build folder '{runner.store.build}' ({e}); "
+              "nothing was built", file=sys.stderr)
+        return 1
     finally:
         signal.signal(signal.SIGTERM, previous)
         report.close()
     exit_status = status.exit_status(args.verify, args.allow_na)
     status_file = runner.store.meta / "status.json"
+    if runner.status_error is not None:
+        print(f"mpc run: error: cannot write the status file '{status_file}' ({runner.status_error})",
+              file=sys.stderr)
+        exit_status = max(exit_status, 1)
+    _print_model_diagnostics(status, args.format)  # on stderr: also with JSON lines on stdout
     if args.log_format == "json":
         assert isinstance(report, progress.JsonLog)
         report.emit("end", exit_status=exit_status, counts=status.counts(), seconds=round(status.seconds, 3),
                     status=str(status_file))
         return exit_status
-    if args.format == "json":  # one list for tools
-        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
-    for name in sorted(status.models) if args.format != "json" else ():
-        diagnostics = status.models[name].diagnostics()
-        if diagnostics and args.format == "human":
-            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
-        _print_diagnostics(diagnostics, args.format)
     if sys.stdout.isatty():
         progress.rich_table(status)
     else:
         print(plain_table(status))
-    print(f"status: {status_file}")
+    if runner.status_error is None:
+        print(f"status: {status_file}")
     return exit_status
+
+
+def _print_model_diagnostics(status: RunStatus, fmt: str) -> None:
+    """Each model's diagnostics under its name; with `--format json`, one list for tools."""
+    if fmt == "json":
+        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
+        return
+    for name in sorted(status.models):
+        diagnostics = status.models[name].diagnostics()
+        if diagnostics and fmt == "human":
+            print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
+        _print_diagnostics(diagnostics, fmt)
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -161,7 +180,12 @@ def ci(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(text)
     else:
-        args.output.parent.mkdir(parents=True, exist_ok=True)
-        args.output.write_text(text, encoding="utf-8")
+        from mpc.compiler.pipeline.store import describe, write_text
+
+        try:
+            write_text(args.output, text)
+        except OSError as e:
+            print(f"mpc ci: error: cannot write '{args.output}' ({describe(e)})", file=sys.stderr)
+            return 1
         print(f"wrote {args.output}: {len(plan.models)} jobs")
     return 0

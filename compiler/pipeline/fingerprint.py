@@ -54,59 +54,86 @@ def mpc_version() -> str:
     """mpc's version and a digest of its source files (compiler, ir, backends, grammar, …)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    import mpc.compiler
-
     try:
         ver = version("model-pipeline-compiler")
     except PackageNotFoundError:  # running from a checkout without installing
         ver = "unknown"
     h = hashlib.sha256(ver.encode())
-    top = Path(mpc.compiler.__file__).resolve().parent.parent
-    for folder in sorted(top.iterdir()):
-        if not (folder / "__init__.py").is_file() and folder.name != "grammar":
-            continue
-        for file in sorted(folder.rglob("*")):
-            if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts:
-                h.update(str(file.relative_to(top)).encode())
-                h.update(file.read_bytes())
+    for name, file in source_files():
+        h.update(name.encode())
+        h.update(file.read_bytes())
     return f"{ver}+{h.hexdigest()[:16]}"
+
+
+def source_files() -> list[tuple[str, Path]]:
+    """mpc's own source files (Python and grammars), each with its name inside `mpc`.
+
+    The packages are found through the `mpc` namespace, not as the folders next to
+    `compiler/`: in a checkout those include tests/, which are not part of mpc.
+    """
+    import importlib.util
+
+    import mpc.compiler
+
+    top = Path(mpc.compiler.__file__).resolve().parent.parent
+    out = []
+    for folder in sorted(top.iterdir()):
+        if not (folder.is_dir() and folder.name.isidentifier()):
+            continue
+        spec = importlib.util.find_spec(f"mpc.{folder.name}")
+        locations = spec.submodule_search_locations if spec is not None else None
+        if not locations or Path(next(iter(locations))).resolve() != folder:
+            continue
+        out += [(f"{folder.name}/{file.relative_to(folder).as_posix()}", file)
+                for file in sorted(folder.rglob("*"))
+                if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts]
+    return out
 
 
 MISSING = "missing"  # the digest of a file the build looked for and did not find
 
 
-def dep_entry(path: Path) -> list[Any] | None:
-    """[path, size, mtime_ns, sha256] of a file; [path, -1, 0, "missing"] when there is no such
-    file (a build that failed on it runs again once it appears); None when it cannot be read."""
+def dep_name(path: Path, root: Path) -> str:
+    """How the state names a file the build read: relative to the workspace root when it is
+    inside it, so a checkout moved or cloned elsewhere keeps its cache; else absolute."""
+    return path.relative_to(root).as_posix() if path.is_relative_to(root) else str(path)
+
+
+def dep_entry(path: Path, root: Path) -> list[Any] | None:
+    """[name, size, mtime_ns, sha256] of a file (name: `dep_name`); [name, -1, 0, "missing"]
+    when there is no such file (a build that failed on it runs again once it appears); None
+    when it cannot be read."""
+    name = dep_name(path, root)
     try:
         st = os.stat(path)
-        return [str(path), st.st_size, st.st_mtime_ns, file_digest(path)]
+        return [name, st.st_size, st.st_mtime_ns, file_digest(path)]
     except FileNotFoundError:
-        return [str(path), -1, 0, MISSING]
+        return [name, -1, 0, MISSING]
     except OSError:
         return None
 
 
-def deps_current(deps: list[list[Any]]) -> list[list[Any]] | None:
+def deps_current(deps: list[list[Any]], root: Path) -> list[list[Any]] | None:
     """The recorded deps, refreshed where only the time changed; None when a file's content
     changed or the file is gone."""
     out = []
-    for path, size, mtime, sha in deps:
+    for name, size, mtime, sha in deps:
+        path = root / name  # an absolute name stays as it is
         try:
             st = os.stat(path)
         except OSError:
             if sha == MISSING and not os.path.lexists(path):
-                out.append([path, size, mtime, sha])
+                out.append([name, size, mtime, sha])
                 continue
             return None
         if sha == MISSING:
             return None
         if st.st_size == size and st.st_mtime_ns == mtime:
-            out.append([path, size, mtime, sha])
+            out.append([name, size, mtime, sha])
             continue
         if st.st_size != size:
             return None
-        entry = dep_entry(Path(path))
+        entry = dep_entry(path, root)
         if entry is None or entry[3] != sha:
             return None
         out.append(entry)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import itertools
 import os
+import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -76,20 +78,38 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
         return None
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
-    root = (path.resolve().parent / os.path.expandvars(settings.get("root", ".."))).resolve()
+    expanded = os.path.expandvars(settings.get("root", ".."))
+    root = _path(path.resolve().parent, expanded)
+    if root is None or not root.is_dir():
+        problem = ("is not a folder" if root.exists() else "does not exist") if root else "is not a path"
+        unset = re.findall(r"\$\{?(\w+)", expanded)
+        hint = (f"the environment variable {unset[0]} is not set" if unset
+                else "`root` is relative to the folder of the pipeline file")
+        sink.error(doc.value_span(("pipeline", "root")), "E0640",
+                   f"the workspace root '{root or expanded.encode('unicode_escape').decode()}' {problem}",
+                   hint=hint)
+        return None
     defaults = PipelineDefaults(doc)
     by_file: dict[Path, PlannedModel] = {}
+    unusable = False
     derived: dict[Path, list[tuple[Path, Span]]] = {}
     for i, written in enumerate(settings["model_definitions"]):
         span = doc.value_span(("pipeline", "model_definitions", i))
-        definition = (path.resolve().parent / written).resolve()
+        definition = _path(path.resolve().parent, written)
+        if definition is None:  # no name for a model, nor a folder for its output
+            shown = written.encode("unicode_escape").decode()
+            sink.error(span, "E0601", f"model definition '{shown}' is not a path")
+            unusable = True
+            continue
         if definition in by_file:
             sink.warning(span, "W0611", f"model definition '{written}' is listed twice; it is built once",
                          notes=((by_file[definition].span, "first listed here"),))
             continue
-        model, parents = _load_model(path, written, definition, span, defaults)
+        model, parents = _load_model(path, root, written, definition, span, defaults)
         by_file[definition] = model
         derived[definition] = parents
+    if unusable:
+        return None
     _link(by_file, derived)
     models: dict[str, PlannedModel] = {}
     for model in by_file.values():
@@ -99,33 +119,41 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     return Plan(path, doc, settings, root, models)
 
 
-# What `mpc check pipeline.yml` adds to checking each definition: the problems of the
-# pipeline as a whole (checking the definitions reports the rest, cycles as E0308).
-_WHOLE_PIPELINE = ("E0610", "E0612", "W0610", "W0611")
+# What `mpc check pipeline.yml` reports of planning; checking each definition reports the
+# rest (its own errors, cycles as E0308).
+_WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "W0610")
 
 
-def check_models(path: Path, sink: Sink) -> None:
-    """Report what only the pipeline as a whole shows: clashing modelnames, names that
-    cannot be folders, derived_base parents outside the pipeline, definitions listed twice."""
-    quiet = Sink()
-    plan = load_plan(path, quiet)
-    for d in quiet.diagnostics:
-        if d.code in _WHOLE_PIPELINE:
-            sink.report(d)
+def check_pipeline(path: Path, sink: Sink,
+                   check_definition: Callable[[Path, PipelineDefaults], None]) -> None:
+    """`mpc check pipeline.yml`: the file itself, what only the whole pipeline shows (clashing
+    modelnames, names that cannot be folders, definitions that are missing, listed twice or
+    outside the root, derived_base parents outside the pipeline), and each definition that
+    can be read, through `check_definition` with the pipeline's defaults."""
+    plan = load_plan(path, sink)
     for model in plan.models.values() if plan else ():
         for d in model.diagnostics:
             if d.code in _WHOLE_PIPELINE:
                 sink.report(d)
+        if not any(d.code in ("E0601", "E0641") for d in model.diagnostics):
+            check_definition(model.definition, plan.defaults)  # type: ignore[union-attr]
 
 
-def _load_model(pipeline: Path, written: str, definition: Path, span: Span,
+def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span: Span,
                 defaults: PipelineDefaults) -> tuple[PlannedModel, list[tuple[Path, Span]]]:
     """One definition, with its defaults applied, and the derived_base files it names."""
     sink = Sink()
     model = PlannedModel(Path(written).stem, definition, written, span)
     display = os.path.normpath(os.path.join(os.path.dirname(str(pipeline)), written))
-    if not definition.is_file():
+    if not definition.is_relative_to(root):
+        # Its build could not be found again from a clone elsewhere, nor kept by CI.
+        sink.error(span, "E0641", f"model definition '{written}' is outside the workspace root '{root}'",
+                   hint="set the pipeline's `root` to a folder that holds every model definition")
+    elif definition.is_dir():
+        sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
+    elif not definition.is_file():
         sink.error(span, "E0601", f"model definition '{written}' does not exist")
+    if sink.diagnostics:
         model.diagnostics = sink.diagnostics
         return model, []
     doc = source.load(definition, sink, display=display, origin=span)
@@ -146,8 +174,18 @@ def _load_model(pipeline: Path, written: str, definition: Path, span: Span,
             at = doc.value_span(("model", "input_models", key, "derived_base"))
             # Relative to the file that wrote it (a defaults file, or the definition).
             folder = Path(at.file).resolve().parent if at.file else definition.parent
-            parents.append(((folder / entry["derived_base"]).resolve(), at))
+            parent = _path(folder, entry["derived_base"])
+            if parent is not None:  # else compiling the model reports it
+                parents.append((parent, at))
     return model, parents
+
+
+def _path(folder: Path, written: str) -> Path | None:
+    """`written` resolved against `folder`; None when it cannot name a file (a NUL byte)."""
+    try:
+        return (folder / written).resolve()
+    except ValueError:
+        return None
 
 
 def _link(by_file: dict[Path, PlannedModel], derived: dict[Path, list[tuple[Path, Span]]]) -> None:

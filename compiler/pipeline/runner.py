@@ -29,9 +29,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.fingerprint import data_digest, deps_current, digest, mpc_version, with_deps
+from mpc.compiler.pipeline.fingerprint import mpc_version, with_deps
+from mpc.compiler.pipeline.freshness import Freshness
 from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome
+from mpc.compiler.pipeline.stages import StageJob, StageOutcome, first_error
 from mpc.compiler.pipeline.status import (
     ModelRecord,
     RunStatus,
@@ -39,7 +40,7 @@ from mpc.compiler.pipeline.status import (
     diagnostics_from_json,
     diagnostics_json,
 )
-from mpc.compiler.pipeline.store import Store
+from mpc.compiler.pipeline.store import Store, describe
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
@@ -50,7 +51,8 @@ if TYPE_CHECKING:
 class RunOptions:
     """What to run: the stages (each with the stages it needs), the models (`only`; empty:
     all), how many workers, whether to ignore the cache, the build folder (None:
-    `<root>/build`), package folders, and whether warnings fail a stage."""
+    `<root>/build`), package folders, whether warnings fail a stage, and how the exit status
+    is counted (`--verify`, `--allow-na`; recorded in status.json)."""
 
     stages: tuple[str, ...] = ("compile",)
     only: tuple[str, ...] = ()
@@ -59,6 +61,8 @@ class RunOptions:
     build: Path | None = None
     package_map: dict[str, Path] = field(default_factory=dict)
     werror: bool = False
+    verify: bool = False
+    allow_na: bool = False
 
 
 class Reporter(Protocol):
@@ -73,6 +77,10 @@ class Reporter(Protocol):
 
 @dataclass
 class _Running:
+    """A model whose worker runs: its process and the pipe it answers on; `pre`, its
+    fingerprint before building (freshness.before_build); the stages it runs and those that
+    were cached; when it started; and its message, once received."""
+
     model: str
     process: BaseProcess
     conn: Connection
@@ -95,6 +103,8 @@ class Runner:
         self.fingerprints: dict[str, str | None] = {}  # compile fingerprints of finished models
         self.done: set[str] = set()
         self.running: dict[str, _Running] = {}
+        self.status_error: str | None = None  # why status.json could not be written
+        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force)
 
     # -- the loop ----------------------------------------------------------------------------
 
@@ -131,7 +141,10 @@ class Runner:
                 self._interrupt()
         finally:
             self.status.seconds = time.perf_counter() - start
-            self.store.save_status(self.status.to_json())
+            try:
+                self.store.save_status(self.status.to_json(self.opts.verify, self.opts.allow_na))
+            except OSError as e:
+                self.status_error = e.strerror or str(e)
             self.store.unlock()
         return self.status
 
@@ -145,72 +158,36 @@ class Runner:
         """Finish the model now (failed in planning, blocked, cached) or return what to build."""
         model = self.plan.models[name]
         record = self._record(model)
+        unusable = self.store.unusable_state(name)
+        if unusable is not None:
+            record.warnings.append(Diagnostic(
+                Severity.WARNING, "W0640", f"the state of model '{name}' from an earlier run is unusable "
+                f"({unusable}); the model is built again", Span.of_file(str(self.store.state_file(name)))))
         if model.failed:
             errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
-            self._finish_all(name, "failed", _first(errors), diagnostics=errors)
+            self._finish_all(name, "failed", first_error(errors), diagnostics=errors)
             return None
         for parent in model.parents:
             if parent in self.selected and self.fingerprints.get(parent) is None:
                 state = self.status.models[parent].stages[self.opts.stages[0]].state
                 self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
                 return None
-        packages = repr(sorted((k, str(v)) for k, v in self.opts.package_map.items()))
-        pre = digest(mpc_version(), data_digest(model.data), packages, str(self.opts.werror),
-                     *(f"{p}={self._fingerprint_of(p)}" for p in sorted(model.parents)))
-        failure = self._cached_failure(name, pre)
+        pre = self.freshness.before_build(model, self.fingerprints)
+        failure = self.freshness.last_failure(name, pre)
         if failure is not None:
             self._finish_all(name, "failed", "unchanged since it failed: " + failure["summary"],
                              diagnostics_from_json(failure["diagnostics"]), details={"cached": True})
             return None
-        cached = self._cached(name, pre)
+        cached = self.freshness.cached_stages(name, pre)
         if len(cached) == len(self.opts.stages):
             state = self.store.state(name)
             for stage in self.opts.stages:
                 record.stages[stage] = StageRecord("cached",
-                                                   fingerprint=state["stages"][stage]["fingerprint"])
+                                                   fingerprint=state["stages"][stage].get("fingerprint"))
             self.fingerprints[name] = state["fingerprint"]
             self._done(name)
             return None
         return name, pre, cached
-
-    def _cached_failure(self, name: str, pre: str) -> dict[str, Any] | None:
-        """The model's last compile failure, when nothing it depends on changed since: compiling
-        is deterministic, so it would fail again the same way."""
-        failure = self.store.state(name).get("failure")
-        if self.opts.force or not isinstance(failure, dict) or failure.get("pre") != pre:
-            return None
-        return failure if deps_current(failure.get("deps", [])) is not None else None
-
-    def _cached(self, name: str, pre: str) -> list[str]:
-        """The selected stages whose result from an earlier run still holds."""
-        state = self.store.state(name)
-        stages = state.get("stages", {})
-        if self.opts.force or state.get("pre") != pre or "compile" not in stages:
-            return []
-        if not self.store.output(name).is_dir():
-            return []
-        deps = deps_current(state.get("deps", []))
-        if deps is None:
-            return []
-        if deps != state["deps"]:  # only times changed: remember them, so the next run stats only
-            self.store.save_state(name, {**state, "deps": deps})
-        fp = state["fingerprint"]
-        return [s for s in self.opts.stages
-                if s == "compile" or stages.get(s, {}).get("fingerprint") == self._stage_fingerprint(fp, s)]
-
-    def _stage_fingerprint(self, compile_fp: str, stage: str) -> str:
-        if stage == "compile":
-            return compile_fp
-        return digest(compile_fp, stage, data_digest(self.plan.settings))
-
-    def _fingerprint_of(self, parent: str) -> str:
-        """A parent's compile fingerprint: from this run, else from its last build."""
-        if parent in self.fingerprints and self.fingerprints[parent] is not None:
-            return str(self.fingerprints[parent])
-        state = self.store.state(parent)
-        if isinstance(state.get("fingerprint"), str):
-            return state["fingerprint"]
-        return "unbuilt:" + data_digest(self.plan.models[parent].data)
 
     # -- workers -----------------------------------------------------------------------------
 
@@ -230,9 +207,14 @@ class Runner:
 
         _preload()
         model = self.plan.models[name]
-        shutil.rmtree(self.store.staging(name), ignore_errors=True)
-        self.store.staging(name).mkdir(parents=True)
-        self.store.workdir(name).mkdir(parents=True, exist_ok=True)
+        try:
+            shutil.rmtree(self.store.staging(name), ignore_errors=True)
+            self.store.staging(name).mkdir(parents=True)
+            self.store.workdir(name).mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            diag = _unwritable(name, model, e)
+            self._finish_all(name, "failed", diag.message, diagnostics=[diag])
+            return
         job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
                        pipeline=self.plan.settings, root=self.plan.root, options=self.options,
@@ -277,7 +259,12 @@ class Runner:
             # Moving the output into place and saving its state happen together or not at
             # all: an interruption waits until both are done.
             with _uninterrupted():
-                self._collect(r)
+                try:
+                    self._collect(r)
+                except OSError as e:  # the output or state could not be written: the model failed
+                    diag = _unwritable(r.model, self.plan.models[r.model], e)
+                    self._finish_all(r.model, "failed", diag.message, [diag])
+                    self._discard(r.model)
 
     def _collect(self, r: _Running) -> None:
         """Record what a finished worker did; move its output into place when compile succeeded."""
@@ -294,9 +281,7 @@ class Runner:
                                   "its previous output is unchanged", Span.of_file(str(model.definition)))
             else:
                 self.status.internal_error = True
-                diag = Diagnostic(Severity.ERROR, "E0614", f"mpc failed while building model '{name}' "
-                                  f"(a bug in mpc, please report it): {message['internal_error']}",
-                                  Span.of_file(str(model.definition)), notes=((None, message["traceback"]),))
+                diag = message["internal_error"]  # worker.bug
             for stage in r.cached:
                 record.stages[stage] = StageRecord("cached")
             record.stages[r.run[0]] = StageRecord("failed", diag.message, [diag],
@@ -321,6 +306,9 @@ class Runner:
         state = self.store.state(name) if "compile" in r.cached else {}
         compiled = outcomes.get("compile", {}).get("state") == "ok"
         if compiled:
+            # Without its state, a model is built again: so a state that could not be saved
+            # never describes an output it did not make.
+            self.store.forget_state(name)
             _replace(self.store.staging(name) / "out", self.store.output(name))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
@@ -336,7 +324,7 @@ class Runner:
             o = outcomes[stage]
             if o["details"].get("internal_error"):
                 self.status.internal_error = True
-            sfp = self._stage_fingerprint(fp, stage) if fp else None
+            sfp = self.freshness.stage_fingerprint(fp, stage) if fp else None
             record.stages[stage] = StageRecord(
                 o["state"], o["summary"], o["diagnostics"], o["seconds"],
                 sfp if o["state"] == "ok" else None, o["details"], o["blocked"])
@@ -416,12 +404,15 @@ def _uninterrupted() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
+def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
+    """E0642: the build folder refused a model's output or state."""
+    return Diagnostic(Severity.ERROR, "E0642", f"cannot write the build of model '{name}' "
+                      f"({describe(error)}); its previous output is unchanged",
+                      model.span)
+
+
 def _past(state: str) -> str:
     return {"failed": "failed", "skipped": "was skipped", "interrupted": "was interrupted"}.get(state, state)
-
-
-def _first(diagnostics: list[Diagnostic]) -> str:
-    return f"{diagnostics[0].code} {diagnostics[0].message}" if diagnostics else ""
 
 
 def _preload() -> None:
@@ -430,17 +421,3 @@ def _preload() -> None:
     from mpc.compiler import driver  # noqa: F401
 
     BACKENDS["urdf"]()
-
-
-def stages_with_needs(selected: tuple[str, ...]) -> tuple[str, ...]:
-    """The selected stages and every stage they need, in the order stages run."""
-    from mpc.compiler.pipeline.stages import KNOWN
-
-    wanted = set(selected)
-    todo = list(selected)
-    while todo:
-        for need in STAGES[todo.pop()].needs:
-            if need not in wanted:
-                wanted.add(need)
-                todo.append(need)
-    return tuple(s for s in KNOWN if s in wanted)

@@ -107,6 +107,18 @@ def register(stage: Stage) -> None:
     STAGES[stage.name] = stage
 
 
+def stages_with_needs(selected: tuple[str, ...]) -> tuple[str, ...]:
+    """The selected stages and every stage they need, in the order stages run."""
+    wanted = set(selected)
+    todo = list(selected)
+    while todo:
+        for need in STAGES[todo.pop()].needs:
+            if need not in wanted:
+                wanted.add(need)
+                todo.append(need)
+    return tuple(s for s in KNOWN if s in wanted)
+
+
 def ensure_program(job: StageJob) -> bool:
     """Give a job whose compile was cached its program (the front end only); False on errors."""
     if job.program is not None:

@@ -14,6 +14,7 @@ state on with its output.
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import json
 import os
@@ -25,6 +26,10 @@ from typing import IO, Any
 
 class BuildFolderBusy(Exception):
     """Another `mpc run` holds the build folder."""
+
+
+class BuildFolderUnusable(Exception):
+    """The build folder cannot be made or written (a file in the way, no permission)."""
 
 
 class Store:
@@ -46,8 +51,11 @@ class Store:
 
     def lock(self) -> None:
         """Take the build folder for this run; BuildFolderBusy when another run has it."""
-        self.meta.mkdir(parents=True, exist_ok=True)
-        handle = open(self.meta / "lock", "a+")  # noqa: SIM115 (held until unlock)
+        try:
+            self.meta.mkdir(parents=True, exist_ok=True)
+            handle = open(self.meta / "lock", "a+")  # noqa: SIM115 (held until unlock)
+        except OSError as e:
+            raise BuildFolderUnusable(describe(e)) from None
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -62,16 +70,37 @@ class Store:
             self._lock.close()
             self._lock = None
 
+    def state_file(self, model: str) -> Path:
+        return self.meta / "state" / f"{model}.json"
+
     def state(self, model: str) -> dict[str, Any]:
-        """The model's state from its last build, or {} (none, or unreadable: then it is rebuilt)."""
+        """The model's state from its last build, or {} when there is none or it is unusable
+        (see `unusable_state`): then the model is built again."""
+        data, _ = self._read_state(model)
+        return data
+
+    def unusable_state(self, model: str) -> str | None:
+        """Why the model's state file cannot be used (unreadable, truncated, edited), or None
+        when it is fine or absent."""
+        return self._read_state(model)[1]
+
+    def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
+        path = self.state_file(model)
         try:
-            data = json.loads((self.meta / "state" / f"{model}.json").read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return {}
-        return data if isinstance(data, dict) else {}
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            return {}, None
+        except OSError as e:
+            return {}, describe(e)
+        except ValueError as e:
+            return {}, f"not JSON: {e}"
+        return (data, None) if well_formed(data) else ({}, "not a state mpc writes")
 
     def save_state(self, model: str, state: dict[str, Any]) -> None:
-        write_json(self.meta / "state" / f"{model}.json", state)
+        write_json(self.state_file(model), state)
+
+    def forget_state(self, model: str) -> None:
+        self.state_file(model).unlink(missing_ok=True)
 
     def save_status(self, status: dict[str, Any]) -> Path:
         path = self.meta / "status.json"
@@ -79,15 +108,78 @@ class Store:
         return path
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def describe(error: OSError) -> str:
+    """An OSError as a user reads it: "Not a directory: '/x/build/.mpc'"."""
+    where = f": '{error.filename}'" if error.filename else ""
+    return f"{error.strerror or error}{where}"
+
+
 def write_json(path: Path, data: Any) -> None:
     """Write `data` as JSON to `path` atomically."""
+    write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def write_text(path: Path, text: str) -> None:
+    """Write `text` to `path` atomically: a reader, or a write that fails half-way, never
+    sees a partial file, and the previous one stays until the new one is complete."""
+    # Named as the user named them, not as mkdir and the temporary file would.
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+    blocking = next((p for p in path.parents if p.exists()), None)
+    if blocking is not None and not blocking.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(blocking))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
+        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes it private; state travels as CI artifacts
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(data, f, indent=2, sort_keys=True)
-            f.write("\n")
+            f.write(text)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def well_formed(state: Any) -> bool:
+    """Whether `state` has the shape `save_state` gives it, so the runner can trust its types."""
+    from mpc.compiler.pipeline.status import diagnostics_from_json
+
+    if not isinstance(state, dict):
+        return False
+    if not all(isinstance(state.get(k, ""), str) for k in ("pre", "fingerprint")):
+        return False
+    if not _deps(state.get("deps", [])):
+        return False
+    stages = state.get("stages", {})
+    if not isinstance(stages, dict) or not all(
+            isinstance(s, dict) and isinstance(s.get("fingerprint", ""), str)
+            and isinstance(s.get("summary", ""), str) and isinstance(s.get("details", {}), dict)
+            for s in stages.values()):
+        return False
+    if "stages" in state and not isinstance(state.get("fingerprint"), str):
+        return False
+    failure = state.get("failure")
+    if failure is None:
+        return True
+    if not (isinstance(failure, dict) and isinstance(failure.get("pre"), str)
+            and isinstance(failure.get("summary"), str) and _deps(failure.get("deps"))
+            and isinstance(failure.get("diagnostics"), list)):
+        return False
+    try:
+        diagnostics_from_json(failure["diagnostics"])
+    except (KeyError, TypeError, ValueError):
+        return False
+    return True
+
+
+def _deps(deps: Any) -> bool:
+    """A list of [path, size, mtime_ns, sha256] entries (fingerprint.dep_entry)."""
+    return isinstance(deps, list) and all(
+        isinstance(d, list) and len(d) == 4 and isinstance(d[0], str) and isinstance(d[3], str)
+        and all(isinstance(n, int) and not isinstance(n, bool) for n in d[1:3]) for d in deps)

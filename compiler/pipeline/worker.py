@@ -34,7 +34,7 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
     try:
         message: dict[str, Any] = run_stages(job, run, cached, recorder, werror)
     except Exception as e:  # a bug in mpc; the runner reports it as one
-        message = {"internal_error": f"{type(e).__name__}: {e}", "traceback": traceback.format_exc()}
+        message = {"internal_error": bug(job, e)}
     conn.send(message)
     conn.close()
 
@@ -48,6 +48,9 @@ def bug(job: StageJob, error: Exception) -> Diagnostic:
 
 def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadRecorder,
                werror: bool) -> dict[str, Any]:
+    """Each stage of `run` in order, skipping one whose needs did not succeed; the message
+    for the runner: each stage's outcome, and the files compile read (`deps`, None when
+    compile did not run here)."""
     outcomes: dict[str, dict[str, Any]] = {}
     deps = None
     for name in run:
@@ -72,5 +75,5 @@ def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadR
                           "details": outcome.details, "seconds": time.perf_counter() - started,
                           "blocked": bool(missing)}
         if name == "compile":
-            deps = [e for p in recorder.inputs() if (e := dep_entry(p)) is not None]
+            deps = [e for p in recorder.inputs() if (e := dep_entry(p, job.root)) is not None]
     return {"outcomes": outcomes, "deps": deps}

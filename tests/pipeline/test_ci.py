@@ -100,3 +100,15 @@ def test_the_documented_parent_pipeline_is_valid(tmp_path: Path) -> None:
     _validate(path, "vendor.gitlab-ci")
     assert yaml.safe_load(path.read_text())["models"]["trigger"]["include"] == [
         {"artifact": "models.yml", "job": "generate"}]
+
+
+@pytest.mark.parametrize(("output", "message"), [
+    ("pipeline.yml/child.yml", "mpc ci: error: cannot write 'pipeline.yml/child.yml' (Not a directory: "
+                               "'pipeline.yml')\n"),
+    ("models", "mpc ci: error: cannot write 'models' (Is a directory: 'models')\n"),
+])
+def test_an_output_that_cannot_be_written_is_an_error(fleet: Path, tmp_path: Path, output: str,
+                                                      message: str) -> None:
+    (fleet.parent / "models").mkdir(exist_ok=True)
+    done = mpc("ci", "gitlab", "pipeline.yml", "-o", output, cwd=fleet.parent)
+    assert (done.returncode, done.stdout, done.stderr) == (1, "", message)

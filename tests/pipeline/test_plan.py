@@ -177,3 +177,33 @@ def test_check_reports_what_only_the_whole_pipeline_shows(tmp_path: Path) -> Non
     assert done.returncode == 1
     assert done.stderr.splitlines()[0] == ("pipeline.yml:3:32: error[E0610]: model definitions 'one.yml' and "
                                            "'two.yml' both build model 'same'")
+
+
+def test_check_of_a_definition_imports_nothing_of_the_pipeline(tmp_path: Path) -> None:
+    """`mpc check` stays fast: the pipeline runner (multiprocessing, rich) loads only for pipelines."""
+    import subprocess
+    import sys
+
+    write(tmp_path / "m.yml", _model("m"))
+    code = ("import sys\nfrom mpc.compiler.cli import main\nstatus = main(['check', sys.argv[1]])\n"
+            "print(status, sorted(m for m in sys.modules if m.startswith('mpc.compiler.pipeline') "
+            "or m in ('multiprocessing', 'rich')))")
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "m.yml")], capture_output=True,
+                          text=True, check=True)
+    assert done.stdout == "0 []\n"
+
+
+def test_check_reports_unusable_entries_once_and_reads_none_of_them(tmp_path: Path) -> None:
+    write(tmp_path / "outside.yml", "not: [a definition\n")  # would be E0102 if it were read
+    write(tmp_path / "p/m.yml", _model("m"))
+    (tmp_path / "p/folder").mkdir()
+    write(tmp_path / "p/pipeline.yml", "pipeline:\n  root: .\n  model_definitions: [m.yml, folder, nope.yml, "
+                                       "../outside.yml]\n")
+    done = mpc("check", "pipeline.yml", cwd=tmp_path / "p")
+    assert done.returncode == 1
+    assert [line for line in done.stderr.splitlines() if "error" in line] == [
+        "pipeline.yml:3:30: error[E0601]: model definition 'folder' is a folder, not a file",
+        "pipeline.yml:3:38: error[E0601]: model definition 'nope.yml' does not exist",
+        f"pipeline.yml:3:48: error[E0641]: model definition '../outside.yml' is outside the workspace root "
+        f"'{tmp_path / 'p'}'",
+        "3 errors in 1 file"]

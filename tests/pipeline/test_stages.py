@@ -98,6 +98,16 @@ def test_unchanged_stages_are_cached_and_a_changed_setting_reruns_the_later_stag
         str(pipeline.parent / "build/good"), "cached", "2 files, 0 meshes", "@robots")
 
 
+def test_a_model_added_to_the_pipeline_does_not_rerun_the_others_stages(pipeline: Path) -> None:
+    _run(pipeline)
+    (pipeline.parent / "new.yml").write_text(_model("new"))
+    pipeline.write_text(pipeline.read_text().replace("na.yml]", "na.yml, new.yml]"))
+    again = _run(pipeline)
+    states = {name: {s: r.state for s, r in m.stages.items()} for name, m in again.models.items()}
+    assert states["good"] == {"compile": "cached", "test": "cached"}
+    assert states["new"] == {"compile": "ok", "test": "ok"}
+
+
 def test_verify_counts_a_stage_that_skipped_by_its_own_choice_unless_allowed(pipeline: Path) -> None:
     pipeline.write_text(pipeline.read_text().replace("bad.yml, ", ""))
     status = _run(pipeline)
@@ -106,6 +116,11 @@ def test_verify_counts_a_stage_that_skipped_by_its_own_choice_unless_allowed(pip
     assert status.exit_status() == 0
     assert status.exit_status(verify=True) == 1
     assert status.exit_status(verify=True, allow_na=True) == 0
+    recorded = json.loads((pipeline.parent / "build/.mpc/status.json").read_text())["exit_status"]
+    assert recorded == 0
+    _run(pipeline, verify=True)
+    recorded = json.loads((pipeline.parent / "build/.mpc/status.json").read_text())["exit_status"]
+    assert recorded == 1  # status.json says what `mpc run --verify` returned
 
 
 def failing_stage(job: StageJob) -> StageOutcome:
