@@ -96,10 +96,15 @@ def _span(file: str, node: Node) -> Span:
 class _Builder:
     def __init__(self, doc: Document, sink: Sink) -> None:
         self.doc, self.sink = doc, sink
+        self.unusable = False  # a value no later step can take (a NUL character)
 
     def scalar(self, node: ScalarNode, path: Path_) -> Any:
         v, tag = node.value, node.tag
         if tag == "tag:yaml.org,2002:str":
+            if "\0" in v:
+                self.sink.error(_span(self.doc.file, node), "E0106", "a NUL character in a string: "
+                                "no file, link, joint or other name can hold one")
+                self.unusable = True
             return v
         if tag == "tag:yaml.org,2002:null":
             return None
@@ -184,8 +189,9 @@ def loads(text: str, file: str, sink: Sink) -> Document | None:
         sink.error(Span.of_file(file), "E0104", f"'{file}' is empty")
         return None
     doc = Document(file, None)
-    doc.data = _Builder(doc, sink).build(node, ())
-    return doc
+    builder = _Builder(doc, sink)
+    doc.data = builder.build(node, ())
+    return None if builder.unusable else doc
 
 
 def source_line(file: str, line: int) -> str | None:
