@@ -43,11 +43,14 @@ def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: 
 
 
 class ForgeAdapter(Protocol):
-    """How a forge is told about a merge request: options on the push, a call after it."""
+    """How a forge is told about a merge request: options on the push, a check before it
+    (raising DeployError leaves the remote untouched), a call after it."""
 
     name: str
 
     def push_options(self, request: MergeRequest) -> list[str]: ...
+
+    def before_push(self, request: MergeRequest) -> None: ...
 
     def after_push(self, request: MergeRequest, push_output: str) -> str | None: ...
 
@@ -60,11 +63,14 @@ class NoForge:
     def push_options(self, request: MergeRequest) -> list[str]:
         return []
 
+    def before_push(self, request: MergeRequest) -> None:
+        pass
+
     def after_push(self, request: MergeRequest, push_output: str) -> str | None:
         return None
 
 
-class GitLab:
+class GitLab(NoForge):
     """GitLab's push options. A push option is one line, so the description's newlines
     become `<br/>` (GitLab renders it as Markdown); it is cut at MAX_OPTION_BYTES."""
 
@@ -78,7 +84,7 @@ class GitLab:
         options = ["merge_request.create", f"merge_request.target={request.target}",
                    f"merge_request.title={_one_line(request.title)}",
                    f"merge_request.description={description}"]
-        options += [f"merge_request.assign={user.lstrip('@')}" for user in request.mention]
+        options += [f"merge_request.assign={_one_line(user.lstrip('@'))}" for user in request.mention]
         return options
 
     def after_push(self, request: MergeRequest, push_output: str) -> str | None:

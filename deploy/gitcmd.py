@@ -14,7 +14,7 @@ from pathlib import Path
 
 EMPTY_TREE = "4b825dc642cb6eb9a060e54bf8d69288fbee4904"
 # user:password@ (or token@) in URLs that git or the forge echo back.
-_URL_CREDENTIALS = re.compile(r"(?P<scheme>[a-zA-Z][a-zA-Z0-9+.-]*://)[^/@\s]+@")
+_URL_CREDENTIALS = re.compile(r"(?P<scheme>[a-zA-Z][a-zA-Z0-9+.-]*://)(?P<user>[^/@\s:]*)(?::[^/@\s]*)?@")
 # Environment variables whose values are secrets wherever they appear.
 SECRET_VARIABLES = ("GITHUB_TOKEN", "GH_TOKEN", "MPC_GITHUB_TOKEN", "GITLAB_TOKEN", "CI_JOB_TOKEN",
                     "SYSTEM_ACCESSTOKEN")
@@ -37,6 +37,17 @@ def scrub(text: str) -> str:
         if value and len(value) >= 4:
             text = text.replace(value, "***")
     return text
+
+
+def without_credentials(url: str) -> str:
+    """`url` without its `user:password@` (or `token@`) part: the address to write into a
+    repository (`.gitmodules`) or to compare clones by, since CI tokens change from job to job."""
+    def keep_ssh_user(m: re.Match[str]) -> str:
+        # ssh://git@host/x names the account, not a secret; any password goes all the same
+        ssh = "ssh" in m.group("scheme").lower()
+        return m.group("scheme") + (f"{m.group('user')}@" if ssh and m.group("user") else "")
+
+    return _URL_CREDENTIALS.sub(keep_ssh_user, url)
 
 
 def git_environment() -> dict[str, str]:

@@ -9,11 +9,10 @@ the model repository.
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path, PurePosixPath
 
-from mpc.deploy import lfs
-from mpc.deploy.gitcmd import DeployError
+from mpc.deploy import content, lfs
+from mpc.deploy.gitcmd import DeployError, without_credentials
 from mpc.deploy.plan import Plan, lfs_patterns
 from mpc.deploy.repository import Clone, locked, open_clone, publish
 from mpc.deploy.settings import DeploySettings, join_remote
@@ -54,16 +53,13 @@ def _deploy_one(source: Path, url: str, folder: Path, mesh_type: str, path: str,
     patterns = lfs_patterns(plan.lfs_patterns, uses_lfs) if uses_lfs else ()
 
     def fill(c: Clone) -> None:
-        for file in sorted(source.rglob("*")):
-            if file.is_file():
-                target = c.folder / file.relative_to(source)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(file, target)
+        for rel in content.build_entries(source):
+            content.copy_entry(source, rel, content.safe_path(c.folder, rel))
         lfs.track(c.git, patterns)
         c.git("add", "-A")
 
-    published = publish(clone, branch, None, fill, message, [], settings.dry_run)
+    published = publish(clone, branch, None, fill, message, settings.dry_run)
     sha = published.sha or clone.remote_sha(branch)
     if sha is None:  # a dry run against an empty mesh repository: nothing to link yet
         return None
-    return Pinned(f"meshes/{mesh_type}", url, url, branch, sha, clone.folder)
+    return Pinned(f"meshes/{mesh_type}", without_credentials(url), url, branch, sha, clone.folder)

@@ -14,7 +14,7 @@ import tarfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from mpc.deploy.gitcmd import DeployError, Git
+from mpc.deploy.gitcmd import DeployError, Git, without_credentials
 from mpc.deploy.repository import locked
 from mpc.ir.program import DeploySubmodule
 
@@ -57,7 +57,7 @@ def pin(sub: DeploySubmodule, superproject: str, default_branch: str, workdir: P
     branch = sub.branch or default_branch
     with locked(cache):
         sha = _find(sub, fetched_from, branch, cache)
-    return Pinned(sub.target, sub.repo, fetched_from, branch, sha, cache)
+    return Pinned(sub.target, without_credentials(sub.repo), fetched_from, branch, sha, cache)
 
 
 def _find(sub: DeploySubmodule, fetched_from: str, branch: str, cache: Path) -> str:
@@ -66,7 +66,7 @@ def _find(sub: DeploySubmodule, fetched_from: str, branch: str, cache: Path) -> 
         cache.mkdir(parents=True)
         Git(cache)("init", "-q", "--bare", code="E0807")
     git = Git(cache)
-    git("fetch", "-q", "--prune", fetched_from, "+refs/heads/*:refs/heads/*", code="E0807")
+    git("fetch", "-q", "--prune", "--", fetched_from, "+refs/heads/*:refs/heads/*", code="E0807")
     if sub.commit:
         ref = f"{sub.commit}^{{commit}}"
         what = f"commit '{sub.commit}'"
