@@ -13,6 +13,8 @@ import re
 from dataclasses import dataclass
 from typing import Protocol
 
+from mpc.deploy.gitcmd import scrub
+
 # A push option travels as one pkt-line (at most 65516 bytes); keep well below.
 FORGES = ("gitlab", "github", "none")  # how merge requests are made (a pipeline's `forge`)
 MAX_OPTION_BYTES = 60000
@@ -32,14 +34,15 @@ class MergeRequest:
 
 
 def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: str) -> str:
-    """The description: the definition's text, the mentions, the test protocol, the footer."""
+    """The description: the definition's text, the mentions, the test protocol, the footer;
+    without credentials, should the protocol quote an address or a token."""
     parts = [text.strip()]
     if mention:
         parts.append(" ".join(mention))
     if protocol and protocol.strip():
         parts.append(protocol.strip())
     parts.append(footer)
-    return "\n\n".join(parts) + "\n"
+    return scrub("\n\n".join(parts) + "\n")
 
 
 class ForgeAdapter(Protocol):

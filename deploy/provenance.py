@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
+from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.ir.program import Program
 
 
@@ -74,7 +75,7 @@ def provenance(program: Program, definition_repo: Path | None, protocol: str | N
     for name, inp in sorted(program.inputs.items()):
         if inp.repo is not None:
             rev = inp.repo.commit or (f"branch {inp.repo.branch}" if inp.repo.branch else "default branch")
-            inputs.append(f"{name}: {inp.repo.git} {rev} {inp.repo.model_in_repo}")
+            inputs.append(f"{name}: {without_credentials(inp.repo.git)} {rev} {inp.repo.model_in_repo}")
             continue
         if inp.path is None:
             inputs.append(f"{name}: {inp.kind}")
@@ -115,7 +116,7 @@ def commit_message(program: Program, prov: Provenance) -> str:
     if prov.inputs:
         lines.append("Input models:")
         lines.extend(f"  {line}" for line in prov.inputs)
-    return "\n".join(lines) + "\n"
+    return scrub("\n".join(lines) + "\n")
 
 
 def footer(prov: Provenance) -> str:
