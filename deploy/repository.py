@@ -63,7 +63,7 @@ def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
             raise DeployError("E0803", f"'{folder}' exists and is not a git clone; mpc clones into "
                                        "folders of its own (remove it or choose another workdir)")
         git = Git(folder)
-        current = git("remote", "get-url", remote, check=False)
+        current = git("config", "--get", f"remote.{remote}.url", check=False)  # as written, no insteadOf
         if without_credentials(current) != without_credentials(url):
             raise DeployError("E0803", f"'{folder}' is a clone of '{current or 'nothing'}', not of '{url}'")
         if current != url:  # the same repository with new credentials (CI tokens change every job)
