@@ -42,7 +42,7 @@ def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: 
     if protocol and protocol.strip():
         parts.append(protocol.strip())
     parts.append(footer)
-    return scrub("\n\n".join(parts) + "\n")
+    return scrub("\n\n".join(parts) + "\n").replace("\0", "")
 
 
 class ForgeAdapter(Protocol):
@@ -96,7 +96,7 @@ class GitLab(NoForge):
 
 
 def _one_line(text: str) -> str:
-    return " ".join(text.split())
+    return " ".join(text.replace("\0", "").split())
 
 
 def adapter(name: str, github_api: str) -> ForgeAdapter:

@@ -63,11 +63,14 @@ class Git:
 
         self.folder = folder
         self._git = git.Git(str(folder))
-        self._git.update_environment(**git_environment())
+        # Never look for a repository above `folder`: should its .git be missing, git must
+        # fail rather than work on a repository around the workdir (the definitions', say).
+        self._git.update_environment(**git_environment(), GIT_CEILING_DIRECTORIES=str(folder.parent))
 
     def __call__(self, *args: str, code: str = "E0803", check: bool = True) -> str:
         import git
 
+        _check_arguments(args, code)
         try:
             return self._git.execute(["git", *args], with_extended_output=False, strip_newline_in_stdout=True)
         except git.GitCommandError as e:
@@ -88,6 +91,15 @@ class Git:
 
     def result(self, *args: str) -> tuple[int, str, str]:
         """(status, stdout, stderr) of a git command that may fail (push)."""
+        _check_arguments(args, "E0803")
         status, out, err = self._git.execute(["git", *args], with_extended_output=True,
                                              with_exceptions=False)
         return status, out, err
+
+
+def _check_arguments(args: tuple[str, ...], code: str) -> None:
+    """A NUL byte cannot be passed to a program (a protocol or title from YAML may hold one)."""
+    for arg in args:
+        if "\0" in arg:
+            raise DeployError(code, f"git {args[0]} cannot take an argument with a NUL byte "
+                                    f"(at offset {arg.index(chr(0))} of '{arg[:40]}…')")

@@ -9,6 +9,7 @@ the model repository.
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path, PurePosixPath
 
 from mpc.deploy import content, lfs
@@ -25,6 +26,9 @@ def deploy_meshes(built: Path, modelname: str, settings: DeploySettings, plan: P
     pins = []
     branch = settings.mesh_branch or plan.base
     for mesh_type, path in sorted(settings.meshes.items()):
+        if not _plain_name(mesh_type):
+            raise DeployError("E0801", f"central mesh type '{mesh_type}' of the pipeline's meshes is not a "
+                                       "folder name of the build's meshes/")
         source = built / "meshes" / mesh_type
         if not source.is_dir():
             continue
@@ -32,13 +36,18 @@ def deploy_meshes(built: Path, modelname: str, settings: DeploySettings, plan: P
             raise DeployError("E0802", "central_meshes needs the pipeline's remote_base to find the "
                                        "mesh repositories")
         url = join_remote(settings.remote_base, path)
-        folder = workdir / ".meshes" / PurePosixPath(path).as_posix()
+        # one folder per repository, named by its address: a path in `meshes` never leads out
+        folder = workdir / ".meshes" / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
         with locked(folder):
             pin = _deploy_one(source, url, folder, mesh_type, path, branch, settings, plan,
                               f"[mpc] Meshes ({mesh_type}) of {modelname}\n{_body(message)}")
         if pin is not None:
             pins.append(pin)
     return pins
+
+
+def _plain_name(name: str) -> bool:
+    return bool(name) and not name.startswith(".") and "/" not in name and "\\" not in name
 
 
 def _body(message: str) -> str:

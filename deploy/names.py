@@ -13,7 +13,7 @@ from mpc.deploy.gitcmd import DeployError, git_environment
 
 def check_branch(name: str, what: str) -> None:
     """Raise E0840 unless git accepts `name` as a branch name; `what` says where it came from."""
-    if name and not name.startswith("-") and name != "HEAD":
+    if name and not name.startswith("-") and name != "HEAD" and name.isprintable():
         run = subprocess.run(["git", "check-ref-format", "--branch", name], capture_output=True,
                              text=True, env={**os.environ, **git_environment()})
         if run.returncode == 0 and run.stdout.strip() == name:

@@ -56,12 +56,15 @@ def locked(folder: Path) -> Iterator[None]:
 
 
 def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
-    """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist."""
+    """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist.
+    The caller holds the folder's lock (`locked`), so a `.git/index.lock` left there is the
+    leftover of a run that was stopped, and goes."""
     existed = folder.exists()
     if existed:
-        if not (folder / ".git").exists():
+        if not (folder / ".git").is_dir():
             raise DeployError("E0803", f"'{folder}' exists and is not a git clone; mpc clones into "
                                        "folders of its own (remove it or choose another workdir)")
+        (folder / ".git" / "index.lock").unlink(missing_ok=True)
         git = Git(folder)
         current = git("config", "--get", f"remote.{remote}.url", check=False)  # as written, no insteadOf
         if without_credentials(current) != without_credentials(url):

@@ -167,7 +167,8 @@ def test_no_token(model: Model, server: Server, github: FakeGitHub, monkeypatch:
 @pytest.mark.parametrize(("status", "body", "said"), [
     (401, {"message": "Bad credentials"}, "GitHub refused GET /repos/acme/arm-model/pulls: 401 Unauthorized: "
                                           "Bad credentials"),
-    (404, {"message": "Not Found"}, "GitHub refused GET /repos/acme/arm-model/pulls: 404 Not Found: Not Found"),
+    (404, {"message": "Not Found"}, "GitHub refused GET /repos/acme/arm-model/pulls: 404 Not Found: "
+                                    "Not Found"),
     (500, "<html>oops</html>", "GitHub refused GET /repos/acme/arm-model/pulls: 500 Internal Server Error"),
     (200, {"message": "not a list"}, "GitHub answered GET /repos/acme/arm-model/pulls with something that "
                                      "is not a list of pull requests"),
@@ -207,6 +208,6 @@ def test_an_api_that_is_not_there(model: Model, server: Server, monkeypatch: pyt
     run = mpc("deploy", model.definition, "--built", model.built, "--remote", server.url,
               "--forge", "github", "--workdir", model.folder.parent / "work")
     assert run.returncode == 1
-    assert ("error[E0805]: cannot reach GitHub's API at http://127.0.0.1:9 (GET /repos/acme/arm-model/pulls): "
-            "[Errno 111] Connection refused") in run.stderr
+    assert ("error[E0805]: cannot reach GitHub's API at http://127.0.0.1:9 (GET "
+            "/repos/acme/arm-model/pulls): [Errno 111] Connection refused") in run.stderr
     assert server.branches() == {}

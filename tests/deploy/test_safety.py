@@ -14,10 +14,14 @@ from pathlib import Path
 import pytest
 
 from mpc.compiler.diagnostics import Sink
-from mpc.deploy import deploy_model
+from mpc.deploy import DeploySettings, deploy_model
 from tests.compiler.test_cli import mpc
 from tests.conftest import Diags
 from tests.deploy.conftest import Model, Server, definition_text, git, heavier, make_server
+
+
+def _plain(model: Model, server: Server) -> DeploySettings:
+    return model.settings(remote=server.url, forge="none")
 
 
 def _push_symlink(server: Server, rel: str, target: str, tmp_path: Path) -> None:
@@ -37,7 +41,7 @@ def test_a_link_out_of_the_build_is_refused(model: Model, server: Server, tmp_pa
     secret = tmp_path / "secret.txt"
     secret.write_text("private key\n")
     (model.built / "urdf" / "stolen.urdf").symlink_to(secret)
-    result = deploy_model(program, model.built, model.settings(remote=server.url, forge="none"), diags)
+    result = deploy_model(program, model.built, _plain(model, server), diags)
     assert not result.ok and server.branches() == {}
     assert diags.take_error("E0844").message == (
         f"the build's 'urdf/stolen.urdf' is a symbolic link to '{secret}', outside the build; mpc deploys "
@@ -47,7 +51,7 @@ def test_a_link_out_of_the_build_is_refused(model: Model, server: Server, tmp_pa
 def test_an_absolute_link_inside_the_build_becomes_relative(model: Model, server: Server) -> None:
     program = model.compile()
     (model.built / "urdf" / "link.urdf").symlink_to(model.built / "urdf" / "arm.urdf")
-    result = deploy_model(program, model.built, model.settings(remote=server.url, forge="none"), Sink())
+    result = deploy_model(program, model.built, _plain(model, server), Sink())
     assert result.ok
     assert git(server.path, "ls-tree", "master", "urdf/link.urdf").split()[0] == "120000"
     assert server.show("master", "urdf/link.urdf") == "arm.urdf"
@@ -59,11 +63,12 @@ def test_git_metadata_in_the_build_is_left_out(model: Model, server: Server, dia
     git(nested, "init", "-q")  # meshes/stl/.git: would become an embedded repository
     (model.built / "urdf" / ".git").write_text("gitdir: /somewhere/else\n")
     (model.built / ".gitmodules").write_text('[submodule "x"]\n\tpath = x\n\turl = https://evil.example/x\n')
-    result = deploy_model(program, model.built, model.settings(remote=server.url, forge="none"), diags)
+    result = deploy_model(program, model.built, _plain(model, server), diags)
     assert result.ok
     for entry in (".gitmodules", "meshes/stl/.git", "urdf/.git"):
         assert diags.take("W0840", diags.diagnostics[0].severity).message == (
-            f"the build's '{entry}' is not deployed: mpc writes no git metadata from a build into a repository")
+            f"the build's '{entry}' is not deployed: mpc writes no git metadata from a build into a "
+            "repository")
     tree = git(server.path, "ls-tree", "-r", "master").splitlines()
     assert sorted(line.split("\t")[1] for line in tree) == [
         "README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf", "urdf/arm.urdf"]
@@ -80,7 +85,7 @@ def test_a_submodule_target_behind_a_link_of_the_remote(model: Model, server: Se
     model.definition.write_text(definition_text(
         "  deployment:\n    submodules:\n      - {repo: ../arm-lua.git, target: ext/lua}\n"))
     before = server.branches()
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), diags)
+    result = deploy_model(model.compile(), model.built, _plain(model, server), diags)
     assert not result.ok and server.branches() == before
     assert diags.take_error("E0804").message == ("'ext/lua' would be written outside the repository "
                                                  "(through a symbolic link in it)")
@@ -96,7 +101,7 @@ def test_kept_files_and_manifest_behind_links_of_the_remote(model: Model, server
     _push_symlink(server, "manifest.xml", str(outside / "manifest.xml"), tmp_path)
     model.definition.write_text(definition_text(
         "  deployment:\n    add_manifest: true\n    keep_files: [submechanisms/*.lua, manifest.xml]\n"))
-    result = deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
+    result = deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert result.ok
     assert sorted(p.name for p in outside.iterdir()) == ["notes.lua"]  # no manifest written through the link
     assert (outside / "notes.lua").read_text() == "-- outside\n"
@@ -115,12 +120,14 @@ def test_a_moved_remote_that_conflicts(model: Model, server: Server, tmp_path: P
     git(tmp_path, "clone", "-q", server.url, str(other))
     hook = clone / ".git" / "hooks" / "pre-push"
     hook.write_text(f"#!/bin/sh\n[ -e '{marker}' ] && exit 0\ntouch '{marker}'\ncd '{other}' && "
-                    "echo '<robot name=\"theirs\"/>' > urdf/arm.urdf && echo '-- 2' > submechanisms/knee.lua && "
+                    "echo '<robot name=\"theirs\"/>' > urdf/arm.urdf && "
+                    "echo '-- 2' > submechanisms/knee.lua && "
                     "git commit -q -am 'theirs' && git push -q origin HEAD:master\n")
     hook.chmod(0o755)
     result = deploy_model(model.compile(heavier()), model.built, settings, Sink())
     assert result.ok and result.pushed
-    assert server.log("master") == ["[mpc] Update arm-model", "theirs", "[mpc] Update arm-model", "hand-written"]
+    assert server.log("master") == ["[mpc] Update arm-model", "theirs", "[mpc] Update arm-model",
+                                    "hand-written"]
     assert server.log("master", "%H")[2] == first.commit
     assert '<mass value="12"/>' in server.show("master", "urdf/arm.urdf")
     assert server.show("master", "submechanisms/knee.lua") == "-- 2"
@@ -146,7 +153,8 @@ def test_credentials_appear_nowhere(model: Model, server: Server, tmp_path: Path
     lua.commit_files({"knee.lua": "--\n"}, "one")
     mirror = make_server(tmp_path, "arm-mirror")
     pipeline = model.folder / "pipeline.yml"
-    pipeline.write_text(f"pipeline:\n  root: .\n  model_definitions: [arm_model.yml]\n  remote_base: {base}\n")
+    pipeline.write_text(f"pipeline:\n  root: .\n  model_definitions: [arm_model.yml]\n"
+                        f"  remote_base: {base}\n")
     model.definition.write_text(definition_text(f"""\
   deployment:
     mr_target_branch: develop
@@ -159,7 +167,8 @@ def test_credentials_appear_nowhere(model: Model, server: Server, tmp_path: Path
     protocol = tmp_path / "protocol.md"
     protocol.write_text(f"cloned {base}arm-model.git with another-secret-value\n")
     (server.path.parent / "arm-model").symlink_to(server.path)  # remote_base + modelname, no .git
-    run = mpc("deploy", model.definition, "--built", model.built, "--pipeline", pipeline, "--protocol", protocol)
+    run = mpc("deploy", model.definition, "--built", model.built, "--pipeline", pipeline,
+              "--protocol", protocol)
     assert run.returncode == 0, run.stderr
     staged = mpc("run", pipeline, "--stages", "compile,deploy", "-j", "1")
     status = (model.folder / "build" / ".mpc" / "status.json").read_text()
@@ -204,3 +213,21 @@ def test_deployments_at_the_same_time_share_the_workdir(model: Model, server: Se
     assert sum("nothing changed" in out for _, out, _ in outcomes) == 2
     for repo in (server, other):
         assert "lua" in repo.files() and "urdf/arm.urdf" in repo.files()
+
+
+def test_a_stale_index_lock_of_a_stopped_run_goes(model: Model, server: Server) -> None:
+    settings = model.settings(remote=server.url, forge="none")
+    deploy_model(model.compile(), model.built, settings, Sink())
+    (settings.workdir / "arm-model" / ".git" / "index.lock").write_text("")
+    result = deploy_model(model.compile(heavier()), model.built, settings, Sink())
+    assert result.ok and result.pushed
+
+
+def test_a_central_mesh_type_that_is_not_a_folder_name(model: Model, server: Server, tmp_path: Path,
+                                                       diags: Diags) -> None:
+    settings = model.settings(remote=server.url, remote_base=str(tmp_path / "server"), central_meshes=True,
+                              meshes={"../../definitions": "meshes/x"}, forge="none")
+    result = deploy_model(model.compile(), model.built, settings, diags)
+    assert not result.ok and server.branches() == {}
+    assert diags.take_error("E0801").message == ("central mesh type '../../definitions' of the pipeline's "
+                                                 "meshes is not a folder name of the build's meshes/")
