@@ -51,8 +51,9 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
         sink.error(span, e.code, e.message)
         result.ok = False
     except OSError as e:
+        where = f": '{e.filename}'" if e.filename else ""
         sink.error(span, "E0843", scrub(f"deploying '{program.modelname}' failed on a file: "
-                                        f"{e.strerror or e}: '{e.filename}'"))
+                                        f"{e.strerror or e}{where}"))
         result.ok = False
     return result
 
@@ -70,6 +71,7 @@ def _checked_inputs(program: Program, built: Path, settings: DeploySettings) -> 
                           "has no remote_base (or give --remote)")
     names.check_address(remote, "the model repository's address")
     names.check_folder_name(program.modelname)
+    names.check_remote_name(settings.remote_name)
     for what, branch in (("success branch", settings.success_branch),
                          ("failure branch", settings.failure_branch),
                          ("production branch", settings.production_branch),

@@ -6,6 +6,7 @@ repository addresses (never taken for an option) and the modelname (one folder o
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 
 from mpc.deploy.gitcmd import DeployError, git_environment
@@ -19,6 +20,12 @@ def check_branch(name: str, what: str) -> None:
         if run.returncode == 0 and run.stdout.strip() == name:
             return
     raise DeployError("E0840", f"{what} '{name}' is not a valid git branch name")
+
+
+def check_remote_name(name: str) -> None:
+    """Raise E0840 for a remote name (GIT_REMOTE_NAME) git would not take, or take for an option."""
+    if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9._-]*", name) or name.endswith((".", ".lock")):
+        raise DeployError("E0840", f"remote name '{name}' (GIT_REMOTE_NAME) is not a valid git remote name")
 
 
 def check_address(url: str, what: str) -> None:

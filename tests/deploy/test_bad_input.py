@@ -156,3 +156,31 @@ def test_a_workdir_clone_of_the_same_repository_with_another_token(model: Model,
     _fails(run, "E0803", "git fetch failed in")  # not "a clone of another repository"
     assert "token" not in run.stderr
     assert git(work, "remote", "get-url", "origin") == "http://ci:new-token-2@127.0.0.1:9/acme/arm.git"
+
+
+def test_a_remote_name_git_refuses(model: Model, used_server: Server,
+                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GIT_REMOTE_NAME", "-x")
+    model.compile()
+    _fails(_deploy(model, "--remote", used_server.url), "E0840",
+           "remote name '-x' (GIT_REMOTE_NAME) is not a valid git remote name")
+    assert used_server.pushes() == []
+
+
+def test_a_gitattributes_link_of_the_remote_is_not_written_through(model: Model, used_server: Server,
+                                                                   tmp_path: Path) -> None:
+    outside = tmp_path / "attributes"
+    outside.write_text("")
+    work = tmp_path / "linker"
+    git(tmp_path, "clone", "-q", used_server.url, str(work))
+    (work / ".gitattributes").symlink_to(outside)
+    git(work, "add", "-A")
+    git(work, "commit", "-q", "-m", "link")
+    git(work, "push", "-q", "origin", "HEAD:master")
+    (used_server.path / "pushes.jsonl").unlink()
+    model.definition.write_text(definition_text("  add_lfs_track: [stl]\n  deployment:\n"
+                                                "    keep_files: [.gitattributes]\n"))
+    model.compile()
+    _fails(_deploy(model, "--remote", used_server.url), "E0804",
+           "'.gitattributes' is a symbolic link; git LFS would write through it")
+    assert outside.read_text() == "" and used_server.pushes() == []
