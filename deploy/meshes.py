@@ -9,13 +9,12 @@ the model repository.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path, PurePosixPath
 
 from mpc.deploy import content, lfs
 from mpc.deploy.gitcmd import DeployError, without_credentials
 from mpc.deploy.plan import Plan, lfs_patterns
-from mpc.deploy.repository import Clone, locked, open_clone, publish
+from mpc.deploy.repository import Clone, folder_for, locked, open_clone, publish
 from mpc.deploy.settings import DeploySettings, join_remote
 from mpc.deploy.submodules import Pinned
 
@@ -36,8 +35,7 @@ def deploy_meshes(built: Path, modelname: str, settings: DeploySettings, plan: P
             raise DeployError("E0802", "central_meshes needs the pipeline's remote_base to find the "
                                        "mesh repositories")
         url = join_remote(settings.remote_base, path)
-        # one folder per repository, named by its address: a path in `meshes` never leads out
-        folder = workdir / ".meshes" / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
+        folder = folder_for(workdir / ".meshes", url)
         with locked(folder):
             pin = _deploy_one(source, url, folder, mesh_type, path, branch, settings, plan,
                               f"[mpc] Meshes ({mesh_type}) of {modelname}\n{_body(message)}")

@@ -10,6 +10,7 @@ stops before the commit and returns the diff stat the push would carry.
 from __future__ import annotations
 
 import fcntl
+import hashlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -53,6 +54,12 @@ def locked(folder: Path) -> Iterator[None]:
             yield
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def folder_for(parent: Path, url: str) -> Path:
+    """A folder of `parent` named by a repository's address (without credentials, so that a CI
+    job's new token finds the same folder); no address leads out of `parent`."""
+    return parent / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
 
 
 def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:

@@ -8,14 +8,13 @@ submodule is ever checked out inside the model repository.
 
 from __future__ import annotations
 
-import hashlib
 import io
 import tarfile
 from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.deploy.gitcmd import DeployError, Git, without_credentials
-from mpc.deploy.repository import locked
+from mpc.deploy.repository import folder_for, locked
 from mpc.ir.program import DeploySubmodule
 
 
@@ -53,7 +52,7 @@ def absolute_url(url: str, superproject: str) -> str:
 def pin(sub: DeploySubmodule, superproject: str, default_branch: str, workdir: Path) -> Pinned:
     """Fetch the submodule and find its commit."""
     fetched_from = absolute_url(sub.repo, superproject)
-    cache = workdir / ".submodules" / hashlib.sha256(fetched_from.encode()).hexdigest()[:16]
+    cache = folder_for(workdir / ".submodules", fetched_from)
     branch = sub.branch or default_branch
     with locked(cache):
         sha = _find(sub, fetched_from, branch, cache)
