@@ -30,12 +30,14 @@ def _repository_state(path: Path) -> tuple[str, bool, str] | None:
 
     try:
         repo = git.Repo(path if path.is_dir() else path.parent, search_parent_directories=True)
+        if repo.working_tree_dir is None:  # a bare repository holds no definitions
+            return None
         commit = repo.head.commit.hexsha
-    except (git.InvalidGitRepositoryError, git.NoSuchPathError, ValueError):
+        top = Path(repo.working_tree_dir).resolve()
+        rel = path.resolve().relative_to(top).as_posix() if path.resolve().is_relative_to(top) else str(path)
+        dirty = repo.is_dirty(untracked_files=True, path=None if rel == "." else rel)
+    except (git.GitError, ValueError, OSError):  # no repository, no commit yet, or git failing
         return None
-    top = Path(repo.working_tree_dir or ".").resolve()
-    rel = path.resolve().relative_to(top).as_posix() if path.resolve().is_relative_to(top) else str(path)
-    dirty = repo.is_dirty(untracked_files=True, path=None if rel == "." else rel)
     return commit, dirty, rel
 
 

@@ -20,7 +20,8 @@ from mpc.ir.program import DeploySubmodule
 
 @dataclass(frozen=True)
 class Pinned:
-    """A submodule resolved: written url (as in the definition), fetched url, commit, cache."""
+    """A submodule resolved: the url written into .gitmodules (as in the definition, without
+    credentials), the url fetched from (absolute), its branch, its commit, its cache."""
 
     target: str
     url: str
