@@ -33,6 +33,14 @@ class MergeRequest:
     mention: tuple[str, ...]
 
 
+def merge_request(remote: str, source: str, target: str, title: str, text: str, mention: tuple[str, ...],
+                  protocol: str | None, footer: str) -> MergeRequest:
+    """The request from `source` into `target`, its description made by `describe`; the title
+    without credentials too."""
+    return MergeRequest(remote, source, target, scrub(title), describe(text, mention, protocol, footer),
+                        mention)
+
+
 def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: str) -> str:
     """The description: the definition's text, the mentions, the test protocol, the footer;
     without credentials, should the protocol quote an address or a token."""

@@ -9,7 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from mpc.deploy import content, lfs, submodules
-from mpc.deploy.forges import MergeRequest, adapter, describe
+from mpc.deploy.forges import adapter, merge_request
 from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.deploy.names import check_address
 from mpc.deploy.plan import Plan
@@ -50,8 +50,8 @@ def deploy_mirror(source: Clone, plan: Plan, pinned: list[submodules.Pinned], se
     target = mirror.mr_target or clone.default_branch
     if mirror.merge_request and target != mirror.branch and forge.name != "none":
         mention = mirror.mr_mention if mirror.mr_mention is not None else plan.mr_mention
-        request = MergeRequest(clone.url, mirror.branch, target, mirror.mr_title or plan.mr_title,
-                               describe(plan.mr_description, mention, protocol, footer(prov)), mention)
+        request = merge_request(clone.url, mirror.branch, target, mirror.mr_title or plan.mr_title,
+                                plan.mr_description, mention, protocol, footer(prov))
     published = publish(clone, mirror.branch, clone.default_branch, fill, message, settings.dry_run,
                         forge, request)
     record_push(result, published, forge, request)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
 from mpc.deploy import content, lfs, names, submodules
-from mpc.deploy.forges import MergeRequest, adapter, describe
+from mpc.deploy.forges import adapter, merge_request
 from mpc.deploy.gitcmd import DeployError, scrub
 from mpc.deploy.plan import Plan, check_plan_branches, do_not_deploy, make_plan
 from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
@@ -110,9 +110,8 @@ def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings:
     forge = adapter(settings.forge, settings.github_api)
     request = None
     if plan.mr_target is not None and forge.name != "none":
-        request = MergeRequest(clone.url, plan.branch, plan.mr_target, plan.mr_title,
-                               describe(plan.mr_description, plan.mr_mention, protocol, footer(prov)),
-                               plan.mr_mention)
+        request = merge_request(clone.url, plan.branch, plan.mr_target, plan.mr_title, plan.mr_description,
+                                plan.mr_mention, protocol, footer(prov))
 
     def fill(c: Clone) -> None:
         fill_model(c, built, program, plan, prov, pinned)

@@ -158,6 +158,7 @@ def test_credentials_appear_nowhere(model: Model, server: Server, tmp_path: Path
     model.definition.write_text(definition_text(f"""\
   deployment:
     mr_target_branch: develop
+    mr_title: "Update from {base}"
     submodules:
       - {{repo: ../arm-lua.git, target: lua}}
       - {{repo: "{base}arm-lua.git", target: lua2}}
@@ -180,6 +181,8 @@ def test_credentials_appear_nowhere(model: Model, server: Server, tmp_path: Path
         texts.append(repo.show("master", ".gitmodules"))
     for text in texts:
         assert TOKEN not in text and "another-secret-value" not in text
+    title = "merge_request.title=Update from https://***@git.example.org/acme/"
+    assert title in server.pushes()[0]["options"]
     assert "deployer" not in server.show("master", ".gitmodules")
     assert "https://git.example.org/acme/arm-mirror.git" not in server.show("master", ".gitmodules")
     assert "url = https://git.example.org/acme/arm-lua.git" in mirror.show("master", ".gitmodules")
