@@ -1,7 +1,7 @@
 """AST `deployment` (and the model's `add_lfs_track`) → ir.Deployment.
 
 Lowering keeps what is not given as None, so that the pipeline's `default_deployment`
-can fill it when deploying (deploy/config.py). It checks that `keep_files` and submodule
+can fill it when deploying (deploy/plan.py). It checks that `keep_files` and submodule
 targets stay inside the repository; it contacts no repository.
 """
 
@@ -18,9 +18,15 @@ from mpc.ir.span import Span
 
 
 def inside_repository(path: str) -> bool:
-    """Whether a path (or glob) written in a definition stays inside the repository."""
+    """Whether a path (or glob) written in a definition stays inside the repository, and out
+    of git's own `.git` folder (a submodule target `.git` would have the clone's deleted)."""
     pure = PurePosixPath(path.replace("\\", "/"))
-    return bool(pure.parts) and not pure.is_absolute() and ".." not in pure.parts
+    return bool(pure.parts) and not pure.is_absolute() and not {"..", ".git"} & set(pure.parts)
+
+
+def usable_glob(pattern: str) -> bool:
+    """Whether `pattern` is a glob pathlib can match (`**` only as a whole path component)."""
+    return all(part == "**" or "**" not in part for part in PurePosixPath(pattern).parts)
 
 
 def lower_deployment(section: DeploymentSection, sink: Sink) -> Deployment:
@@ -31,6 +37,11 @@ def lower_deployment(section: DeploymentSection, sink: Sink) -> Deployment:
             sink.error(_item_span(section, "keep_files", i), "E0801",
                        f"keep_files entry '{pattern}' is outside the repository; write a path "
                        "relative to the repository's top folder")
+            continue
+        if not usable_glob(pattern):
+            sink.error(_item_span(section, "keep_files", i), "E0845",
+                       f"keep_files entry '{pattern}' is not a glob: '**' stands only for whole "
+                       "folders, as in 'a/**/*.lua'")
             continue
         keep.append(pattern)
     submodules = []
@@ -71,7 +82,6 @@ def lower_model_deployment(model: ModelSection, sink: Sink) -> Deployment | None
     if deployment.add_lfs_track is None and lfs is not None:
         deployment = replace(deployment, add_lfs_track=lfs)
     return deployment
-
 
 
 def _item_span(node: DeploymentSection, key: str, i: int) -> Span:

@@ -14,10 +14,14 @@ __all__ = ["DeployResult", "DeploySettings", "deploy_model"]
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("DeployResult", "deploy_model"):
-        from mpc.deploy import model
+    if name == "deploy_model":
+        from mpc.deploy.model import deploy_model
 
-        return getattr(model, name)
+        return deploy_model
+    if name == "DeployResult":
+        from mpc.deploy.result import DeployResult
+
+        return DeployResult
     if name == "DeploySettings":
         from mpc.deploy.settings import DeploySettings
 

@@ -15,7 +15,7 @@ from mpc.deploy.gitcmd import scrub
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
-    from mpc.deploy.model import DeployResult
+    from mpc.deploy.result import DeployResult
     from mpc.deploy.settings import DeploySettings
 
 
@@ -54,13 +54,7 @@ def run(args: argparse.Namespace) -> int:
     # A build exists already: what `compile` does not support yet is no reason to refuse it.
     program = load_program(args.definition, sink, Options(), Severity.WARNING)
     settings = _settings(args, sink)
-    protocol = None
-    if args.protocol is not None:
-        try:
-            protocol = args.protocol.read_text(encoding="utf-8")
-        except OSError as e:
-            sink.error(Span.of_file(str(args.protocol)), "E0802",
-                       f"cannot read the test protocol: {e.strerror}")
+    protocol = None if args.protocol is None else _read_protocol(args.protocol, sink)
     result = None
     if program is not None and settings is not None and not sink.has_errors():
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
@@ -71,6 +65,18 @@ def run(args: argparse.Namespace) -> int:
         return 1
     _report(result, "")
     return 0
+
+
+def _read_protocol(path: Path, sink: Sink) -> str | None:
+    """The test protocol's text; E0802 when it cannot be read or is not UTF-8."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as e:
+        problem = e.strerror
+    except UnicodeDecodeError as e:
+        problem = f"it is not UTF-8 text (byte 0x{e.object[e.start]:02x} at offset {e.start})"
+    sink.error(Span.of_file(str(path)), "E0802", f"cannot read the test protocol: {problem}")
+    return None
 
 
 def _settings(args: argparse.Namespace, sink: Sink) -> DeploySettings | None:

@@ -13,6 +13,8 @@ import re
 from dataclasses import dataclass
 from typing import Protocol
 
+from mpc.deploy.gitcmd import scrub
+
 # A push option travels as one pkt-line (at most 65516 bytes); keep well below.
 FORGES = ("gitlab", "github", "none")  # how merge requests are made (a pipeline's `forge`)
 MAX_OPTION_BYTES = 60000
@@ -31,23 +33,35 @@ class MergeRequest:
     mention: tuple[str, ...]
 
 
+def merge_request(remote: str, source: str, target: str, title: str, text: str, mention: tuple[str, ...],
+                  protocol: str | None, footer: str) -> MergeRequest:
+    """The request from `source` into `target`, its description made by `describe`; the title
+    without credentials too."""
+    return MergeRequest(remote, source, target, scrub(title), describe(text, mention, protocol, footer),
+                        mention)
+
+
 def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: str) -> str:
-    """The description: the definition's text, the mentions, the test protocol, the footer."""
+    """The description: the definition's text, the mentions, the test protocol, the footer;
+    without credentials, should the protocol quote an address or a token."""
     parts = [text.strip()]
     if mention:
         parts.append(" ".join(mention))
     if protocol and protocol.strip():
         parts.append(protocol.strip())
     parts.append(footer)
-    return "\n\n".join(parts) + "\n"
+    return scrub("\n\n".join(parts) + "\n").replace("\0", "")
 
 
 class ForgeAdapter(Protocol):
-    """How a forge is told about a merge request: options on the push, a call after it."""
+    """How a forge is told about a merge request: options on the push, a check before it
+    (raising DeployError leaves the remote untouched), a call after it."""
 
     name: str
 
     def push_options(self, request: MergeRequest) -> list[str]: ...
+
+    def before_push(self, request: MergeRequest) -> None: ...
 
     def after_push(self, request: MergeRequest, push_output: str) -> str | None: ...
 
@@ -60,11 +74,14 @@ class NoForge:
     def push_options(self, request: MergeRequest) -> list[str]:
         return []
 
+    def before_push(self, request: MergeRequest) -> None:
+        pass
+
     def after_push(self, request: MergeRequest, push_output: str) -> str | None:
         return None
 
 
-class GitLab:
+class GitLab(NoForge):
     """GitLab's push options. A push option is one line, so the description's newlines
     become `<br/>` (GitLab renders it as Markdown); it is cut at MAX_OPTION_BYTES."""
 
@@ -78,7 +95,7 @@ class GitLab:
         options = ["merge_request.create", f"merge_request.target={request.target}",
                    f"merge_request.title={_one_line(request.title)}",
                    f"merge_request.description={description}"]
-        options += [f"merge_request.assign={user.lstrip('@')}" for user in request.mention]
+        options += [f"merge_request.assign={_one_line(user.lstrip('@'))}" for user in request.mention]
         return options
 
     def after_push(self, request: MergeRequest, push_output: str) -> str | None:
@@ -87,7 +104,7 @@ class GitLab:
 
 
 def _one_line(text: str) -> str:
-    return " ".join(text.split())
+    return " ".join(text.replace("\0", "").split())
 
 
 def adapter(name: str, github_api: str) -> ForgeAdapter:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 EMPTY_TREE = "4b825dc642cb6eb9a060e54bf8d69288fbee4904"
 # user:password@ (or token@) in URLs that git or the forge echo back.
-_URL_CREDENTIALS = re.compile(r"(?P<scheme>[a-zA-Z][a-zA-Z0-9+.-]*://)[^/@\s]+@")
+_URL_CREDENTIALS = re.compile(r"(?P<scheme>[a-zA-Z][a-zA-Z0-9+.-]*://)(?P<user>[^/@\s:]*)(?::[^/@\s]*)?@")
 # Environment variables whose values are secrets wherever they appear.
 SECRET_VARIABLES = ("GITHUB_TOKEN", "GH_TOKEN", "MPC_GITHUB_TOKEN", "GITLAB_TOKEN", "CI_JOB_TOKEN",
                     "SYSTEM_ACCESSTOKEN")
@@ -39,6 +39,17 @@ def scrub(text: str) -> str:
     return text
 
 
+def without_credentials(url: str) -> str:
+    """`url` without its `user:password@` (or `token@`) part: the address to write into a
+    repository (`.gitmodules`) or to compare clones by, since CI tokens change from job to job."""
+    def keep_ssh_user(m: re.Match[str]) -> str:
+        # ssh://git@host/x names the account, not a secret; any password goes all the same
+        ssh = "ssh" in m.group("scheme").lower()
+        return m.group("scheme") + (f"{m.group('user')}@" if ssh and m.group("user") else "")
+
+    return _URL_CREDENTIALS.sub(keep_ssh_user, url)
+
+
 def git_environment() -> dict[str, str]:
     """Variables for every git run: never prompt (a CI job has nobody to answer)."""
     return {"GIT_TERMINAL_PROMPT": "0", "LC_ALL": "C"}
@@ -52,11 +63,14 @@ class Git:
 
         self.folder = folder
         self._git = git.Git(str(folder))
-        self._git.update_environment(**git_environment())
+        # Never look for a repository above `folder`: should its .git be missing, git must
+        # fail rather than work on a repository around the workdir (the definitions', say).
+        self._git.update_environment(**git_environment(), GIT_CEILING_DIRECTORIES=str(folder.parent))
 
     def __call__(self, *args: str, code: str = "E0803", check: bool = True) -> str:
         import git
 
+        _check_arguments(args, code)
         try:
             return self._git.execute(["git", *args], with_extended_output=False, strip_newline_in_stdout=True)
         except git.GitCommandError as e:
@@ -77,6 +91,15 @@ class Git:
 
     def result(self, *args: str) -> tuple[int, str, str]:
         """(status, stdout, stderr) of a git command that may fail (push)."""
+        _check_arguments(args, "E0803")
         status, out, err = self._git.execute(["git", *args], with_extended_output=True,
                                              with_exceptions=False)
         return status, out, err
+
+
+def _check_arguments(args: tuple[str, ...], code: str) -> None:
+    """A NUL byte cannot be passed to a program (a protocol or title from YAML may hold one)."""
+    for arg in args:
+        if "\0" in arg:
+            raise DeployError(code, f"git {args[0]} cannot take an argument with a NUL byte "
+                                    f"(at offset {arg.index(chr(0))} of '{arg[:40]}…')")

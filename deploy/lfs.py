@@ -16,5 +16,7 @@ def track(git: Git, patterns: tuple[str, ...]) -> None:
     if shutil.which("git-lfs") is None:
         raise DeployError("E0808", "the deployment uses git LFS, but git-lfs is not installed "
                                    "(apt-get install git-lfs)")
+    if (git.folder / ".gitattributes").is_symlink():  # kept from the remote: never written through
+        raise DeployError("E0804", "'.gitattributes' is a symbolic link; git LFS would write through it")
     git("lfs", "install", "--local", code="E0808")
     git("lfs", "track", *patterns, code="E0808")

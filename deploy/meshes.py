@@ -9,13 +9,12 @@ the model repository.
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path, PurePosixPath
 
-from mpc.deploy import lfs
-from mpc.deploy.gitcmd import DeployError
+from mpc.deploy import content, lfs
+from mpc.deploy.gitcmd import DeployError, without_credentials
 from mpc.deploy.plan import Plan, lfs_patterns
-from mpc.deploy.repository import Clone, locked, open_clone, publish
+from mpc.deploy.repository import Clone, folder_for, locked, open_clone, publish
 from mpc.deploy.settings import DeploySettings, join_remote
 from mpc.deploy.submodules import Pinned
 
@@ -26,6 +25,9 @@ def deploy_meshes(built: Path, modelname: str, settings: DeploySettings, plan: P
     pins = []
     branch = settings.mesh_branch or plan.base
     for mesh_type, path in sorted(settings.meshes.items()):
+        if not _plain_name(mesh_type):
+            raise DeployError("E0801", f"central mesh type '{mesh_type}' of the pipeline's meshes is not a "
+                                       "folder name of the build's meshes/")
         source = built / "meshes" / mesh_type
         if not source.is_dir():
             continue
@@ -33,13 +35,17 @@ def deploy_meshes(built: Path, modelname: str, settings: DeploySettings, plan: P
             raise DeployError("E0802", "central_meshes needs the pipeline's remote_base to find the "
                                        "mesh repositories")
         url = join_remote(settings.remote_base, path)
-        folder = workdir / ".meshes" / PurePosixPath(path).as_posix()
+        folder = folder_for(workdir / ".meshes", url)
         with locked(folder):
             pin = _deploy_one(source, url, folder, mesh_type, path, branch, settings, plan,
                               f"[mpc] Meshes ({mesh_type}) of {modelname}\n{_body(message)}")
         if pin is not None:
             pins.append(pin)
     return pins
+
+
+def _plain_name(name: str) -> bool:
+    return bool(name) and not name.startswith(".") and "/" not in name and "\\" not in name
 
 
 def _body(message: str) -> str:
@@ -54,16 +60,13 @@ def _deploy_one(source: Path, url: str, folder: Path, mesh_type: str, path: str,
     patterns = lfs_patterns(plan.lfs_patterns, uses_lfs) if uses_lfs else ()
 
     def fill(c: Clone) -> None:
-        for file in sorted(source.rglob("*")):
-            if file.is_file():
-                target = c.folder / file.relative_to(source)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(file, target)
+        for rel in content.build_entries(source):
+            content.copy_entry(source, rel, content.safe_path(c.folder, rel))
         lfs.track(c.git, patterns)
         c.git("add", "-A")
 
-    published = publish(clone, branch, None, fill, message, [], settings.dry_run)
+    published = publish(clone, branch, None, fill, message, settings.dry_run)
     sha = published.sha or clone.remote_sha(branch)
     if sha is None:  # a dry run against an empty mesh repository: nothing to link yet
         return None
-    return Pinned(f"meshes/{mesh_type}", url, url, branch, sha, clone.folder)
+    return Pinned(f"meshes/{mesh_type}", without_credentials(url), url, branch, sha, clone.folder)

@@ -7,30 +7,29 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from mpc.deploy import content, lfs, submodules
-from mpc.deploy.forges import MergeRequest, adapter, describe
+from mpc.deploy.forges import adapter, merge_request
+from mpc.deploy.gitcmd import scrub, without_credentials
+from mpc.deploy.names import check_address
 from mpc.deploy.plan import Plan
 from mpc.deploy.provenance import Provenance, footer
 from mpc.deploy.repository import Clone, open_clone, publish
+from mpc.deploy.result import DeployResult, record_push
 from mpc.deploy.settings import DeploySettings
-
-if TYPE_CHECKING:
-    from mpc.deploy.model import DeployResult
 
 
 def deploy_mirror(source: Clone, plan: Plan, pinned: list[submodules.Pinned], settings: DeploySettings,
                   message: str, protocol: str | None, prov: Provenance, workdir: Path) -> DeployResult:
     """Copy the model repository's tree (as just deployed) to the mirror and push it."""
-    from mpc.deploy.model import DeployResult
-
     mirror = plan.mirror
     assert mirror is not None
-    result = DeployResult(plan.modelname, remote=mirror.repo, branch=mirror.branch)
+    check_address(mirror.repo, "the mirror's address")
+    result = DeployResult(plan.modelname, remote=scrub(mirror.repo), branch=mirror.branch)
     clone = open_clone(mirror.repo, workdir / ".mirrors" / plan.modelname, settings.remote_name)
     targets = {p.target for p in pinned}
-    absolute = [replace(p, url=p.fetched_from) for p in pinned]
+    # absolute addresses, without the credentials the model repository's address may carry
+    absolute = [replace(p, url=without_credentials(p.fetched_from)) for p in pinned]
 
     def fill(c: Clone) -> None:
         content.replace_content(c.folder, source.folder, set(), targets if mirror.submodules else set())
@@ -51,12 +50,9 @@ def deploy_mirror(source: Clone, plan: Plan, pinned: list[submodules.Pinned], se
     target = mirror.mr_target or clone.default_branch
     if mirror.merge_request and target != mirror.branch and forge.name != "none":
         mention = mirror.mr_mention if mirror.mr_mention is not None else plan.mr_mention
-        request = MergeRequest(clone.url, mirror.branch, target, mirror.mr_title or plan.mr_title,
-                               describe(plan.mr_description, mention, protocol, footer(prov)), mention)
-    options = forge.push_options(request) if request else []
-    published = publish(clone, mirror.branch, clone.default_branch, fill, message, options, settings.dry_run)
-    result.commit, result.pushed, result.diffstat = published.sha, published.pushed, published.diffstat
-    if published.pushed and request is not None:
-        result.push_options, result.merge_request = tuple(options), request
-        result.merge_request_url = forge.after_push(request, published.output)
+        request = merge_request(clone.url, mirror.branch, target, mirror.mr_title or plan.mr_title,
+                                plan.mr_description, mention, protocol, footer(prov))
+    published = publish(clone, mirror.branch, clone.default_branch, fill, message, settings.dry_run,
+                        forge, request)
+    record_push(result, published, forge, request)
     return result

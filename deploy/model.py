@@ -11,79 +11,90 @@ with the forge's options and open the merge request (forges.py); copy to the mir
 from __future__ import annotations
 
 import shutil
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
-from mpc.deploy import content, lfs, submodules
-from mpc.deploy.forges import MergeRequest, adapter, describe
-from mpc.deploy.gitcmd import DeployError
-from mpc.deploy.plan import Plan, do_not_deploy, make_plan
+from mpc.deploy import content, lfs, names, submodules
+from mpc.deploy.forges import adapter, merge_request
+from mpc.deploy.gitcmd import DeployError, scrub
+from mpc.deploy.plan import Plan, check_plan_branches, do_not_deploy, make_plan
 from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
-from mpc.deploy.repository import Clone, open_clone, publish
+from mpc.deploy.repository import Clone, locked, open_clone, publish
+from mpc.deploy.result import DeployResult, record_push
 from mpc.deploy.settings import DeploySettings
 from mpc.ir.program import Program
 
 
-@dataclass
-class DeployResult:
-    """What deploying one model did.
-
-    ok: no error (also when there was nothing to do, or `do_not_deploy`).
-    commit: the new commit on `branch` of `remote` (None: nothing changed, or a dry run).
-    pushed: whether it was pushed. push_options: what the push carried (GitLab's merge
-    request). merge_request: the request made, with merge_request_url when the forge says it.
-    diffstat: what a dry run would push. meshes: mesh type → commit of its central
-    repository. mirror: the mirror's result, if there is a mirror.
-    """
-
-    modelname: str
-    ok: bool = True
-    skipped: bool = False
-    remote: str | None = None
-    branch: str | None = None
-    commit: str | None = None
-    pushed: bool = False
-    push_options: tuple[str, ...] = ()
-    merge_request: MergeRequest | None = None
-    merge_request_url: str | None = None
-    diffstat: str = ""
-    meshes: dict[str, str] = field(default_factory=dict)
-    mirror: DeployResult | None = None
-
-
 def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: Sink, *,
                  protocol_markdown: str | None = None, tests_failed: bool = False) -> DeployResult:
-    """Deploy the build of `program` in `built` (what `mpc compile` wrote)."""
+    """Deploy the build of `program` in `built` (what `mpc compile` wrote).
+
+    Models deployed at the same time (a pipeline's workers, or two CI jobs) may share the
+    workdir: each holds the lock of its own clone, and the shared caches have locks of their own.
+    """
     result = DeployResult(program.modelname)
     span = program.deployment.span if program.deployment else program.span
     if do_not_deploy(program, settings):
         result.skipped = True
         return result
-    remote = settings.remote_of(program.modelname)
-    if not built.is_dir():
-        sink.error(span, "E0802", f"the build of '{program.modelname}' is not at '{built}'; compile it first")
-        result.ok = False
-        return result
-    if remote is None:
-        sink.error(span, "E0802", f"no repository to deploy '{program.modelname}' to: the pipeline "
-                   "has no remote_base (or give --remote)")
-        result.ok = False
-        return result
-    result.remote = remote
     try:
-        _deploy(program, built.resolve(), settings, result, protocol_markdown, tests_failed)
+        remote = _checked_inputs(program, built, settings)
+        result.remote = scrub(remote)
+        for entry in content.not_deployed(built):
+            sink.warning(span, "W0840", f"the build's '{entry}' is not deployed: mpc writes no git "
+                         "metadata from a build into a repository")
+        workdir = _workdir(settings.workdir)
+        with locked(workdir / program.modelname):
+            _deploy(program, built.resolve(), remote, workdir, settings, result, protocol_markdown,
+                    tests_failed)
     except DeployError as e:
         sink.error(span, e.code, e.message)
+        result.ok = False
+    except OSError as e:
+        where = f": '{e.filename}'" if e.filename else ""
+        sink.error(span, "E0843", scrub(f"deploying '{program.modelname}' failed on a file: "
+                                        f"{e.strerror or e}{where}"))
         result.ok = False
     return result
 
 
-def _deploy(program: Program, built: Path, settings: DeploySettings, result: DeployResult,
-            protocol: str | None, tests_failed: bool) -> None:
-    workdir = settings.workdir.resolve()
-    clone = open_clone(result.remote or "", workdir / program.modelname, settings.remote_name)
+def _checked_inputs(program: Program, built: Path, settings: DeploySettings) -> str:
+    """The model repository's address, once the build, the names and the branches given are sound."""
+    if not built.exists():
+        raise DeployError("E0802", f"the build of '{program.modelname}' is not at '{built}'; "
+                                   "compile it first")
+    if not built.is_dir():
+        raise DeployError("E0802", f"the build of '{program.modelname}' at '{built}' is not a folder")
+    remote = settings.remote_of(program.modelname)
+    if remote is None:
+        raise DeployError("E0802", f"no repository to deploy '{program.modelname}' to: the pipeline "
+                          "has no remote_base (or give --remote)")
+    names.check_address(remote, "the model repository's address")
+    names.check_folder_name(program.modelname)
+    names.check_remote_name(settings.remote_name)
+    for what, branch in (("success branch", settings.success_branch),
+                         ("failure branch", settings.failure_branch),
+                         ("production branch", settings.production_branch),
+                         ("mesh branch", settings.mesh_branch), ("feature branch", settings.feature_branch)):
+        if branch is not None:
+            names.check_branch(branch, what)
+    return remote
+
+
+def _workdir(folder: Path) -> Path:
+    """The workdir, made when missing (E0841 when it cannot be)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise DeployError("E0841", f"cannot use the workdir '{folder}': {e.strerror}") from None
+    return folder.resolve()
+
+
+def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings: DeploySettings,
+            result: DeployResult, protocol: str | None, tests_failed: bool) -> None:
+    clone = open_clone(remote, workdir / program.modelname, settings.remote_name)
     plan = make_plan(program, settings, clone.url, clone.default_branch, tests_failed)
+    check_plan_branches(plan)
     result.branch = plan.branch
     prov = provenance(program, settings.definition_repo, protocol, tests_failed)
     message = commit_message(program, prov)
@@ -99,20 +110,14 @@ def _deploy(program: Program, built: Path, settings: DeploySettings, result: Dep
     forge = adapter(settings.forge, settings.github_api)
     request = None
     if plan.mr_target is not None and forge.name != "none":
-        request = MergeRequest(clone.url, plan.branch, plan.mr_target, plan.mr_title,
-                               describe(plan.mr_description, plan.mr_mention, protocol, footer(prov)),
-                               plan.mr_mention)
-    options = forge.push_options(request) if request else []
+        request = merge_request(clone.url, plan.branch, plan.mr_target, plan.mr_title, plan.mr_description,
+                                plan.mr_mention, protocol, footer(prov))
 
     def fill(c: Clone) -> None:
         fill_model(c, built, program, plan, prov, pinned)
 
-    published = publish(clone, plan.branch, plan.base, fill, message, options, settings.dry_run)
-    result.commit, result.pushed, result.diffstat = published.sha, published.pushed, published.diffstat
-    if published.pushed and request is not None:
-        result.push_options = tuple(options)
-        result.merge_request = request
-        result.merge_request_url = forge.after_push(request, published.output)
+    published = publish(clone, plan.branch, plan.base, fill, message, settings.dry_run, forge, request)
+    record_push(result, published, forge, request)
     if plan.mirror is not None:
         from mpc.deploy.mirror import deploy_mirror
 
@@ -128,7 +133,7 @@ def fill_model(clone: Clone, built: Path, program: Program, plan: Plan, prov: Pr
         keep.add("README.md")  # the repository's own README stays; one is written only when missing
     targets = {p.target for p in pinned}
     for target in targets:  # submodules are never checked out here: their folders are empty
-        path = folder / target
+        path = content.safe_path(folder, target)
         if path.is_symlink() or path.is_file():
             path.unlink()
         else:
@@ -140,7 +145,7 @@ def fill_model(clone: Clone, built: Path, program: Program, plan: Plan, prov: Pr
         content.write_manifest(folder, program.modelname, program.robotname, plan.mr_mention)
     lfs.track(clone.git, plan.lfs_patterns)
     for target in targets:
-        (folder / target).mkdir(parents=True, exist_ok=True)
+        content.safe_path(folder, target).mkdir(parents=True, exist_ok=True)
     clone.git("add", "-A")
     submodules.link(clone.git, pinned)
 

@@ -95,3 +95,16 @@ def do_not_deploy(program: Program, settings: DeploySettings) -> bool:
     """Whether the model's (or the pipeline's default) deployment says `do_not_deploy`."""
     d = merged(settings.default_deployment, program.deployment)
     return bool(d and d.do_not_deploy)
+
+
+def check_plan_branches(plan: Plan) -> None:
+    """E0840 for a branch name of the plan that git would refuse, before anything is pushed."""
+    from mpc.deploy.names import check_branch
+
+    named = [("branch", plan.branch), ("success branch", plan.base), ("mr_target_branch", plan.mr_target)]
+    named += [(f"submodule '{s.target}' branch", s.branch) for s in plan.submodules]
+    if plan.mirror is not None:
+        named += [("mirror branch", plan.mirror.branch), ("mirror mr_target", plan.mirror.mr_target)]
+    for what, name in named:
+        if name is not None:
+            check_branch(name, what)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
+from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.ir.program import Program
 
 
@@ -29,12 +30,14 @@ def _repository_state(path: Path) -> tuple[str, bool, str] | None:
 
     try:
         repo = git.Repo(path if path.is_dir() else path.parent, search_parent_directories=True)
+        if repo.working_tree_dir is None:  # a bare repository holds no definitions
+            return None
         commit = repo.head.commit.hexsha
-    except (git.InvalidGitRepositoryError, git.NoSuchPathError, ValueError):
+        top = Path(repo.working_tree_dir).resolve()
+        rel = path.resolve().relative_to(top).as_posix() if path.resolve().is_relative_to(top) else str(path)
+        dirty = repo.is_dirty(untracked_files=True, path=None if rel == "." else rel)
+    except (git.GitError, ValueError, OSError):  # no repository, no commit yet, or git failing
         return None
-    top = Path(repo.working_tree_dir or ".").resolve()
-    rel = path.resolve().relative_to(top).as_posix() if path.resolve().is_relative_to(top) else str(path)
-    dirty = repo.is_dirty(untracked_files=True, path=None if rel == "." else rel)
     return commit, dirty, rel
 
 
@@ -74,7 +77,7 @@ def provenance(program: Program, definition_repo: Path | None, protocol: str | N
     for name, inp in sorted(program.inputs.items()):
         if inp.repo is not None:
             rev = inp.repo.commit or (f"branch {inp.repo.branch}" if inp.repo.branch else "default branch")
-            inputs.append(f"{name}: {inp.repo.git} {rev} {inp.repo.model_in_repo}")
+            inputs.append(f"{name}: {without_credentials(inp.repo.git)} {rev} {inp.repo.model_in_repo}")
             continue
         if inp.path is None:
             inputs.append(f"{name}: {inp.kind}")
@@ -115,7 +118,7 @@ def commit_message(program: Program, prov: Provenance) -> str:
     if prov.inputs:
         lines.append("Input models:")
         lines.extend(f"  {line}" for line in prov.inputs)
-    return "\n".join(lines) + "\n"
+    return scrub("\n".join(lines) + "\n")
 
 
 def footer(prov: Provenance) -> str:

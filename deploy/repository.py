@@ -10,12 +10,14 @@ stops before the commit and returns the diff stat the push would carry.
 from __future__ import annotations
 
 import fcntl
+import hashlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git
+from mpc.deploy.forges import ForgeAdapter, MergeRequest
+from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git, without_credentials
 
 ATTEMPTS = 3
 
@@ -54,20 +56,31 @@ def locked(folder: Path) -> Iterator[None]:
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
+def folder_for(parent: Path, url: str) -> Path:
+    """A folder of `parent` named by a repository's address (without credentials, so that a CI
+    job's new token finds the same folder); no address leads out of `parent`."""
+    return parent / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
+
+
 def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
-    """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist."""
+    """A clone of `url` in `folder`, fetched now; cloned when the folder does not exist.
+    The caller holds the folder's lock (`locked`), so a `.git/index.lock` left there is the
+    leftover of a run that was stopped, and goes."""
     existed = folder.exists()
     if existed:
-        if not (folder / ".git").exists():
+        if not (folder / ".git").is_dir():
             raise DeployError("E0803", f"'{folder}' exists and is not a git clone; mpc clones into "
                                        "folders of its own (remove it or choose another workdir)")
+        (folder / ".git" / "index.lock").unlink(missing_ok=True)
         git = Git(folder)
-        current = git("remote", "get-url", remote, check=False)
-        if current != url:
+        current = git("config", "--get", f"remote.{remote}.url", check=False)  # as written, no insteadOf
+        if without_credentials(current) != without_credentials(url):
             raise DeployError("E0803", f"'{folder}' is a clone of '{current or 'nothing'}', not of '{url}'")
+        if current != url:  # the same repository with new credentials (CI tokens change every job)
+            git("remote", "set-url", remote, url)
     else:
         folder.parent.mkdir(parents=True, exist_ok=True)
-        Git(folder.parent)("clone", "-q", "--no-checkout", "--origin", remote, url, str(folder))
+        Git(folder.parent)("clone", "-q", "--no-checkout", "--origin", remote, "--", url, str(folder))
         git = Git(folder)
     clone = Clone(folder, git, remote, url, "")
     if existed:
@@ -135,9 +148,17 @@ class Published:
 Fill = Callable[[Clone], None]
 
 
-def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: str,
-            push_options: list[str], dry_run: bool) -> Published:
-    """Fill `branch` (from the remote's branch, or `base`) with `fill`, commit and push."""
+def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: str, dry_run: bool,
+            forge: ForgeAdapter | None = None, request: MergeRequest | None = None) -> Published:
+    """Fill `branch` (from the remote's branch, or `base`) with `fill`, commit and push, with the
+    forge's push options for `request`. The forge checks it can make the request before the
+    push, so that a forge that refuses leaves the remote as it was.
+
+    A branch that moved after the fetch is filled again from its new commit: the build wins
+    for every file it writes, the remote's new commit for the files `keep_files` names, and
+    files the other commit added that neither names are removed, as on every update.
+    """
+    options = forge.push_options(request) if forge is not None and request is not None else []
     for attempt in range(1, ATTEMPTS + 1):
         start = start_branch(clone, branch, base)
         fill(clone)
@@ -146,10 +167,12 @@ def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: st
         if dry_run:
             return Published(None, False, diff_stat(clone.git, start), attempts=attempt)
         sha = commit(clone.git, message)
+        if forge is not None and request is not None and attempt == 1:
+            forge.before_push(request)
         args = ["push", "--porcelain"]
-        for option in push_options:
+        for option in options:
             args += ["-o", option]
-        status, out, err = clone.git.result(*args, clone.remote, f"HEAD:refs/heads/{branch}")
+        status, out, err = clone.git.result(*args, "--", clone.remote, f"HEAD:refs/heads/{branch}")
         if status == 0:
             return Published(sha, True, output=f"{out}\n{err}", attempts=attempt)
         before = clone.remote_sha(branch)

@@ -8,20 +8,20 @@ submodule is ever checked out inside the model repository.
 
 from __future__ import annotations
 
-import hashlib
 import io
 import tarfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from mpc.deploy.gitcmd import DeployError, Git
-from mpc.deploy.repository import locked
+from mpc.deploy.gitcmd import DeployError, Git, without_credentials
+from mpc.deploy.repository import folder_for, locked
 from mpc.ir.program import DeploySubmodule
 
 
 @dataclass(frozen=True)
 class Pinned:
-    """A submodule resolved: written url (as in the definition), fetched url, commit, cache."""
+    """A submodule resolved: the url written into .gitmodules (as in the definition, without
+    credentials), the url fetched from (absolute), its branch, its commit, its cache."""
 
     target: str
     url: str
@@ -53,11 +53,11 @@ def absolute_url(url: str, superproject: str) -> str:
 def pin(sub: DeploySubmodule, superproject: str, default_branch: str, workdir: Path) -> Pinned:
     """Fetch the submodule and find its commit."""
     fetched_from = absolute_url(sub.repo, superproject)
-    cache = workdir / ".submodules" / hashlib.sha256(fetched_from.encode()).hexdigest()[:16]
+    cache = folder_for(workdir / ".submodules", fetched_from)
     branch = sub.branch or default_branch
     with locked(cache):
         sha = _find(sub, fetched_from, branch, cache)
-    return Pinned(sub.target, sub.repo, fetched_from, branch, sha, cache)
+    return Pinned(sub.target, without_credentials(sub.repo), fetched_from, branch, sha, cache)
 
 
 def _find(sub: DeploySubmodule, fetched_from: str, branch: str, cache: Path) -> str:
@@ -66,7 +66,7 @@ def _find(sub: DeploySubmodule, fetched_from: str, branch: str, cache: Path) -> 
         cache.mkdir(parents=True)
         Git(cache)("init", "-q", "--bare", code="E0807")
     git = Git(cache)
-    git("fetch", "-q", "--prune", fetched_from, "+refs/heads/*:refs/heads/*", code="E0807")
+    git("fetch", "-q", "--prune", "--", fetched_from, "+refs/heads/*:refs/heads/*", code="E0807")
     if sub.commit:
         ref = f"{sub.commit}^{{commit}}"
         what = f"commit '{sub.commit}'"

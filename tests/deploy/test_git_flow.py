@@ -258,3 +258,14 @@ def test_definition_outside_git_is_named_in_the_message(model: Model, server: Se
     settings = model.settings(remote=server.url, forge="none")
     deploy_model(program, model.built, settings, Sink())
     assert server.message().splitlines()[2] == "Definition: arm_model.yml (not in a git repository)"
+
+
+def test_definitions_in_a_repository_without_commits(model: Model, server: Server, tmp_path: Path) -> None:
+    import shutil
+
+    program = model.compile()
+    shutil.rmtree(model.folder / ".git")
+    git(model.folder, "init", "-q")  # a repository, but no commit yet
+    result = deploy_model(program, model.built, model.settings(remote=server.url, forge="none"), Sink())
+    assert result.ok
+    assert server.message().splitlines()[2] == "Definition: arm_model.yml (not in a git repository)"

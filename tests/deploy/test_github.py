@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import threading
+import time
 from collections.abc import Iterator
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -25,6 +26,8 @@ class FakeGitHub(ThreadingHTTPServer):
         self.requests: list[dict] = []
         self.pulls: list[dict] = []
         self.refuse: tuple[int, dict] | None = None
+        self.answer_get: tuple[int, object] | None = None  # instead of the open pull requests
+        self.delay = 0.0  # seconds before answering
 
     @property
     def url(self) -> str:
@@ -55,7 +58,11 @@ class Handler(BaseHTTPRequestHandler):
 
     def do_GET(self) -> None:
         self._record()
-        self._answer(200, [p for p in self.server.pulls if p["state"] == "open"])
+        time.sleep(self.server.delay)
+        if self.server.answer_get is not None:
+            self._answer(*self.server.answer_get)
+        else:
+            self._answer(200, [p for p in self.server.pulls if p["state"] == "open"])
 
     def do_POST(self) -> None:
         entry = self._record()
@@ -154,4 +161,53 @@ def test_no_token(model: Model, server: Server, github: FakeGitHub, monkeypatch:
               "--forge", "github", "--workdir", tmp_path / "work")
     assert run.returncode == 1
     assert "error[E0806]: forge 'github' needs a token in GITHUB_TOKEN (or GH_TOKEN)" in run.stderr
-    assert github.requests == []
+    assert github.requests == [] and server.branches() == {}
+
+
+@pytest.mark.parametrize(("status", "body", "said"), [
+    (401, {"message": "Bad credentials"}, "GitHub refused GET /repos/acme/arm-model/pulls: 401 Unauthorized: "
+                                          "Bad credentials"),
+    (404, {"message": "Not Found"}, "GitHub refused GET /repos/acme/arm-model/pulls: 404 Not Found: "
+                                    "Not Found"),
+    (500, "<html>oops</html>", "GitHub refused GET /repos/acme/arm-model/pulls: 500 Internal Server Error"),
+    (200, {"message": "not a list"}, "GitHub answered GET /repos/acme/arm-model/pulls with something that "
+                                     "is not a list of pull requests"),
+    (200, [{"title": "no number"}], "GitHub answered GET /repos/acme/arm-model/pulls without a pull request "
+                                    "number"),
+])
+def test_an_api_that_refuses_leaves_the_remote_unchanged(model: Model, server: Server, github: FakeGitHub,
+                                                         status: int, body: object, said: str) -> None:
+    github.answer_get = (status, body)
+    model.compile()
+    run = mpc("deploy", model.definition, "--built", model.built, "--remote", server.url,
+              "--forge", "github", "--workdir", model.folder.parent / "work")
+    assert run.returncode == 1 and "Traceback" not in run.stderr
+    assert f"error[E0805]: {said}" in run.stderr
+    assert [r["method"] for r in github.requests] == ["GET"]
+    assert server.branches() == {} and server.pushes() == []  # nothing was pushed
+    assert TOKEN not in run.stdout + run.stderr
+
+
+def test_an_api_that_does_not_answer_in_time(model: Model, server: Server, github: FakeGitHub,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    github.delay = 3
+    monkeypatch.setenv("MPC_GITHUB_TIMEOUT", "0.5")
+    model.compile()
+    run = mpc("deploy", model.definition, "--built", model.built, "--remote", server.url,
+              "--forge", "github", "--workdir", model.folder.parent / "work")
+    assert run.returncode == 1
+    assert (f"error[E0805]: cannot reach GitHub's API at {github.url} (GET /repos/acme/arm-model/pulls): "
+            "timed out") in run.stderr
+    assert server.branches() == {}
+
+
+def test_an_api_that_is_not_there(model: Model, server: Server, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("GITHUB_API_URL", "http://127.0.0.1:9")
+    monkeypatch.setenv("GITHUB_TOKEN", TOKEN)
+    model.compile()
+    run = mpc("deploy", model.definition, "--built", model.built, "--remote", server.url,
+              "--forge", "github", "--workdir", model.folder.parent / "work")
+    assert run.returncode == 1
+    assert ("error[E0805]: cannot reach GitHub's API at http://127.0.0.1:9 (GET "
+            "/repos/acme/arm-model/pulls): [Errno 111] Connection refused") in run.stderr
+    assert server.branches() == {}

@@ -138,3 +138,50 @@ def test_inside_repository(path: str, inside: bool) -> None:
     from mpc.compiler.lower_deploy import inside_repository
 
     assert inside_repository(path) is inside
+
+
+def test_keep_files_and_targets_in_git_s_own_folder_or_not_globs(tmp_path: Path, diags: Diags) -> None:
+    _program(tmp_path, """\
+  deployment:
+    keep_files: [".git/hooks/*", "a**b", "ok/**/*.lua"]
+    submodules: [{repo: x.git, target: .git}, {repo: x.git, target: sub/.git/x}]
+""", diags)
+    assert diags.take_error("E0801").message == ("keep_files entry '.git/hooks/*' is outside the repository; "
+                                                 "write a path relative to the repository's top folder")
+    assert diags.take_error("E0845").message == ("keep_files entry 'a**b' is not a glob: '**' stands only "
+                                                 "for whole folders, as in 'a/**/*.lua'")
+    for target in (".git", "sub/.git/x"):
+        assert diags.take_error("E0801").message == (f"submodule target '{target}' is not a folder inside "
+                                                     "the repository")
+
+
+def test_git_never_works_on_a_repository_around_its_folder(tmp_path: Path) -> None:
+    from mpc.deploy.gitcmd import DeployError, Git
+    from tests.deploy.conftest import git
+
+    git(tmp_path, "init", "-q")
+    (tmp_path / "clone").mkdir()
+    with pytest.raises(DeployError, match="not a git repository"):
+        Git(tmp_path / "clone")("status")
+
+
+def test_no_nul_byte_reaches_git(tmp_path: Path) -> None:
+    from mpc.deploy.forges import GitLab, MergeRequest, describe
+    from mpc.deploy.gitcmd import DeployError, Git
+
+    description = describe("text\0", ("@a",), "proto\0col", "footer")
+    assert description == "text\n\n@a\n\nprotocol\n\nfooter\n"
+    options = GitLab().push_options(MergeRequest("r", "s", "t", "ti\0tle", description, ()))
+    assert options[2] == "merge_request.title=title"
+    with pytest.raises(DeployError, match="cannot take an argument with a NUL byte"):
+        Git(tmp_path)("commit", "-m", "a\0b")
+
+
+def test_credentials_are_left_out_of_written_addresses() -> None:
+    from mpc.deploy.gitcmd import without_credentials
+
+    assert without_credentials("https://ci:tok@h.org/a/b.git") == "https://h.org/a/b.git"
+    assert without_credentials("https://tok@h.org/a") == "https://h.org/a"
+    assert without_credentials("ssh://git:pw@h.org:22/a") == "ssh://git@h.org:22/a"
+    assert without_credentials("ssh://git@h.org/a") == "ssh://git@h.org/a"
+    assert without_credentials("git@h.org:a/b.git") == "git@h.org:a/b.git"
