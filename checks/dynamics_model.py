@@ -168,8 +168,10 @@ class Dynamics:
         rank = int(np.sum(sv > 1e-10 * sv[0])) if sv.size else 0
         null = vt[rank:, :len(index)]
         if null.size and np.max(np.abs(null)) > 1e-8:
+            hint = "" if self.robot.motors else (": without motors every movable joint counts as "
+                                                 "actuated; mark the driven ones `active: true` in `joints`")
             raise DynamicsError(f"the actuated joints ({', '.join(index)}) do not determine their torques "
-                                "(the mechanism is overactuated)")
+                                f"(the mechanism is overactuated{hint})")
         return {n: float(x[k]) for k, n in enumerate(index)}
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpc.checks.protocol import Result, failed, skipped, verdict
+from mpc.checks.protocol import Result, Tolerance, failed, skipped, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.kinematics import link_in_root
 from mpc.ir.program import ModelTest
@@ -14,7 +14,9 @@ from mpc.ir.tree import joints_up
 
 
 def link_mass(robot: Robot, link: str) -> float:
-    inertial = robot.links[link].inertial
+    """The link's mass; 0 for a link without inertial and for a link the robot lacks."""
+    found = robot.links.get(link)
+    inertial = found.inertial if found is not None else None
     return inertial.mass if inertial is not None else 0.0
 
 
@@ -37,11 +39,14 @@ def compare_link_masses(ctx: Context, test: ModelTest) -> Result:
     assert ctx.new is not None and ctx.old is not None
     new, old = ctx.new.robot, ctx.old.robot
     diffs = {n: link_mass(new, n) - link_mass(old, n) for n in set(new.links) | set(old.links)}
-    return _worst(test.name, diffs, ctx.tol.mass, "mass", "kg", "link mass", "link masses")
+    return differences_verdict(test.name, diffs, *ctx.bound("mass", "kg"), "link mass", "link masses")
 
 
-def _worst(name: str, diffs: dict[str, float], tol: float, tol_name: str, unit: str, what: str,
-           whats: str = "") -> Result:
+def differences_verdict(name: str, diffs: dict[str, float], bound: Tolerance, what: str,
+                        whats: str = "") -> Result:
+    """A verdict over named differences (Δ per link or link pair): every |Δ| ≤ the bound;
+    the figure is the worst |Δ|."""
+    tol, unit = bound.value, bound.unit
     order = sorted(diffs, key=lambda n: (-abs(diffs[n]), n))
     worst = abs(diffs[order[0]]) if order else 0.0
     bad = [n for n in order if abs(diffs[n]) > tol]
@@ -50,8 +55,7 @@ def _worst(name: str, diffs: dict[str, float], tol: float, tol_name: str, unit: 
     reason = (f"{len(bad)} {what if len(bad) == 1 else whats} differ by more than {tol:g} {unit}, most "
               f"'{bad[0]}' by {diffs[bad[0]]:+.6g} {unit}") if bad else \
         f"{len(diffs)} {whats} within {tol:g} {unit}"
-    return verdict(name, not bad, reason, figure=worst, unit=unit, tolerance=tol_name, tolerance_value=tol,
-                   details=details)
+    return verdict(name, not bad, reason, figure=worst, unit=unit, tolerances=(bound,), details=details)
 
 
 @register("compare_link_transformations")
@@ -86,8 +90,8 @@ def pose_verdict(name: str, rows: list[tuple[str, float, float]], distance: floa
     else:
         reason = (f"{len(rows)} links within {distance:g} m and {rad:g} rad "
                   f"(worst rotation {worst_angle:.3g} rad)")
-    return verdict(name, not bad, reason, figure=worst, unit="m", tolerance="distance, rad",
-                   tolerance_value=distance, details=details)
+    bounds = (Tolerance("distance", distance, "m"), Tolerance("rad", rad, "rad"))
+    return verdict(name, not bad, reason, figure=worst, unit="m", tolerances=bounds, details=details)
 
 
 @register("total_mass")
@@ -107,7 +111,7 @@ def total_mass(ctx: Context, test: ModelTest) -> Result:
     old = f"; the compare model has {total_mass_of(ctx.old.robot):.6g} kg" if ctx.old else ""
     return verdict(test.name, abs(diff) <= ctx.tol.mass,
                    f"total mass {mass:.6g} kg, expected {expected:.6g} kg{old}", figure=abs(diff), unit="kg",
-                   tolerance="mass", tolerance_value=ctx.tol.mass)
+                   tolerances=ctx.bound("mass", "kg"))
 
 
 def chain(robot: Robot, link: str) -> list[str]:
@@ -137,4 +141,4 @@ def symmetry_check_masses(ctx: Context, test: ModelTest) -> Result:
         return failed(test.name, f"the way to '{left}' has {len(a)} links after the branch, the way to "
                       f"'{right}' {len(b)}", details=(" → ".join(a), " → ".join(b)))
     diffs = {f"{x} / {y}": link_mass(robot, x) - link_mass(robot, y) for x, y in zip(a, b, strict=True)}
-    return _worst(test.name, diffs, ctx.tol.mass, "mass", "kg", "link pair")
+    return differences_verdict(test.name, diffs, *ctx.bound("mass", "kg"), "link pair")

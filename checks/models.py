@@ -168,7 +168,8 @@ def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]
     workdir.mkdir(parents=True, exist_ok=True)
     try:
         kwargs = {"branch": target.branch} if target.branch else {}
-        repo = git.Repo.clone_from(target.git, folder, **kwargs)
+        # never ask for credentials: a CI job has no terminal to answer
+        repo = git.Repo.clone_from(target.git, folder, env={"GIT_TERMINAL_PROMPT": "0"}, **kwargs)
         if target.commit:
             repo.git.checkout(target.commit)
         commit = repo.head.commit.hexsha
@@ -181,9 +182,12 @@ def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]
 
 
 def _git_error(e: Exception) -> str:
+    """git's own complaint (its last `fatal:` or `error:` line), without GitPython's framing."""
     text = str(getattr(e, "stderr", "") or e)
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
-    return lines[-1].removeprefix("stderr: ").strip("'") if lines else type(e).__name__
+    lines = [ln.strip().removeprefix("stderr: ").strip("'").strip() for ln in text.splitlines()]
+    lines = [ln for ln in lines if ln]
+    said = [ln for ln in lines if ln.startswith(("fatal:", "error:"))]
+    return (said or lines or [type(e).__name__])[-1]
 
 
 def _first_error(sink: Sink) -> str:

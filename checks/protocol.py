@@ -17,6 +17,19 @@ Status = Literal["passed", "failed", "waived", "skipped"]
 _SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
 
 
+@dataclass(frozen=True, slots=True)
+class Tolerance:
+    """A bound a figure was held to: `|figure| ≤ value` in `unit`, always absolute (a
+    tolerance is never a fraction of the compared value). name: its key in `tolerances`."""
+
+    name: str
+    value: float
+    unit: str
+
+    def __str__(self) -> str:
+        return f"`{self.name}` ≤ {self.value:g}{' ' + self.unit if self.unit else ''}"
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Result:
     """The outcome of one test.
@@ -24,7 +37,8 @@ class Result:
     name: the test's definition name (`compare_com`, …), with ` 2`, ` 3` for repeats.
     status: passed / failed / waived / skipped. reason: why, in one sentence.
     figure: the measured value the verdict rests on (the worst one), with `unit`.
-    tolerance: the name of the tolerance it was measured against, and its value.
+    tolerances: the bounds it was held to (absolute; two for a pose: distance and angle);
+    none for an exact comparison or a test without a figure.
     details: lines for the protocol (per link, per joint …), worst first.
     log: what a library printed meanwhile (PyBullet's console).
     """
@@ -34,8 +48,7 @@ class Result:
     reason: str = ""
     figure: float | None = None
     unit: str = ""
-    tolerance: str = ""
-    tolerance_value: float | None = None
+    tolerances: tuple[Tolerance, ...] = ()
     details: tuple[str, ...] = ()
     log: str = ""
 
@@ -121,7 +134,8 @@ class Protocol:
             "model": self.model, "failed": self.failed, "counts": self.counts(),
             "compare": self.compare, "waiver": self.waiver,
             "tests": [{"name": r.name, "status": r.status, "reason": r.reason, "figure": r.figure,
-                       "unit": r.unit, "tolerance": r.tolerance, "tolerance_value": r.tolerance_value,
+                       "unit": r.unit, "tolerances": [{"name": t.name, "value": t.value, "unit": t.unit,
+                                                       "kind": "absolute"} for t in r.tolerances],
                        "details": list(r.details), "log": r.log} for r in self.results],
         }
 
@@ -133,7 +147,7 @@ class Protocol:
                f'failures="{c["failed"]}" skipped="{c["skipped"] + c["waived"]}" errors="0">']
         for r in self.results:
             head = f'    <testcase classname={quoteattr(self.model)} name={quoteattr(r.name)}'
-            text = "\n".join([f"{_figure(r)} (tolerance {_tolerance(r)})", *r.details])
+            text = "\n".join([f"{_figure(r)} (tolerance {_tolerance(r) or 'none'})", *r.details])
             if r.status == "passed" and not r.log:
                 out.append(head + "/>")
                 continue
@@ -157,14 +171,17 @@ class Protocol:
         (folder / "test_protocol.junit.xml").write_text(self.junit(), encoding="utf-8")
 
 
+def vector_text(v: object) -> str:
+    """A 3-vector for a reason: (0.1, -0.2, 0.3), four significant digits."""
+    return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"  # type: ignore[attr-defined]
+
+
 def _figure(r: Result) -> str:
     return "" if r.figure is None else f"{r.figure:.6g}{' ' + r.unit if r.unit else ''}"
 
 
 def _tolerance(r: Result) -> str:
-    if not r.tolerance:
-        return ""
-    return r.tolerance if r.tolerance_value is None else f"`{r.tolerance}` = {r.tolerance_value:g}"
+    return ", ".join(map(str, r.tolerances)) + " (absolute)" if r.tolerances else ""
 
 
 def _cell(text: str) -> str:

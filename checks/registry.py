@@ -10,7 +10,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mpc.checks.models import Model
-from mpc.checks.protocol import Result, failed, skipped
+from mpc.checks.protocol import Result, Tolerance, failed, skipped
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.program import ModelTest, Program, TestPlan, Tolerances
 from mpc.ir.robot import Robot
@@ -51,6 +51,10 @@ class Context:
     @property
     def tol(self) -> Tolerances:
         return self.plan.tolerances
+
+    def bound(self, name: str, unit: str) -> tuple[Tolerance]:
+        """The tolerance `name` (mass, distance, rad, default) as a result's bound in `unit`."""
+        return (Tolerance(name, getattr(self.tol, name), unit),)
 
     def need_new(self, name: str) -> Result | None:
         """A failed result when the compiled model could not be read."""

@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpc.checks.protocol import Result, failed, passed
+from mpc.checks.protocol import Result, failed, passed, vector_text
 from mpc.checks.registry import Context, register
+from mpc.checks.topology import MOVABLE
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.program import ModelTest
@@ -25,7 +26,6 @@ from mpc.ir.span import Span
 from mpc.ir.tree import child_joints
 
 RELATIVE = 1e-6
-MOVABLE = frozenset({"revolute", "continuous", "prismatic", "floating", "planar"})
 
 
 def principal_moments(i: Inertia) -> np.ndarray:
@@ -38,10 +38,10 @@ def inertia_problem(i: Inertia) -> str:
     moments = principal_moments(i)
     scale = max(float(np.max(np.abs(moments))), 1e-300)
     if moments[0] <= 0:
-        return f"inertia is not positive definite (principal moments {_vec(moments)})"
+        return f"inertia is not positive definite (principal moments {vector_text(moments)})"
     a, b, c = moments  # ascending: only a + b ≥ c can fail
     if a + b < c - RELATIVE * scale:
-        return (f"principal moments {_vec(moments)} violate the triangle inequality: "
+        return (f"principal moments {vector_text(moments)} violate the triangle inequality: "
                 f"{a:.4g} + {b:.4g} < {c:.4g}")
     return ""
 
@@ -114,8 +114,8 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
             lo, hi = box
             outside = float(np.max(np.maximum(lo - com, com - hi)))
             if outside > distance:
-                out.append((name, f"COM {_vec(com)} m lies {outside:.4g} m outside the collision "
-                                  f"bounding box {_vec(lo)}…{_vec(hi)} m"))
+                out.append((name, f"COM {vector_text(com)} m lies {outside:.4g} m outside the collision "
+                                  f"bounding box {vector_text(lo)}…{vector_text(hi)} m"))
     return out
 
 
@@ -131,18 +131,15 @@ def physical_validity(ctx: Context, test: ModelTest) -> Result:
     figure = float(len(found))
     if not found:
         return passed(test.name, f"{len(robot.links)} links: masses, inertias and COMs are possible",
-                      figure=0.0, unit="findings", tolerance="distance", tolerance_value=ctx.tol.distance)
+                      figure=0.0, unit="findings", tolerances=ctx.bound("distance", "m"))
     more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
     first = f"link '{found[0][0]}' {found[0][1]}{more}"
     if test.as_error:
-        return failed(test.name, first, figure=figure, unit="findings", tolerance="distance",
-                      tolerance_value=ctx.tol.distance, details=details)
+        return failed(test.name, first, figure=figure, unit="findings", tolerances=ctx.bound("distance", "m"),
+                      details=details)
     for link, problem in found:
         span = robot.links[link].span or Span.of_file(str(ctx.new.path))
         ctx.sink.warning(span, "W0701", f"link '{link}' {problem}")
     return passed(test.name, f"{len(found)} warnings: {first}", figure=figure, unit="findings",
-                  tolerance="distance", tolerance_value=ctx.tol.distance, details=details)
+                  tolerances=ctx.bound("distance", "m"), details=details)
 
-
-def _vec(v: np.ndarray) -> str:
-    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"

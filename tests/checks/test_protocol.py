@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from mpc.checks import Protocol, run_model_tests
-from mpc.checks.protocol import Result, failed, passed, skipped
+from mpc.checks.protocol import Result, Tolerance, failed, passed, skipped
 from mpc.checks.registry import TESTS
 from mpc.compiler.diagnostics import Sink
 from tests.checks.helpers import compile_ok, definition, result, run, statuses, write
@@ -21,10 +21,10 @@ SOLO = ERD / "solo_description/robots/solo12.urdf"
 
 def sample() -> Protocol:
     p = Protocol(model="arm-model", compare="`ref` at commit `0123abcd`")
-    p.add(passed("compare_com", "COM within", figure=0.001, unit="m", tolerance="distance",
-                 tolerance_value=0.003))
-    p.add(failed("compare_com", "COM 4.5 mm off", figure=0.0045, unit="m", tolerance="distance",
-                 tolerance_value=0.003, details=("base_link: Δ = +0.0045 m",)))
+    within = (Tolerance("distance", 0.003, "m"),)
+    p.add(passed("compare_com", "COM within", figure=0.001, unit="m", tolerances=within))
+    p.add(failed("compare_com", "COM 4.5 mm off", figure=0.0045, unit="m", tolerances=within,
+                 details=("base_link: Δ = +0.0045 m",)))
     p.add(skipped("total_mass", "no expected mass"))
     p.add(Result(name="load_in_pybullet", status="passed", reason="loaded", log="b3Printf: <robot> & co"))
     return p
@@ -50,7 +50,8 @@ def test_a_waiver_turns_failures_into_waived_and_only_failures() -> None:
 def test_markdown_has_a_row_per_test_with_figure_and_tolerance() -> None:
     text = sample().markdown()
     assert text.startswith("## Model tests of `arm-model`: **failed** (2 passed, 1 failed, 1 skipped)\n")
-    assert "| `compare_com 2` | ❌ failed | 0.0045 m | `distance` = 0.003 | COM 4.5 mm off |" in text
+    assert ("| `compare_com 2` | ❌ failed | 0.0045 m | `distance` ≤ 0.003 m (absolute) | COM 4.5 mm off |"
+            in text)
     assert "| `total_mass` | ⏭️ skipped |  |  | no expected mass |" in text
     assert "--- output ---\nb3Printf: <robot> & co" in text
 
@@ -75,7 +76,8 @@ def test_write_puts_three_files(tmp_path: Path) -> None:
     assert data["tests"][1] == {
         "name": "compare_com 2", "status": "failed", "reason": "COM 4.5 mm off", "figure": 0.0045,
         "unit": "m",
-        "tolerance": "distance", "tolerance_value": 0.003, "details": ["base_link: Δ = +0.0045 m"], "log": ""}
+        "tolerances": [{"name": "distance", "value": 0.003, "unit": "m", "kind": "absolute"}],
+        "details": ["base_link: Δ = +0.0045 m"], "log": ""}
     assert (tmp_path / "test_protocol.md").read_text() == sample().markdown()
     ET.parse(tmp_path / "test_protocol.junit.xml")
 
