@@ -52,7 +52,8 @@ def differences_verdict(name: str, diffs: dict[str, float], bound: Tolerance, wh
     bad = [n for n in order if abs(diffs[n]) > tol]
     details = tuple(f"{n}: Δ = {diffs[n]:+.6g} {unit}" for n in order if abs(diffs[n]) > 0)
     whats = whats or what + "s"
-    reason = (f"{len(bad)} {what if len(bad) == 1 else whats} differ by more than {tol:g} {unit}, most "
+    differ = f"{what} differs" if len(bad) == 1 else f"{whats} differ"
+    reason = (f"{len(bad)} {differ} by more than {tol:g} {unit}, most "
               f"'{bad[0]}' by {diffs[bad[0]]:+.6g} {unit}") if bad else \
         f"{len(diffs)} {whats} within {tol:g} {unit}"
     return verdict(name, not bad, reason, figure=worst, unit=unit, tolerances=(bound,), details=details)

@@ -8,12 +8,15 @@ passed. The protocol fails when a test failed and was not waived.
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 from xml.sax.saxutils import escape, quoteattr
 
 Status = Literal["passed", "failed", "waived", "skipped"]
+# Characters XML 1.0 cannot hold, even escaped (a library's console may print them).
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 _SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
 
 
@@ -143,21 +146,22 @@ class Protocol:
         c = self.counts()
         out = ['<?xml version="1.0" encoding="UTF-8"?>',
                f'<testsuites name="mpc test" tests="{len(self.results)}" failures="{c["failed"]}">',
-               f'  <testsuite name={quoteattr(self.model)} tests="{len(self.results)}" '
+               f'  <testsuite name={_xml_attribute(self.model)} tests="{len(self.results)}" '
                f'failures="{c["failed"]}" skipped="{c["skipped"] + c["waived"]}" errors="0">']
         for r in self.results:
-            head = f'    <testcase classname={quoteattr(self.model)} name={quoteattr(r.name)}'
-            text = "\n".join([f"{_figure(r)} (tolerance {_tolerance(r) or 'none'})", *r.details])
+            head = f'    <testcase classname={_xml_attribute(self.model)} name={_xml_attribute(r.name)}'
+            measured = [] if r.figure is None else [f"{_figure(r)} (tolerance {_tolerance(r) or 'none'})"]
+            text = "\n".join([*measured, *r.details])
             if r.status == "passed" and not r.log:
                 out.append(head + "/>")
                 continue
             out.append(head + ">")
             if r.status == "failed":
-                out.append(f"      <failure message={quoteattr(r.reason)}>{escape(text)}</failure>")
+                out.append(f"      <failure message={_xml_attribute(r.reason)}>{_xml_text(text)}</failure>")
             elif r.status in ("skipped", "waived"):
-                out.append(f"      <skipped message={quoteattr(r.status + ': ' + r.reason)}/>")
+                out.append(f"      <skipped message={_xml_attribute(r.status + ': ' + r.reason)}/>")
             if r.log:
-                out.append(f"      <system-out>{escape(r.log)}</system-out>")
+                out.append(f"      <system-out>{_xml_text(r.log)}</system-out>")
             out.append("    </testcase>")
         out += ["  </testsuite>", "</testsuites>"]
         return "\n".join(out) + "\n"
@@ -174,6 +178,15 @@ class Protocol:
 def vector_text(v: object) -> str:
     """A 3-vector for a reason: (0.1, -0.2, 0.3), four significant digits."""
     return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"  # type: ignore[attr-defined]
+
+
+def _xml_text(text: str) -> str:
+    """`text` escaped for XML content, with characters XML cannot hold dropped."""
+    return escape(_NOT_XML.sub("", text))
+
+
+def _xml_attribute(text: str) -> str:
+    return quoteattr(_NOT_XML.sub("", text))
 
 
 def _figure(r: Result) -> str:

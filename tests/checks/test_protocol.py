@@ -127,3 +127,21 @@ def test_an_output_that_was_not_compiled_fails_every_test(tmp_path: Path) -> Non
     assert sink.diagnostics[0].message == \
         f"cannot test 'solo-model': '{tmp_path / 'empty/urdf/solo.urdf'}' does not exist: " \
         "compile the model first"
+
+
+def test_junit_drops_characters_xml_cannot_hold_and_lxml_reads_it(tmp_path: Path) -> None:
+    """A console may print escape sequences or NUL; XML 1.0 cannot hold them even escaped."""
+    from lxml import etree
+
+    p = Protocol(model="m\x01")
+    p.add(failed("compare_com", "off by \x1b[31m5 mm\x1b[0m", details=("a\x00b",)))
+    p.add(Result(name="load_in_pybullet", status="passed", reason="loaded", log="warn\x07ing\n"))
+    p.add(skipped("total_mass", "no \x0bexpected mass"))
+    p.write(tmp_path)
+    suite = etree.parse(str(tmp_path / "test_protocol.junit.xml")).getroot().find("testsuite")
+    assert suite.get("name") == "m"
+    cases = {c.get("name"): c for c in suite.iter("testcase")}
+    assert cases["compare_com"].find("failure").get("message") == "off by [31m5 mm[0m"
+    assert cases["compare_com"].find("failure").text == "ab"
+    assert cases["load_in_pybullet"].find("system-out").text == "warning\n"
+    assert cases["total_mass"].find("skipped").get("message") == "skipped: no expected mass"
