@@ -17,6 +17,7 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
+from mpc.ir.span import Span
 
 
 @dataclass
@@ -51,6 +52,7 @@ def read_model(path: Path, sink: Sink) -> Robot | None:
     if path.suffix.lower() == ".smurf":
         urdf = _urdf_of_smurf(path)
         if urdf is None:
+            sink.error(Span.of_file(str(path)), "E0704", "the SMURF file lists no URDF in `files`")
             return None
         path = urdf
     from mpc.backends.urdf_reader import read as read_urdf

@@ -111,6 +111,8 @@ def test_edge_models_compared_with_themselves_never_crash(tmp_path: Path, name: 
      "malformed XML in '{tmp}/notes.txt': Start tag expected, '<' not found"),
     ("      path: broken.urdf\n", "cannot read the compare model 'broken.urdf': {tmp}/broken.urdf:1:33: "
      "joint 'j' has no <child link=…>"),
+    ("      path: robot.smurf\n", "cannot read the compare model 'robot.smurf': {tmp}/robot.smurf:1:1: "
+     "the SMURF file lists no URDF in `files`"),
     ("      git: {tmp}/remote.git\n      branch: nope\n", "cannot get branch 'nope' of compare repository "
      "'{tmp}/remote.git': fatal: Remote branch nope not found in upstream origin"),
     ("      git: {tmp}/remote.git\n      model_in_repo: urdf/other.urdf\n",
@@ -121,6 +123,7 @@ def test_edge_models_compared_with_themselves_never_crash(tmp_path: Path, name: 
 def test_a_compare_model_that_cannot_be_loaded_fails_the_compare_tests_only(
         tmp_path: Path, compare: str, reason: str) -> None:
     write(tmp_path / "notes.txt", "not a model\n")
+    write(tmp_path / "robot.smurf", "modelname: robot\nfiles: [robot_submechanisms.yml]\n")
     write(tmp_path / "broken.urdf", '<robot name="b"><link name="a"/><joint name="j" type="fixed">'
           '<parent link="a"/></joint></robot>\n')
     bare = tmp_path / "remote.git"

@@ -145,3 +145,14 @@ def test_junit_drops_characters_xml_cannot_hold_and_lxml_reads_it(tmp_path: Path
     assert cases["compare_com"].find("failure").text == "ab"
     assert cases["load_in_pybullet"].find("system-out").text == "warning\n"
     assert cases["total_mass"].find("skipped").get("message") == "skipped: no expected mass"
+
+
+def test_importing_the_checks_loads_no_heavy_library() -> None:
+    """Pinocchio, PyBullet, trimesh and GitPython load only when a test uses them."""
+    import subprocess
+    import sys
+
+    code = ("import sys, mpc.checks, mpc.checks.runner; "
+            "print(sorted(m for m in ('pinocchio', 'pybullet', 'trimesh', 'git') if m in sys.modules))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout == "[]\n"
