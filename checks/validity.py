@@ -1,6 +1,8 @@
 """physical_validity (always run): is each link physically possible?
 
-- every movable joint moves a body with mass > 0 (its child with the fixed-joint descendants);
+- every movable joint carries mass > 0: its child or a link beyond it (a massless link between
+  two joints of a 2- or 3-DoF joint is fine; a joint that moves nothing makes the mass
+  matrix singular);
 - each inertia tensor (mass > 0) is positive definite and its principal moments satisfy the
   triangle inequality A + B ≥ C, with a tolerance relative to the largest moment (1e-6:
   what the six written digits of a URDF inertia can carry);
@@ -85,14 +87,24 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     children = child_joints(robot)
 
-    def body_mass(link: str) -> float:
-        inertial = robot.links[link].inertial
-        own = inertial.mass if inertial else 0.0
-        return own + sum(body_mass(j.child) for j in children.get(link, []) if j.type == "fixed")
+    def carried_mass(link: str) -> float:
+        """The mass of the link and of every link beyond it (each link once, should the
+        joints not form a tree)."""
+        total, todo, seen = 0.0, [link], {link}
+        while todo:
+            at = todo.pop()
+            inertial = robot.links[at].inertial
+            total += max(inertial.mass, 0.0) if inertial else 0.0
+            for j in children.get(at, []):
+                if j.child in robot.links and j.child not in seen:
+                    seen.add(j.child)
+                    todo.append(j.child)
+        return total
 
     for joint in sorted(robot.joints.values(), key=lambda j: j.name):
-        if joint.type in MOVABLE and body_mass(joint.child) <= 0:
-            out.append((joint.child, f"moves with joint '{joint.name}' but has no mass"))
+        if joint.type in MOVABLE and joint.child in robot.links and carried_mass(joint.child) <= 0:
+            out.append((joint.child, f"moves with joint '{joint.name}' but neither it nor a link "
+                                     "beyond it has mass"))
     for name in sorted(robot.links):
         link = robot.links[name]
         inertial = link.inertial
