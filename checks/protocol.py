@@ -175,6 +175,11 @@ class Protocol:
         (folder / "test_protocol.junit.xml").write_text(self.junit(), encoding="utf-8")
 
 
+def first_of(problems: list[str]) -> str:
+    """The first problem, and how many more there are: a reason for the protocol's table."""
+    return problems[0] + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else "")
+
+
 def vector_text(v: object) -> str:
     """A 3-vector for a reason: (0.1, -0.2, 0.3), four significant digits."""
     return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"  # type: ignore[attr-defined]

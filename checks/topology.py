@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mpc.checks.protocol import Result, failed, passed, verdict
+from mpc.checks.protocol import Result, failed, first_of, passed, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.program import ModelTest
 from mpc.ir.robot import Robot
@@ -67,8 +67,8 @@ def topological_self_consistency(ctx: Context, test: ModelTest) -> Result:
     what = "a tree" + (" with no breaking change against the compare model" if ctx.old else
                        " (no compare model: only the tree was checked)" if ctx.plan.compare is None else "")
     if problems:
-        return failed(name, problems[0] + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""),
-                      figure=float(len(problems)), unit="problems", details=(*problems, *details))
+        return failed(name, first_of(problems), figure=float(len(problems)), unit="problems",
+                      details=(*problems, *details))
     return passed(name, what, figure=0.0, unit="problems", details=tuple(details))
 
 

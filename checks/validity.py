@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpc.checks.protocol import Result, failed, passed, vector_text
+from mpc.checks.protocol import Result, failed, first_of, passed, vector_text
 from mpc.checks.registry import Context, register
 from mpc.checks.topology import MOVABLE
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
@@ -144,8 +144,7 @@ def physical_validity(ctx: Context, test: ModelTest) -> Result:
     if not found:
         return passed(test.name, f"{len(robot.links)} links: masses, inertias and COMs are possible",
                       figure=0.0, unit="findings", tolerances=ctx.bound("distance", "m"))
-    more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
-    first = f"link '{found[0][0]}' {found[0][1]}{more}"
+    first = first_of([f"link '{link}' {problem}" for link, problem in found])
     if test.as_error:
         return failed(test.name, first, figure=figure, unit="findings", tolerances=ctx.bound("distance", "m"),
                       details=details)
