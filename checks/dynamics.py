@@ -71,12 +71,8 @@ def _guard(fn: Any) -> Any:
 
 
 def _both(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarray]:
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        raise _Missing(missing)
-    assert ctx.new is not None and ctx.old is not None
-    a, qa = _state(ctx, ctx.new, test.name, "compiled model")
-    b, qb = _state(ctx, ctx.old, test.name, "compare model")
+    a, qa = _state(ctx, ctx.built, test.name, "compiled model")
+    b, qb = _state(ctx, ctx.compare, test.name, "compare model")
     return a, qa, b, qb
 
 
@@ -85,11 +81,7 @@ def _both(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarr
 def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
     """The compiled model (and the compare model, when there is one) loads in the dynamics
     library, Pinocchio, with its loop closures."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn, _ = _state(ctx, ctx.new, test.name, "compiled model")
+    dyn, _ = _state(ctx, ctx.built, test.name, "compiled model")
     if ctx.old is not None:
         _state(ctx, ctx.old, test.name, "compare model")
     n = len(dyn.constraints)
@@ -98,7 +90,7 @@ def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
                   figure=float(dyn.model.nv), unit="DoF")
 
 
-@register("compare_masses", dynamics=True)
+@register("compare_masses", dynamics=True, needs="both")
 @_guard
 def compare_masses(ctx: Context, test: ModelTest) -> Result:
     """|total mass − the compare model's| ≤ `mass` (both ways: a heavier model fails too)."""
@@ -109,7 +101,7 @@ def compare_masses(ctx: Context, test: ModelTest) -> Result:
                    figure=abs(diff), unit="kg", tolerances=ctx.bound("mass", "kg"))
 
 
-@register("compare_com", dynamics=True)
+@register("compare_com", dynamics=True, needs="both")
 @_guard
 def compare_com(ctx: Context, test: ModelTest) -> Result:
     """‖COM − the compare model's COM‖ ≤ `distance`, in the root frame, at the configuration."""
@@ -121,7 +113,7 @@ def compare_com(ctx: Context, test: ModelTest) -> Result:
                    figure=dist, unit="m", tolerances=ctx.bound("distance", "m"))
 
 
-@register("compare_torques", dynamics=True)
+@register("compare_torques", dynamics=True, needs="both")
 @_guard
 def compare_torques(ctx: Context, test: ModelTest) -> Result:
     """The gravity torques of the compiled model's actuated joints (or the joints given) in
@@ -150,7 +142,7 @@ def compare_torques(ctx: Context, test: ModelTest) -> Result:
                    details=details)
 
 
-@register("compare_link_positions", dynamics=True)
+@register("compare_link_positions", dynamics=True, needs="both")
 @_guard
 def compare_link_positions(ctx: Context, test: ModelTest) -> Result:
     """The given links' (every shared link's, when none is given) positions ≤ `distance` and
@@ -177,11 +169,7 @@ def _mirror(p: np.ndarray, plane: tuple[float, float, float]) -> np.ndarray:
 def symmetry_check(ctx: Context, test: ModelTest) -> Result:
     """The right link's position is the left one's mirrored in the plane through the root's
     origin with normal `plane` (default y: the xz-plane), within `distance`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn, q = _state(ctx, ctx.new, test.name, "compiled model")
+    dyn, q = _state(ctx, ctx.built, test.name, "compiled model")
     placements = dyn.link_placements(q)
     left, right = test.links
     for link in test.links:
@@ -202,12 +190,8 @@ def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
     """The actuated joints on the way to the left and the right link, pairwise from where the
     two ways part: equal magnitudes of gravity torque, ||τ_L| − |τ_R|| ≤ `default`. Magnitudes,
     because a mirrored joint axis may flip the sign."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
-    dyn, q = _state(ctx, ctx.new, test.name, "compiled model")
+    robot = ctx.built.robot
+    dyn, q = _state(ctx, ctx.built, test.name, "compiled model")
     for link in test.links:
         if link not in robot.links:
             return failed(test.name, f"link '{link}' is not in the model")
@@ -234,11 +218,7 @@ def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
 def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     """Set the configuration of the dynamics checks that follow, for both models: one value
     for every joint, one per joint (in the compiled model's joint order), or by joint name."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn = _dyn(ctx.new, test.name, "compiled model")
+    dyn = _dyn(ctx.built, test.name, "compiled model")
     joints = dyn.joint_names()
     if test.joint_angles is not None:
         unknown = sorted(set(test.joint_angles) - set(joints))
@@ -254,7 +234,7 @@ def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
         assert test.angle is not None
         values = dict.fromkeys(dyn.actuated if dyn.constraints else joints, test.angle)
     ctx.configuration = values
-    _state(ctx, ctx.new, test.name, "compiled model")  # the loops must close there
+    _state(ctx, ctx.built, test.name, "compiled model")  # the loops must close there
     return passed(test.name, f"the checks after this one run {_where(ctx)}",
                   details=tuple(f"{k} = {v:g}" for k, v in values.items()))
 

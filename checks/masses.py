@@ -29,15 +29,11 @@ def rotation_angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)))
 
 
-@register("compare_link_masses")
+@register("compare_link_masses", needs="both")
 def compare_link_masses(ctx: Context, test: ModelTest) -> Result:
     """Every link's mass against the compare model's, |Δm| ≤ `mass`. A link in only one of
     the models counts with its whole mass (a mass that appeared or disappeared)."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    new, old = ctx.new.robot, ctx.old.robot
+    new, old = ctx.built.robot, ctx.compare.robot
     diffs = {n: link_mass(new, n) - link_mass(old, n) for n in set(new.links) | set(old.links)}
     return differences_verdict(test.name, diffs, *ctx.bound("mass", "kg"), "link mass", "link masses")
 
@@ -59,16 +55,12 @@ def differences_verdict(name: str, diffs: dict[str, float], bound: Tolerance, wh
     return verdict(name, not bad, reason, figure=worst, unit=unit, tolerances=(bound,), details=details)
 
 
-@register("compare_link_transformations")
+@register("compare_link_transformations", needs="both")
 def compare_link_transformations(ctx: Context, test: ModelTest) -> Result:
     """Every link's pose in the root at q = 0 against the compare model's: the position error
     ≤ `distance` and the geodesic rotation angle of X_old⁻¹·X_new ≤ `rad`. Links in only
     one model are left to topological_self_consistency."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    new, old = ctx.new.robot, ctx.old.robot
+    new, old = ctx.built.robot, ctx.compare.robot
     rows = []
     for link in sorted(set(new.links) & set(old.links)):
         X_new, X_old = link_in_root(new, link), link_in_root(old, link)
@@ -99,15 +91,11 @@ def pose_verdict(name: str, rows: list[tuple[str, float, float]], distance: floa
 def total_mass(ctx: Context, test: ModelTest) -> Result:
     """The model's total mass against the expected one (the argument, else `expected_mass`
     from test_data_file): |m − expected| ≤ `mass`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
     expected = test.value if test.value is not None else ctx.plan.expected_mass
     if expected is None:
         return skipped(test.name, "no expected mass: give one (`- total_mass: 12.5`) or a test_data_file "
                        "with test_data: {expected_mass: …}")
-    mass = total_mass_of(ctx.new.robot)
+    mass = total_mass_of(ctx.built.robot)
     diff = mass - expected
     old = f"; the compare model has {total_mass_of(ctx.old.robot):.6g} kg" if ctx.old else ""
     return verdict(test.name, abs(diff) <= ctx.tol.mass,
@@ -124,11 +112,7 @@ def chain(robot: Robot, link: str) -> list[str]:
 def symmetry_check_masses(ctx: Context, test: ModelTest) -> Result:
     """The links on the way from the root to the left and to the right link, pairwise from
     where the two ways part: equal in number and |m_L − m_R| ≤ `mass`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
+    robot = ctx.built.robot
     left, right = test.links
     for link in test.links:
         if link not in robot.links:

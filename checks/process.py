@@ -92,11 +92,7 @@ def process_double_check(ctx: Context, test: ModelTest) -> Result:
     """The written model has exactly the links and joints the definition produces, every
     operation's mark (removed joints absent, set limits and types present, the robot's name,
     frames, cut joints, motors), and every mesh file it references."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    built = ctx.new.robot
+    built = ctx.built.robot
     problems = _mesh_problems(built)
     checked = 0
     if ctx.robot is not None:
@@ -128,17 +124,13 @@ def _files(folder: Path) -> set[str]:
     return out
 
 
-@register("file_consistency")
+@register("file_consistency", needs="both")
 def file_consistency(ctx: Context, test: ModelTest) -> Result:
     """No file of the compare model's folder is missing from the output (meshes, PDFs,
     Graphviz files, README.md, manifest.xml and git files aside)."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    if ctx.old.path == ctx.old.folder:
+    if ctx.compare.path == ctx.compare.folder:
         return skipped(test.name, "the compare model is a single file, not a folder")
-    old, new = _files(ctx.old.folder), _files(ctx.new.folder)
+    old, new = _files(ctx.compare.folder), _files(ctx.built.folder)
     lost = sorted(old - new)
     added = sorted(new - old)
     details = (*(f"missing: {f}" for f in lost), *(f"added: {f}" for f in added))

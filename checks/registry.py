@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 from mpc.checks.models import Model
 from mpc.checks.protocol import Result, Tolerance, failed, skipped
@@ -20,10 +21,19 @@ TESTS: dict[str, Test] = {}
 DYNAMICS_CHECKS: dict[str, Test] = {}
 
 
-def register(name: str, dynamics: bool = False) -> Callable[[Test], Test]:
-    """Register a test under its definition name (a dynamics check: inside hyrodynChecks)."""
+def register(name: str, dynamics: bool = False, needs: Literal["built", "both"] = "built"
+             ) -> Callable[[Test], Test]:
+    """Register a test under its definition name (a dynamics check: inside hyrodynChecks).
+
+    needs: the models it measures. Without them it does not run: it fails when the compiled
+    model (or a configured compare model) cannot be loaded, and is skipped when it needs a
+    compare model and the definition has none (Context.need_built, Context.need_both)."""
     def add(fn: Test) -> Test:
-        (DYNAMICS_CHECKS if dynamics else TESTS)[name] = fn
+        def run(ctx: Context, test: ModelTest) -> Result:
+            missing = ctx.need_both(test.name) if needs == "both" else ctx.need_built(test.name)
+            return missing if missing is not None else fn(ctx, test)
+        run.__doc__ = fn.__doc__
+        (DYNAMICS_CHECKS if dynamics else TESTS)[name] = run
         return fn
     return add
 
@@ -56,7 +66,19 @@ class Context:
         """The tolerance `name` (mass, distance, rad, default) as a result's bound in `unit`."""
         return (Tolerance(name, getattr(self.tol, name), unit),)
 
-    def need_new(self, name: str) -> Result | None:
+    @property
+    def built(self) -> Model:
+        """The compiled model, for a test registered as needing it (so it is there)."""
+        assert self.new is not None
+        return self.new
+
+    @property
+    def compare(self) -> Model:
+        """The compare model, for a test registered with needs="both"."""
+        assert self.old is not None
+        return self.old
+
+    def need_built(self, name: str) -> Result | None:
         """A failed result when the compiled model could not be read."""
         return None if self.new is not None else failed(name, f"the compiled model cannot be loaded: "
                                                          f"{self.new_problem}")
@@ -64,7 +86,7 @@ class Context:
     def need_both(self, name: str) -> Result | None:
         """A failed or skipped result when a model to compare is missing. Without a
         compare_model the test is skipped; with one that cannot be loaded it fails."""
-        problem = self.need_new(name)
+        problem = self.need_built(name)
         if problem is not None:
             return problem
         if self.old is not None:

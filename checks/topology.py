@@ -44,11 +44,7 @@ def topological_self_consistency(ctx: Context, test: ModelTest) -> Result:
     """The model is a tree; against the compare model no link or joint was removed or
     renamed and no joint changed its type. Additions are reported, not failed."""
     name = test.name
-    missing = ctx.need_new(name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    new = ctx.new.robot
+    new = ctx.built.robot
     problems = tree_problems(new)
     details: list[str] = []
     if ctx.old is not None:
@@ -72,15 +68,11 @@ def topological_self_consistency(ctx: Context, test: ModelTest) -> Result:
     return passed(name, what, figure=0.0, unit="problems", details=tuple(details))
 
 
-@register("compare_amount_joints")
+@register("compare_amount_joints", needs="both")
 def compare_amount_joints(ctx: Context, test: ModelTest) -> Result:
     """The same number of movable joints as the compare model."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    count_new = sum(j.type in MOVABLE for j in ctx.new.robot.joints.values())
-    count_old = sum(j.type in MOVABLE for j in ctx.old.robot.joints.values())
+    count_new = sum(j.type in MOVABLE for j in ctx.built.robot.joints.values())
+    count_old = sum(j.type in MOVABLE for j in ctx.compare.robot.joints.values())
     return verdict(test.name, count_new == count_old,
                    f"{count_new} movable joints, the compare model has {count_old} (compared exactly)",
                    figure=float(count_new - count_old), unit="joints")

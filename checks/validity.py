@@ -133,11 +133,7 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
 
 @register("physical_validity")
 def physical_validity(ctx: Context, test: ModelTest) -> Result:
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
+    robot = ctx.built.robot
     found = findings(robot, ctx.tol.distance)
     details = tuple(f"{link}: {problem}" for link, problem in found)
     figure = float(len(found))
@@ -149,7 +145,7 @@ def physical_validity(ctx: Context, test: ModelTest) -> Result:
         return failed(test.name, first, figure=figure, unit="findings", tolerances=ctx.bound("distance", "m"),
                       details=details)
     for link, problem in found:
-        span = robot.links[link].span or Span.of_file(str(ctx.new.path))
+        span = robot.links[link].span or Span.of_file(str(ctx.built.path))
         ctx.sink.warning(span, "W0701", f"link '{link}' {problem}")
     return passed(test.name, f"{len(found)} warnings: {first}", figure=figure, unit="findings",
                   tolerances=ctx.bound("distance", "m"), details=details)
