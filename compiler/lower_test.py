@@ -148,6 +148,10 @@ class _TestLowering:
             return None
         if name == "total_mass":
             value = self.number(arg, span, f"{what} expected mass")
+            if value is not None and value < 0:
+                self.sink.error(span, "E0703", f"{what}: the expected mass must not be negative, "
+                                f"got {value:g}")
+                return None
             return None if value is None else ModelTest(name=name, span=span, dynamics=dynamics, value=value)
         if name == "physical_validity":
             if arg not in ("error", "warning"):
