@@ -92,12 +92,41 @@ def test_a_test_that_raises_does_not_end_the_others(tmp_path: Path, monkeypatch:
     protocol = run(tmp_path / "m.yml", tmp_path / "out", tmp_path / "work")
     crashed = result(protocol, "compare_amount_joints")
     assert crashed.status == "failed"
-    assert crashed.reason.startswith("the test itself failed (a bug in mpc, please report it): "
+    assert crashed.reason.startswith("the test itself failed (a bug in mpc, please report it: "
                                      "ZeroDivisionError: division by zero at test_protocol.py:")
     assert [r.name for r in protocol.results] == ["compare_amount_joints", "load_in_pybullet",
                                                   "topological_self_consistency", "file_consistency",
                                                   "physical_validity"]
     assert statuses(protocol)["load_in_pybullet"] == "passed"
+
+
+def test_a_loader_that_raises_fails_the_tests_with_the_reason(tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """Even a bug in reading a model (here: the compare model's reader raises) leaves a
+    protocol whose compare tests fail with the exception, and the others pass."""
+    from mpc.checks import models
+
+    original = models.read_model
+
+    def broken_for_the_compare_model(path, sink):
+        if path.is_relative_to(tmp_path / "ref"):
+            raise RuntimeError("reader broke")
+        return original(path, sink)
+
+    write(tmp_path / "ref.yml", definition(SOLO, "solo", "      - compare_amount_joints\n"))
+    compile_ok(tmp_path / "ref.yml", tmp_path / "ref")
+    tests = "      - compare_amount_joints\n      - load_in_pybullet\n"
+    write(tmp_path / "m.yml", definition(SOLO, "solo", tests, compare="      path: ref\n"))
+    result_ = compile_ok(tmp_path / "m.yml", tmp_path / "out")
+    monkeypatch.setattr(models, "read_model", broken_for_the_compare_model)
+    sink = Sink()
+    protocol = run_model_tests(result_.program, tmp_path / "out", sink, workdir=tmp_path / "work",
+                               robot=result_.robot)
+    s = statuses(protocol)
+    assert (s["compare_amount_joints"], s["load_in_pybullet"]) == ("failed", "passed")
+    assert result(protocol, "compare_amount_joints").reason.startswith(
+        "the compare model cannot be loaded: a bug in mpc, please report it: RuntimeError: reader broke at ")
+    assert [d.code for d in sink.diagnostics] == ["E0704"]
 
 
 def test_pybullet_failure_keeps_its_console_and_a_missing_mesh_fails_the_double_check(tmp_path: Path) -> None:
