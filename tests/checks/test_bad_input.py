@@ -14,29 +14,13 @@ import pytest
 from lxml import etree
 
 from tests.checks.fourbar import FOURBAR_DEFINITION, FOURBAR_URDF
-from tests.checks.helpers import definition, edited_urdf, link_el, write
+from tests.checks.helpers import EVERY_TEST, definition, edited_urdf, link_el, write
 from tests.compiler.test_cli import mpc
 from tests.conftest import ERD
 
 SOLO = ERD / "solo_description/robots/solo12.urdf"
-EVERY = """\
-      - process_double_check
-      - load_in_pybullet
-      - compare_link_masses
-      - compare_link_transformations
-      - compare_amount_joints
-      - total_mass: 2.5
-      - physical_validity: error
-      - hyrodynChecks:
-          - load_in_hyrodyn
-          - compare_masses
-          - compare_com
-          - compare_torques
-          - compare_link_positions
-          - move_hyrodyn_model: 0.3
-          - compare_torques
-          - compare_com
-"""
+EVERY = (EVERY_TEST + "          - move_hyrodyn_model: 0.3\n          - compare_torques\n"
+         "          - compare_com\n      - total_mass: 2.5\n      - physical_validity: error\n")
 INERTIAL = ('<inertial><origin xyz="0 0 0.1"/><mass value="1"/>'
             '<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>')
 LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
