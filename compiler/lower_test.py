@@ -192,6 +192,9 @@ class _TestLowering:
         if not isinstance(arg, list) or len(arg) != 2 or not all(isinstance(x, str) for x in arg):
             self.sink.error(test.span, "E0703", f"{what} needs two link names [left, right], got {arg!r}")
             return None
+        if arg[0] == arg[1]:
+            self.sink.error(test.span, "E0703", f"{what} compares two different links; both are '{arg[0]}'")
+            return None
         return ModelTest(name=test.name, span=test.span, dynamics=test.dynamics, links=tuple(arg),
                          plane=plane)
 

@@ -79,6 +79,8 @@ def test_every_argument_form_and_the_ir_round_trip(tmp_path: Path, diags: Diags)
      "test 'symmetry_check': 'plane' is the normal of the mirror plane, three numbers not all zero, "
      "e.g. [0, 1, 0]"),
     ("    tolerances: {distance: -1}\n", "E0701", "tolerance 'distance' must not be negative, got -1"),
+    ("    tests:\n      - symmetry_check_masses: [upper, upper]\n", "E0703",
+     "test 'symmetry_check_masses' compares two different links; both are 'upper'"),
     ("    tests:\n      - total_mass: -5\n", "E0703",
      "test 'total_mass': the expected mass must not be negative, got -5"),
     ("    compare_model: {git: a.git, path: b}\n", "E0701",
