@@ -217,7 +217,9 @@ def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
 @_guard
 def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     """Set the configuration of the dynamics checks that follow, for both models: one value
-    for every joint, one per joint (in the compiled model's joint order), or by joint name."""
+    for every joint, one per joint (in the compiled model's joint order), or by joint name.
+    A configuration that cannot be set (an unknown joint, loops that do not close there)
+    fails this check and leaves the configuration as it was."""
     dyn = _dyn(ctx.built, test.name, "compiled model")
     joints = dyn.joint_names()
     if test.joint_angles is not None:
@@ -233,8 +235,12 @@ def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     else:
         assert test.angle is not None
         values = dict.fromkeys(dyn.actuated if dyn.constraints else joints, test.angle)
-    ctx.configuration = values
-    _state(ctx, ctx.built, test.name, "compiled model")  # the loops must close there
+    previous, ctx.configuration = ctx.configuration, values
+    try:
+        _state(ctx, ctx.built, test.name, "compiled model")  # the loops must close there
+    except _Missing:
+        ctx.configuration = previous  # the checks after it keep the configuration they had
+        raise
     return passed(test.name, f"the checks after this one run {_where(ctx)}",
                   details=tuple(f"{k} = {v:g}" for k, v in values.items()))
 
