@@ -143,6 +143,17 @@ def test_built_pointing_at_an_empty_folder_fails_every_test_with_the_reason(tmp_
     assert reasons(data)["load_in_pybullet"] == f"the compiled model cannot be loaded: {why}"
 
 
+def test_built_with_out_writes_the_protocol_there(tmp_path: Path) -> None:
+    write(tmp_path / "m.yml", definition(SOLO, "solo", "      - compare_amount_joints\n"))
+    assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "built").returncode == 0
+    run = mpc("test", tmp_path / "m.yml", "--built", tmp_path / "built", "-o", tmp_path / "reports")
+    data = protocol_of(tmp_path / "reports", run)
+    assert statuses(data)["compare_amount_joints"] == "skipped"
+    assert not (tmp_path / "built/test_protocol.md").exists()
+    assert run.stderr.endswith(f"wrote {tmp_path}/reports/test_protocol.md, test_protocol.json and "
+                               "test_protocol.junit.xml\n")
+
+
 def test_built_of_another_model_fails_process_double_check_and_masses_compare(tmp_path: Path) -> None:
     write(tmp_path / "m.yml", definition(SOLO, "solo", EVERY, compare="      path: ref\n"))
     assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "ref").returncode == 0
