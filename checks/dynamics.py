@@ -22,27 +22,32 @@ from mpc.ir.program import ModelTest
 from mpc.ir.tree import joints_up
 
 
-class _Missing(Exception):
+class _CheckFailed(Exception):
+    """Raised inside a check to end it with `result` (a failed one, with the reason)."""
+
     def __init__(self, result: Result) -> None:
         self.result = result
 
 
-def _dyn(model: Model, name: str, which: str) -> Any:
+def _dynamics_of(model: Model, name: str, which: str) -> Any:
+    """The model's Pinocchio model (dynamics_model.Dynamics); `which` names it in the reason."""
     try:
         return model.dynamics()
     except DynamicsError as e:
-        raise _Missing(failed(name, f"the {which} does not load in Pinocchio: {e}")) from None
+        raise _CheckFailed(failed(name, f"the {which} does not load in Pinocchio: {e}")) from None
 
 
 def _state(ctx: Context, model: Model, name: str, which: str) -> tuple[Any, np.ndarray]:
     """The model's dynamics and its q at the current configuration."""
-    dyn = _dyn(model, name, which)
+    dyn = _dynamics_of(model, name, which)
     # The compare model moves the joints the compiled model drives (its file may not say).
-    actuated = None if model is ctx.new or ctx.new is None else _dyn(ctx.new, name, "compiled model").actuated
+    actuated = None
+    if model is not ctx.new and ctx.new is not None:
+        actuated = _dynamics_of(ctx.new, name, "compiled model").actuated
     try:
         return dyn, dyn.configuration(ctx.configuration, actuated)
     except DynamicsError as e:
-        raise _Missing(failed(name, f"the {which}: {e}")) from None
+        raise _CheckFailed(failed(name, f"the {which}: {e}")) from None
 
 
 def _where(ctx: Context) -> str:
@@ -56,13 +61,13 @@ def _where(ctx: Context) -> str:
     return "at the configuration set"
 
 
-def _guard(fn: Any) -> Any:
+def _reasons_for_failures(fn: Any) -> Any:
     """A check whose model is missing, or whose mechanism Pinocchio cannot solve (a loop
     that does not close, actuated joints that cannot hold it), fails with that reason."""
     def run(ctx: Context, test: ModelTest) -> Result:
         try:
             return fn(ctx, test)
-        except _Missing as m:
+        except _CheckFailed as m:
             return m.result
         except DynamicsError as e:
             return failed(test.name, str(e))
@@ -70,14 +75,14 @@ def _guard(fn: Any) -> Any:
     return run
 
 
-def _both(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarray]:
+def _both_states(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarray]:
     a, qa = _state(ctx, ctx.built, test.name, "compiled model")
     b, qb = _state(ctx, ctx.compare, test.name, "compare model")
     return a, qa, b, qb
 
 
 @register("load_in_hyrodyn", dynamics=True)
-@_guard
+@_reasons_for_failures
 def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
     """The compiled model (and the compare model, when there is one) loads in the dynamics
     library, Pinocchio, with its loop closures."""
@@ -91,10 +96,10 @@ def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("compare_masses", dynamics=True, needs="both")
-@_guard
+@_reasons_for_failures
 def compare_masses(ctx: Context, test: ModelTest) -> Result:
     """|total mass − the compare model's| ≤ `mass` (both ways: a heavier model fails too)."""
-    a, _, b, _ = _both(ctx, test)
+    a, _, b, _ = _both_states(ctx, test)
     diff = a.total_mass() - b.total_mass()
     return verdict(test.name, abs(diff) <= ctx.tol.mass,
                    f"total mass {a.total_mass():.6g} kg, the compare model {b.total_mass():.6g} kg",
@@ -102,10 +107,10 @@ def compare_masses(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("compare_com", dynamics=True, needs="both")
-@_guard
+@_reasons_for_failures
 def compare_com(ctx: Context, test: ModelTest) -> Result:
     """‖COM − the compare model's COM‖ ≤ `distance`, in the root frame, at the configuration."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     ca, cb = a.com(qa), b.com(qb)
     dist = float(np.linalg.norm(ca - cb))
     return verdict(test.name, dist <= ctx.tol.distance,
@@ -114,13 +119,13 @@ def compare_com(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("compare_torques", dynamics=True, needs="both")
-@_guard
+@_reasons_for_failures
 def compare_torques(ctx: Context, test: ModelTest) -> Result:
     """The gravity torques of the compiled model's actuated joints (or the joints given) in
     both models, |Δτ| ≤ `default` (N·m or N), at the configuration; loops closed. The compare
     model is asked for the same joints' torques, so that a compare file that does not say
     which joints are driven (URDF, SDF) is measured like the compiled model."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     ta = a.gravity_torques(qa, test.links or None)
     tb = b.gravity_torques(qb, tuple(ta))
     joints = list(test.links) or list(ta)
@@ -143,11 +148,11 @@ def compare_torques(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("compare_link_positions", dynamics=True, needs="both")
-@_guard
+@_reasons_for_failures
 def compare_link_positions(ctx: Context, test: ModelTest) -> Result:
     """The given links' (every shared link's, when none is given) positions ≤ `distance` and
     orientations ≤ `rad` against the compare model, at the configuration."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     pa, pb = a.link_placements(qa), b.link_placements(qb)
     links = list(test.links) or sorted(set(pa) & set(pb))
     unknown = [n for n in links if n not in pa or n not in pb]
@@ -165,7 +170,7 @@ def _mirror(p: np.ndarray, plane: tuple[float, float, float]) -> np.ndarray:
 
 
 @register("symmetry_check", dynamics=True)
-@_guard
+@_reasons_for_failures
 def symmetry_check(ctx: Context, test: ModelTest) -> Result:
     """The right link's position is the left one's mirrored in the plane through the root's
     origin with normal `plane` (default y: the xz-plane), within `distance`."""
@@ -185,7 +190,7 @@ def symmetry_check(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("symmetry_check_torques", dynamics=True)
-@_guard
+@_reasons_for_failures
 def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
     """The actuated joints on the way to the left and the right link, pairwise from where the
     two ways part: equal magnitudes of gravity torque, ||τ_L| − |τ_R|| ≤ `default`. Magnitudes,
@@ -214,13 +219,13 @@ def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
 
 
 @register("move_hyrodyn_model", dynamics=True)
-@_guard
+@_reasons_for_failures
 def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     """Set the configuration of the dynamics checks that follow, for both models: one value
     for every joint, one per joint (in the compiled model's joint order), or by joint name.
     A configuration that cannot be set (an unknown joint, loops that do not close there)
     fails this check and leaves the configuration as it was."""
-    dyn = _dyn(ctx.built, test.name, "compiled model")
+    dyn = _dynamics_of(ctx.built, test.name, "compiled model")
     joints = dyn.joint_names()
     if test.joint_angles is not None:
         unknown = sorted(set(test.joint_angles) - set(joints))
@@ -238,7 +243,7 @@ def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     previous, ctx.configuration = ctx.configuration, values
     try:
         _state(ctx, ctx.built, test.name, "compiled model")  # the loops must close there
-    except _Missing:
+    except _CheckFailed:
         ctx.configuration = previous  # the checks after it keep the configuration they had
         raise
     return passed(test.name, f"the checks after this one run {_where(ctx)}",

@@ -1,7 +1,9 @@
 """The test registry and what every test sees: both models, the tolerances, the configuration.
 
 Each test is a function registered under its definition name (`@register("compare_com",
-dynamics=True)`), taking the context and its `ModelTest` entry and returning a Result.
+dynamics=True, needs="both")`), taking the context and its `ModelTest` entry and returning
+a Result. It runs only when the models it measures are there (`ctx.built`, and with
+needs="both" `ctx.compare`); else its result says why.
 """
 
 from __future__ import annotations
