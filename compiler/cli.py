@@ -187,9 +187,13 @@ def _test(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="mpc-test-") as work:
         protocol = run_model_tests(program, out, sink, workdir=Path(work), robot=robot)
     target = args.out if args.built is not None and args.out is not None else out  # -o with --built
-    protocol.write(target)
     _print_diagnostics(sink, args.format)
     print(protocol.markdown())
+    try:
+        protocol.write(target)
+    except OSError as e:
+        print(f"error: cannot write the test protocol into '{target}': {e.strerror or e}", file=sys.stderr)
+        return 1
     print(f"wrote {target / 'test_protocol.md'}, test_protocol.json and test_protocol.junit.xml",
           file=sys.stderr)
     return 1 if protocol.failed else 0

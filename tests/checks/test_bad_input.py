@@ -154,6 +154,17 @@ def test_built_with_out_writes_the_protocol_there(tmp_path: Path) -> None:
                                "test_protocol.junit.xml\n")
 
 
+def test_a_protocol_folder_that_is_a_file_is_an_error_not_a_crash(tmp_path: Path) -> None:
+    write(tmp_path / "m.yml", definition(SOLO, "solo", "      - compare_amount_joints\n"))
+    assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "built").returncode == 0
+    write(tmp_path / "reports", "a file\n")
+    run = mpc("test", tmp_path / "m.yml", "--built", tmp_path / "built", "-o", tmp_path / "reports")
+    assert run.returncode == 1
+    assert run.stderr.endswith(f"error: cannot write the test protocol into '{tmp_path}/reports': "
+                               "File exists\n")
+    assert run.stdout.startswith("## Model tests of `solo-model`: **passed**")  # still printed
+
+
 def test_built_of_another_model_fails_process_double_check_and_masses_compare(tmp_path: Path) -> None:
     write(tmp_path / "m.yml", definition(SOLO, "solo", EVERY, compare="      path: ref\n"))
     assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "ref").returncode == 0
