@@ -51,6 +51,7 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
         where = target.git or str(target.path)
         if ctx.old is None:
             sink.error(target.span, "E0704", ctx.old_problem)
+            protocol.compare = f"`{where}`, which could not be loaded"
         else:
             at = f" at commit `{ctx.old.commit[:12]}`" if ctx.old.commit else ""
             protocol.compare = f"`{where}`{at}"
