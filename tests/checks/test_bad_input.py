@@ -218,3 +218,18 @@ def test_a_loop_without_motors_fails_the_torque_checks_with_a_hint(tmp_path: Pat
     assert reasons(data)["compare_torques"] == why
     assert reasons(data)["symmetry_check_torques"] == why
     assert statuses(data)["load_in_hyrodyn"] == "passed"
+
+
+def test_zero_tolerances_are_exact_and_a_model_still_equals_itself(tmp_path: Path) -> None:
+    """Tolerances are absolute: at 0 a model compared with its own release passes every test
+    (no relative scaling, no noise from reading it twice), and each bound shows as ≤ 0."""
+    write(tmp_path / "m.yml", definition(SOLO, "solo", EVERY_TEST + "          - move_hyrodyn_model: 0.3\n"
+                                         "          - compare_torques\n", compare="      path: ref\n")
+          .replace("  test:\n", "  test:\n    tolerances: {default: 0, mass: 0, rad: 0, distance: 0}\n"))
+    assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "ref").returncode == 0
+    run = mpc("test", tmp_path / "m.yml", "-o", tmp_path / "out")
+    data = protocol_of(tmp_path / "out", run)
+    assert set(statuses(data).values()) == {"passed"}, run.stdout
+    assert "| `compare_torques 2` | ✅ passed | 0 N·m | `default` ≤ 0 N·m (absolute) |" in run.stdout
+    [masses] = [t for t in data["tests"] if t["name"] == "compare_masses"]
+    assert masses["tolerances"] == [{"name": "mass", "value": 0.0, "unit": "kg", "kind": "absolute"}]
