@@ -16,14 +16,10 @@ from mpc.ir.program import ModelTest
 def load_in_pybullet(ctx: Context, test: ModelTest) -> Result:
     """`loadURDF` of the compiled URDF in a DIRECT PyBullet, with URDF_USE_INERTIA_FROM_FILE;
     the figure is the number of links PyBullet made, which must be all of them."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    path = ctx.new.path
+    path = ctx.built.path
     if path.suffix != ".urdf":
         return failed(test.name, f"PyBullet is given a URDF; the model is '{path.name}' (add a urdf export)")
-    links = len(ctx.new.robot.links)
+    links = len(ctx.built.robot.links)
     with captured_fds() as log:
         import pybullet  # it prints its build time on import
 

@@ -13,39 +13,41 @@ from typing import Any
 
 import numpy as np
 
+from mpc.checks.dynamics_model import DynamicsError
 from mpc.checks.masses import pose_verdict, rotation_angle
 from mpc.checks.models import Model
-from mpc.checks.protocol import Result, failed, passed, verdict
+from mpc.checks.protocol import Result, failed, passed, skipped, vector_text, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.program import ModelTest
 from mpc.ir.tree import joints_up
 
 
-class _Missing(Exception):
+class _CheckFailed(Exception):
+    """Raised inside a check to end it with `result` (a failed one, with the reason)."""
+
     def __init__(self, result: Result) -> None:
         self.result = result
 
 
-def _dyn(model: Model, name: str, which: str) -> Any:
-    from mpc.checks.dynamics_model import DynamicsError
-
+def _dynamics_of(model: Model, name: str, which: str) -> Any:
+    """The model's Pinocchio model (dynamics_model.Dynamics); `which` names it in the reason."""
     try:
         return model.dynamics()
     except DynamicsError as e:
-        raise _Missing(failed(name, f"the {which} does not load in Pinocchio: {e}")) from None
+        raise _CheckFailed(failed(name, f"the {which} does not load in Pinocchio: {e}")) from None
 
 
 def _state(ctx: Context, model: Model, name: str, which: str) -> tuple[Any, np.ndarray]:
     """The model's dynamics and its q at the current configuration."""
-    from mpc.checks.dynamics_model import DynamicsError
-
-    dyn = _dyn(model, name, which)
+    dyn = _dynamics_of(model, name, which)
     # The compare model moves the joints the compiled model drives (its file may not say).
-    actuated = None if model is ctx.new or ctx.new is None else _dyn(ctx.new, name, "compiled model").actuated
+    actuated = None
+    if model is not ctx.new and ctx.new is not None:
+        actuated = _dynamics_of(ctx.new, name, "compiled model").actuated
     try:
         return dyn, dyn.configuration(ctx.configuration, actuated)
     except DynamicsError as e:
-        raise _Missing(failed(name, f"the {which}: {e}")) from None
+        raise _CheckFailed(failed(name, f"the {which}: {e}")) from None
 
 
 def _where(ctx: Context) -> str:
@@ -59,36 +61,32 @@ def _where(ctx: Context) -> str:
     return "at the configuration set"
 
 
-def _guard(fn: Any) -> Any:
+def _reasons_for_failures(fn: Any) -> Any:
+    """A check whose model is missing, or whose mechanism Pinocchio cannot solve (a loop
+    that does not close, actuated joints that cannot hold it), fails with that reason."""
     def run(ctx: Context, test: ModelTest) -> Result:
         try:
             return fn(ctx, test)
-        except _Missing as m:
+        except _CheckFailed as m:
             return m.result
+        except DynamicsError as e:
+            return failed(test.name, str(e))
     run.__doc__ = fn.__doc__
     return run
 
 
-def _both(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarray]:
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        raise _Missing(missing)
-    assert ctx.new is not None and ctx.old is not None
-    a, qa = _state(ctx, ctx.new, test.name, "compiled model")
-    b, qb = _state(ctx, ctx.old, test.name, "compare model")
+def _both_states(ctx: Context, test: ModelTest) -> tuple[Any, np.ndarray, Any, np.ndarray]:
+    a, qa = _state(ctx, ctx.built, test.name, "compiled model")
+    b, qb = _state(ctx, ctx.compare, test.name, "compare model")
     return a, qa, b, qb
 
 
 @register("load_in_hyrodyn", dynamics=True)
-@_guard
+@_reasons_for_failures
 def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
     """The compiled model (and the compare model, when there is one) loads in the dynamics
     library, Pinocchio, with its loop closures."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn, _ = _state(ctx, ctx.new, test.name, "compiled model")
+    dyn, _ = _state(ctx, ctx.built, test.name, "compiled model")
     if ctx.old is not None:
         _state(ctx, ctx.old, test.name, "compare model")
     n = len(dyn.constraints)
@@ -97,45 +95,45 @@ def load_in_hyrodyn(ctx: Context, test: ModelTest) -> Result:
                   figure=float(dyn.model.nv), unit="DoF")
 
 
-@register("compare_masses", dynamics=True)
-@_guard
+@register("compare_masses", dynamics=True, needs="both")
+@_reasons_for_failures
 def compare_masses(ctx: Context, test: ModelTest) -> Result:
     """|total mass − the compare model's| ≤ `mass` (both ways: a heavier model fails too)."""
-    a, _, b, _ = _both(ctx, test)
+    a, _, b, _ = _both_states(ctx, test)
     diff = a.total_mass() - b.total_mass()
     return verdict(test.name, abs(diff) <= ctx.tol.mass,
                    f"total mass {a.total_mass():.6g} kg, the compare model {b.total_mass():.6g} kg",
-                   figure=abs(diff), unit="kg", tolerance="mass", tolerance_value=ctx.tol.mass)
+                   figure=abs(diff), unit="kg", tolerances=ctx.bound("mass", "kg"))
 
 
-@register("compare_com", dynamics=True)
-@_guard
+@register("compare_com", dynamics=True, needs="both")
+@_reasons_for_failures
 def compare_com(ctx: Context, test: ModelTest) -> Result:
     """‖COM − the compare model's COM‖ ≤ `distance`, in the root frame, at the configuration."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     ca, cb = a.com(qa), b.com(qb)
     dist = float(np.linalg.norm(ca - cb))
     return verdict(test.name, dist <= ctx.tol.distance,
-                   f"COM {_vec(ca)} m, the compare model {_vec(cb)} m {_where(ctx)}", figure=dist, unit="m",
-                   tolerance="distance", tolerance_value=ctx.tol.distance)
+                   f"COM {vector_text(ca)} m, the compare model {vector_text(cb)} m {_where(ctx)}",
+                   figure=dist, unit="m", tolerances=ctx.bound("distance", "m"))
 
 
-@register("compare_torques", dynamics=True)
-@_guard
+@register("compare_torques", dynamics=True, needs="both")
+@_reasons_for_failures
 def compare_torques(ctx: Context, test: ModelTest) -> Result:
     """The gravity torques of the compiled model's actuated joints (or the joints given) in
     both models, |Δτ| ≤ `default` (N·m or N), at the configuration; loops closed. The compare
     model is asked for the same joints' torques, so that a compare file that does not say
     which joints are driven (URDF, SDF) is measured like the compiled model."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     ta = a.gravity_torques(qa, test.links or None)
     tb = b.gravity_torques(qb, tuple(ta))
     joints = list(test.links) or list(ta)
     unknown = [j for j in joints if j not in ta or j not in tb]
     if unknown:
         return failed(test.name, f"joint '{unknown[0]}' is not an actuated joint of both models")
-    if not joints:
-        return failed(test.name, "the models share no actuated joint")
+    if not joints:  # no joint to hold: nothing was measured, so nothing passed
+        return skipped(test.name, "the compiled model has no actuated joint")
     diffs = {j: ta[j] - tb[j] for j in joints}
     worst = max(joints, key=lambda j: (abs(diffs[j]), j))
     details = tuple(f"{j}: τ = {ta[j]:+.6g}, compare {tb[j]:+.6g}, Δ = {diffs[j]:+.3g}"
@@ -145,16 +143,16 @@ def compare_torques(ctx: Context, test: ModelTest) -> Result:
     return verdict(test.name, abs(diffs[worst]) <= ctx.tol.default,
                    f"{len(joints)} joint torques{loops} {_where(ctx)}, worst '{worst}' "
                    f"Δ = {diffs[worst]:+.3g}",
-                   figure=abs(diffs[worst]), unit="N·m", tolerance="default", tolerance_value=ctx.tol.default,
+                   figure=abs(diffs[worst]), unit="N·m", tolerances=ctx.bound("default", "N·m"),
                    details=details)
 
 
-@register("compare_link_positions", dynamics=True)
-@_guard
+@register("compare_link_positions", dynamics=True, needs="both")
+@_reasons_for_failures
 def compare_link_positions(ctx: Context, test: ModelTest) -> Result:
     """The given links' (every shared link's, when none is given) positions ≤ `distance` and
     orientations ≤ `rad` against the compare model, at the configuration."""
-    a, qa, b, qb = _both(ctx, test)
+    a, qa, b, qb = _both_states(ctx, test)
     pa, pb = a.link_placements(qa), b.link_placements(qb)
     links = list(test.links) or sorted(set(pa) & set(pb))
     unknown = [n for n in links if n not in pa or n not in pb]
@@ -172,40 +170,33 @@ def _mirror(p: np.ndarray, plane: tuple[float, float, float]) -> np.ndarray:
 
 
 @register("symmetry_check", dynamics=True)
-@_guard
+@_reasons_for_failures
 def symmetry_check(ctx: Context, test: ModelTest) -> Result:
     """The right link's position is the left one's mirrored in the plane through the root's
     origin with normal `plane` (default y: the xz-plane), within `distance`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn, q = _state(ctx, ctx.new, test.name, "compiled model")
+    dyn, q = _state(ctx, ctx.built, test.name, "compiled model")
     placements = dyn.link_placements(q)
     left, right = test.links
     for link in test.links:
         if link not in placements:
             return failed(test.name, f"link '{link}' is not in the model")
     pl, pr = placements[left][:3, 3], placements[right][:3, 3]
-    dist = float(np.linalg.norm(pr - _mirror(pl, test.plane)))
+    mirrored = _mirror(pl, test.plane)
+    dist = float(np.linalg.norm(pr - mirrored))
     return verdict(test.name, dist <= ctx.tol.distance,
-                   f"'{right}' at {_vec(pr)} m, '{left}' mirrored at {_vec(_mirror(pl, test.plane))} m "
-                   f"(plane normal {_vec(np.asarray(test.plane))})", figure=dist, unit="m",
-                   tolerance="distance", tolerance_value=ctx.tol.distance)
+                   f"'{right}' at {vector_text(pr)} m, '{left}' mirrored at {vector_text(mirrored)} m "
+                   f"(plane normal {vector_text(np.asarray(test.plane))})", figure=dist, unit="m",
+                   tolerances=ctx.bound("distance", "m"))
 
 
 @register("symmetry_check_torques", dynamics=True)
-@_guard
+@_reasons_for_failures
 def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
     """The actuated joints on the way to the left and the right link, pairwise from where the
     two ways part: equal magnitudes of gravity torque, ||τ_L| − |τ_R|| ≤ `default`. Magnitudes,
     because a mirrored joint axis may flip the sign."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
-    dyn, q = _state(ctx, ctx.new, test.name, "compiled model")
+    robot = ctx.built.robot
+    dyn, q = _state(ctx, ctx.built, test.name, "compiled model")
     for link in test.links:
         if link not in robot.links:
             return failed(test.name, f"link '{link}' is not in the model")
@@ -223,20 +214,18 @@ def symmetry_check_torques(ctx: Context, test: ModelTest) -> Result:
     figure = abs(diffs[worst]) if worst else 0.0
     return verdict(test.name, figure <= ctx.tol.default,
                    f"{len(diffs)} joint pairs {_where(ctx)}" + (f", worst {worst}" if worst else ""),
-                   figure=figure, unit="N·m", tolerance="default", tolerance_value=ctx.tol.default,
+                   figure=figure, unit="N·m", tolerances=ctx.bound("default", "N·m"),
                    details=tuple(f"{k}: {v:+.3g}" for k, v in diffs.items()))
 
 
 @register("move_hyrodyn_model", dynamics=True)
-@_guard
+@_reasons_for_failures
 def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     """Set the configuration of the dynamics checks that follow, for both models: one value
-    for every joint, one per joint (in the compiled model's joint order), or by joint name."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    dyn = _dyn(ctx.new, test.name, "compiled model")
+    for every joint, one per joint (in the compiled model's joint order), or by joint name.
+    A configuration that cannot be set (an unknown joint, loops that do not close there)
+    fails this check and leaves the configuration as it was."""
+    dyn = _dynamics_of(ctx.built, test.name, "compiled model")
     joints = dyn.joint_names()
     if test.joint_angles is not None:
         unknown = sorted(set(test.joint_angles) - set(joints))
@@ -251,11 +240,12 @@ def move_hyrodyn_model(ctx: Context, test: ModelTest) -> Result:
     else:
         assert test.angle is not None
         values = dict.fromkeys(dyn.actuated if dyn.constraints else joints, test.angle)
-    ctx.configuration = values
-    _state(ctx, ctx.new, test.name, "compiled model")  # the loops must close there
+    previous, ctx.configuration = ctx.configuration, values
+    try:
+        _state(ctx, ctx.built, test.name, "compiled model")  # the loops must close there
+    except _CheckFailed:
+        ctx.configuration = previous  # the checks after it keep the configuration they had
+        raise
     return passed(test.name, f"the checks after this one run {_where(ctx)}",
                   details=tuple(f"{k} = {v:g}" for k, v in values.items()))
 
-
-def _vec(v: np.ndarray) -> str:
-    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"

@@ -8,6 +8,10 @@ A cut joint becomes a `pin.RigidConstraintModel` between the parent joints of it
 continuous and universal ones (a revolute closure's two rotational constraints are left
 out: in a planar loop they are redundant, in a spatial one the mechanism is then checked
 as if the closure were a ball joint).
+
+A mimic joint (URDF `<mimic>`) follows its joint, q_k = multiplier · q_j + offset: it is not
+actuated and not set by a configuration; the coupling is one more constraint row, so the
+torque of the joint it follows includes its load (τ_j = g_j + multiplier · g_k).
 """
 
 from __future__ import annotations
@@ -28,6 +32,16 @@ class DynamicsError(Exception):
     """The model cannot be built or moved in Pinocchio; the message says why."""
 
 
+@dataclass(frozen=True)
+class MimicCoupling:
+    """q_follower = multiplier · q_leader + offset; Pinocchio joint ids of one-coordinate joints."""
+
+    follower: int
+    leader: int
+    multiplier: float
+    offset: float
+
+
 @dataclass
 class Dynamics:
     """A Pinocchio model of a robot, its loop constraints and which joints are actuated.
@@ -41,13 +55,25 @@ class Dynamics:
     data: Any
     constraints: list[Any]
     actuated: tuple[str, ...]
+    mimics: tuple[MimicCoupling, ...] = ()
 
     # -- configurations ---------------------------------------------------------------------
 
     def joint_names(self) -> list[str]:
-        """The movable joints with one degree of freedom, in Pinocchio's (depth-first) order."""
+        """The movable joints with one degree of freedom, in Pinocchio's (depth-first) order;
+        mimic joints left out (they follow another joint)."""
         m = self.model
-        return [m.names[j] for j in range(1, m.njoints) if m.nvs[j] == 1]
+        return [m.names[j] for j in range(1, m.njoints) if m.nvs[j] == 1 and m.names[j] not in self.followers]
+
+    @property
+    def followers(self) -> frozenset[str]:
+        """The mimic joints: their values follow other joints."""
+        return _followers(self.robot)
+
+    @property
+    def coupled(self) -> bool:
+        """Whether q has couplings to satisfy: loop closures or mimic joints."""
+        return bool(self.constraints or self.mimics)
 
     def configuration(self, values: Mapping[str, float],
                       actuated: tuple[str, ...] | None = None) -> np.ndarray:
@@ -66,10 +92,10 @@ class Dynamics:
                     q[m.idx_qs[j]:m.idx_qs[j] + 2] = np.cos(value), np.sin(value)
                 else:
                     q[m.idx_qs[j]] = value
-        if not self.constraints:
+        if not self.coupled:
             return q
         fixed = {m.idx_vs[m.getJointId(n)] for n in (self.actuated if actuated is None else actuated)
-                 if m.existJointName(n)}
+                 if m.existJointName(n) and n not in self.followers}
         free = [i for i in range(m.nv) if i not in fixed]
         for _ in range(50):
             r, J = self.residual(q)
@@ -85,13 +111,20 @@ class Dynamics:
         return q
 
     def residual(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The loop closures' error (position, and rotation for 6D ones) and its Jacobian."""
+        """The loop closures' error (position, and rotation for 6D ones) and the mimic
+        couplings' error, and its Jacobian."""
         import pinocchio as pin
 
         m, d = self.model, self.data
         pin.computeJointJacobians(m, d, q)
         pin.updateFramePlacements(m, d)
         errors, rows = [], []
+        for c in self.mimics:
+            follower, leader = q[m.idx_qs[c.follower]], q[m.idx_qs[c.leader]]
+            errors.append(np.array([follower - c.multiplier * leader - c.offset]))
+            row = np.zeros((1, m.nv))
+            row[0, m.idx_vs[c.follower]], row[0, m.idx_vs[c.leader]] = 1.0, -c.multiplier
+            rows.append(row)
         for c in self.constraints:
             A = d.oMi[c.joint1_id] * c.joint1_placement
             B = d.oMi[c.joint2_id] * c.joint2_placement
@@ -149,8 +182,8 @@ class Dynamics:
         g = pin.computeGeneralizedGravity(m, self.data, q)
         joints = self.actuated if actuated is None else actuated
         index = {n: m.idx_vs[m.getJointId(n)] for n in joints
-                 if m.existJointName(n) and m.nvs[m.getJointId(n)] == 1}
-        if not self.constraints:
+                 if m.existJointName(n) and m.nvs[m.getJointId(n)] == 1 and n not in self.followers}
+        if not self.coupled:
             return {n: float(g[i]) for n, i in index.items()}
         _, J = self.residual(q)
         S = np.zeros((m.nv, len(index)))
@@ -168,8 +201,10 @@ class Dynamics:
         rank = int(np.sum(sv > 1e-10 * sv[0])) if sv.size else 0
         null = vt[rank:, :len(index)]
         if null.size and np.max(np.abs(null)) > 1e-8:
+            hint = "" if self.robot.motors else (": without motors every movable joint counts as "
+                                                 "actuated; mark the driven ones `active: true` in `joints`")
             raise DynamicsError(f"the actuated joints ({', '.join(index)}) do not determine their torques "
-                                "(the mechanism is overactuated)")
+                                f"(the mechanism is overactuated{hint})")
         return {n: float(x[k]) for k, n in enumerate(index)}
 
 
@@ -197,11 +232,37 @@ def build(robot: Robot) -> Dynamics:
     constraints = []
     for cut in sorted(robot.cut_joints.values(), key=lambda c: c.name):
         constraints.append(_constraint(pin, model, robot, cut))
-    movable = [model.names[j] for j in range(1, model.njoints) if model.nvs[j] == 1]
+    mimics = _mimic_couplings(model, robot)
+    followers = _followers(robot)
+    movable = [model.names[j] for j in range(1, model.njoints)
+               if model.nvs[j] == 1 and model.names[j] not in followers]
     motors = {m.joint for m in robot.motors.values()} or _active_in_submechanisms(robot)
     actuated = [n for n in movable if n in motors] if constraints and motors else movable
     return Dynamics(robot=robot, model=model, data=model.createData(), constraints=constraints,
-                    actuated=tuple(actuated))
+                    actuated=tuple(actuated), mimics=mimics)
+
+
+def _followers(robot: Robot) -> frozenset[str]:
+    return frozenset(j.name for j in robot.joints.values() if j.mimic is not None)
+
+
+def _mimic_couplings(model: Any, robot: Robot) -> tuple[MimicCoupling, ...]:
+    """The couplings of the robot's mimic joints (revolute and prismatic ones)."""
+    out = []
+    for joint in sorted(robot.joints.values(), key=lambda j: j.name):
+        if joint.mimic is None:
+            continue
+        ids = []
+        for name in (joint.name, joint.mimic.joint):
+            jid = model.getJointId(name) if model.existJointName(name) else 0
+            if not jid or model.nqs[jid] != 1 or model.nvs[jid] != 1:
+                raise DynamicsError(f"mimic joint '{joint.name}' follows '{joint.mimic.joint}': only "
+                                    "revolute and prismatic joints can be coupled")
+            ids.append(jid)
+        multiplier = 1.0 if joint.mimic.multiplier is None else joint.mimic.multiplier
+        offset = 0.0 if joint.mimic.offset is None else joint.mimic.offset
+        out.append(MimicCoupling(follower=ids[0], leader=ids[1], multiplier=multiplier, offset=offset))
+    return tuple(out)
 
 
 def _active_in_submechanisms(robot: Robot) -> set[str]:

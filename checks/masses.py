@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpc.checks.protocol import Result, failed, skipped, verdict
+from mpc.checks.protocol import Result, Tolerance, failed, skipped, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.kinematics import link_in_root
 from mpc.ir.program import ModelTest
@@ -14,7 +14,9 @@ from mpc.ir.tree import joints_up
 
 
 def link_mass(robot: Robot, link: str) -> float:
-    inertial = robot.links[link].inertial
+    """The link's mass; 0 for a link without inertial and for a link the robot lacks."""
+    found = robot.links.get(link)
+    inertial = found.inertial if found is not None else None
     return inertial.mass if inertial is not None else 0.0
 
 
@@ -27,43 +29,38 @@ def rotation_angle(R: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)))
 
 
-@register("compare_link_masses")
+@register("compare_link_masses", needs="both")
 def compare_link_masses(ctx: Context, test: ModelTest) -> Result:
     """Every link's mass against the compare model's, |Δm| ≤ `mass`. A link in only one of
     the models counts with its whole mass (a mass that appeared or disappeared)."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    new, old = ctx.new.robot, ctx.old.robot
+    new, old = ctx.built.robot, ctx.compare.robot
     diffs = {n: link_mass(new, n) - link_mass(old, n) for n in set(new.links) | set(old.links)}
-    return _worst(test.name, diffs, ctx.tol.mass, "mass", "kg", "link mass", "link masses")
+    return differences_verdict(test.name, diffs, *ctx.bound("mass", "kg"), "link mass", "link masses")
 
 
-def _worst(name: str, diffs: dict[str, float], tol: float, tol_name: str, unit: str, what: str,
-           whats: str = "") -> Result:
+def differences_verdict(name: str, diffs: dict[str, float], bound: Tolerance, what: str,
+                        whats: str = "") -> Result:
+    """A verdict over named differences (Δ per link or link pair): every |Δ| ≤ the bound;
+    the figure is the worst |Δ|."""
+    tol, unit = bound.value, bound.unit
     order = sorted(diffs, key=lambda n: (-abs(diffs[n]), n))
     worst = abs(diffs[order[0]]) if order else 0.0
     bad = [n for n in order if abs(diffs[n]) > tol]
     details = tuple(f"{n}: Δ = {diffs[n]:+.6g} {unit}" for n in order if abs(diffs[n]) > 0)
     whats = whats or what + "s"
-    reason = (f"{len(bad)} {what if len(bad) == 1 else whats} differ by more than {tol:g} {unit}, most "
+    differ = f"{what} differs" if len(bad) == 1 else f"{whats} differ"
+    reason = (f"{len(bad)} {differ} by more than {tol:g} {unit}, most "
               f"'{bad[0]}' by {diffs[bad[0]]:+.6g} {unit}") if bad else \
         f"{len(diffs)} {whats} within {tol:g} {unit}"
-    return verdict(name, not bad, reason, figure=worst, unit=unit, tolerance=tol_name, tolerance_value=tol,
-                   details=details)
+    return verdict(name, not bad, reason, figure=worst, unit=unit, tolerances=(bound,), details=details)
 
 
-@register("compare_link_transformations")
+@register("compare_link_transformations", needs="both")
 def compare_link_transformations(ctx: Context, test: ModelTest) -> Result:
     """Every link's pose in the root at q = 0 against the compare model's: the position error
     ≤ `distance` and the geodesic rotation angle of X_old⁻¹·X_new ≤ `rad`. Links in only
     one model are left to topological_self_consistency."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    new, old = ctx.new.robot, ctx.old.robot
+    new, old = ctx.built.robot, ctx.compare.robot
     rows = []
     for link in sorted(set(new.links) & set(old.links)):
         X_new, X_old = link_in_root(new, link), link_in_root(old, link)
@@ -86,28 +83,24 @@ def pose_verdict(name: str, rows: list[tuple[str, float, float]], distance: floa
     else:
         reason = (f"{len(rows)} links within {distance:g} m and {rad:g} rad "
                   f"(worst rotation {worst_angle:.3g} rad)")
-    return verdict(name, not bad, reason, figure=worst, unit="m", tolerance="distance, rad",
-                   tolerance_value=distance, details=details)
+    bounds = (Tolerance("distance", distance, "m"), Tolerance("rad", rad, "rad"))
+    return verdict(name, not bad, reason, figure=worst, unit="m", tolerances=bounds, details=details)
 
 
 @register("total_mass")
 def total_mass(ctx: Context, test: ModelTest) -> Result:
     """The model's total mass against the expected one (the argument, else `expected_mass`
     from test_data_file): |m − expected| ≤ `mass`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
     expected = test.value if test.value is not None else ctx.plan.expected_mass
     if expected is None:
         return skipped(test.name, "no expected mass: give one (`- total_mass: 12.5`) or a test_data_file "
                        "with test_data: {expected_mass: …}")
-    mass = total_mass_of(ctx.new.robot)
+    mass = total_mass_of(ctx.built.robot)
     diff = mass - expected
     old = f"; the compare model has {total_mass_of(ctx.old.robot):.6g} kg" if ctx.old else ""
     return verdict(test.name, abs(diff) <= ctx.tol.mass,
                    f"total mass {mass:.6g} kg, expected {expected:.6g} kg{old}", figure=abs(diff), unit="kg",
-                   tolerance="mass", tolerance_value=ctx.tol.mass)
+                   tolerances=ctx.bound("mass", "kg"))
 
 
 def chain(robot: Robot, link: str) -> list[str]:
@@ -119,11 +112,7 @@ def chain(robot: Robot, link: str) -> list[str]:
 def symmetry_check_masses(ctx: Context, test: ModelTest) -> Result:
     """The links on the way from the root to the left and to the right link, pairwise from
     where the two ways part: equal in number and |m_L − m_R| ≤ `mass`."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
+    robot = ctx.built.robot
     left, right = test.links
     for link in test.links:
         if link not in robot.links:
@@ -137,4 +126,4 @@ def symmetry_check_masses(ctx: Context, test: ModelTest) -> Result:
         return failed(test.name, f"the way to '{left}' has {len(a)} links after the branch, the way to "
                       f"'{right}' {len(b)}", details=(" → ".join(a), " → ".join(b)))
     diffs = {f"{x} / {y}": link_mass(robot, x) - link_mass(robot, y) for x, y in zip(a, b, strict=True)}
-    return _worst(test.name, diffs, ctx.tol.mass, "mass", "kg", "link pair")
+    return differences_verdict(test.name, diffs, *ctx.bound("mass", "kg"), "link pair")

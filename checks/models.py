@@ -17,6 +17,7 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
+from mpc.ir.span import Span
 
 
 @dataclass
@@ -51,6 +52,7 @@ def read_model(path: Path, sink: Sink) -> Robot | None:
     if path.suffix.lower() == ".smurf":
         urdf = _urdf_of_smurf(path)
         if urdf is None:
+            sink.error(Span.of_file(str(path)), "E0704", "the SMURF file lists no URDF in `files`")
             return None
         path = urdf
     from mpc.backends.urdf_reader import read as read_urdf
@@ -168,7 +170,8 @@ def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]
     workdir.mkdir(parents=True, exist_ok=True)
     try:
         kwargs = {"branch": target.branch} if target.branch else {}
-        repo = git.Repo.clone_from(target.git, folder, **kwargs)
+        # never ask for credentials: a CI job has no terminal to answer
+        repo = git.Repo.clone_from(target.git, folder, env={"GIT_TERMINAL_PROMPT": "0"}, **kwargs)
         if target.commit:
             repo.git.checkout(target.commit)
         commit = repo.head.commit.hexsha
@@ -181,9 +184,12 @@ def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]
 
 
 def _git_error(e: Exception) -> str:
+    """git's own complaint (its last `fatal:` or `error:` line), without GitPython's framing."""
     text = str(getattr(e, "stderr", "") or e)
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
-    return lines[-1].removeprefix("stderr: ").strip("'") if lines else type(e).__name__
+    lines = [ln.strip().removeprefix("stderr: ").strip("'").strip() for ln in text.splitlines()]
+    lines = [ln for ln in lines if ln]
+    said = [ln for ln in lines if ln.startswith(("fatal:", "error:"))]
+    return (said or lines or [type(e).__name__])[-1]
 
 
 def _first_error(sink: Sink) -> str:

@@ -4,9 +4,10 @@ left its mark on the written model) and file_consistency (no file of the compare
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
-from mpc.checks.protocol import Result, failed, passed, skipped
+from mpc.checks.protocol import Result, failed, first_of, passed, skipped
 from mpc.checks.registry import Context, register
 from mpc.ir.geometry import Mesh
 from mpc.ir.ops import AddCutJoint, EditJoint, RemoveJoint, SetMotor, SetRobotName
@@ -22,15 +23,17 @@ def _close(a: float | None, b: float | None) -> bool:
     return a is not None and b is not None and abs(a - b) <= 1e-9 * max(1.0, abs(a), abs(b))
 
 
-def op_marks(ctx: Context, built: Robot, robot: Robot) -> tuple[list[str], int]:
-    """Problems with the marks the ops should have left, and how many marks were checked.
+def op_marks(ops: Sequence[object], built: Robot, robot: Robot) -> tuple[list[str], int]:
+    """Problems with the marks the ops should have left on the written model `built` (with
+    the cut joints and motors the definition lends it), and how many marks were checked.
+    `robot` is the definition applied.
 
     A name an op used may have been renamed or removed by a later op; such a mark is not
     looked for (the names of the whole model are compared separately)."""
     problems: list[str] = []
     checked = 0
     last_edit: dict[str, EditJoint] = {}
-    for op in ctx.program.ops:
+    for op in ops:
         if isinstance(op, EditJoint):
             last_edit[op.joint] = op
         elif isinstance(op, RemoveJoint) and op.joint not in robot.joints:
@@ -43,11 +46,11 @@ def op_marks(ctx: Context, built: Robot, robot: Robot) -> tuple[list[str], int]:
                 problems.append(f"the robot is named '{built.name}', not '{op.name}'")
         elif isinstance(op, AddCutJoint) and op.joint not in robot.joints:
             checked += 1
-            if op.joint not in ctx.new.robot.cut_joints:  # type: ignore[union-attr]
+            if op.joint not in built.cut_joints:
                 problems.append(f"cut joint '{op.joint}' is missing")
         elif isinstance(op, SetMotor) and op.joint in robot.joints:
             checked += 1
-            if not any(m.joint == op.joint for m in ctx.new.robot.motors.values()):  # type: ignore[union-attr]
+            if not any(m.joint == op.joint for m in built.motors.values()):
                 problems.append(f"joint '{op.joint}' has no motor")
         elif isinstance(op, AddFrame) and op.link in robot.links:
             checked += 1
@@ -89,11 +92,7 @@ def process_double_check(ctx: Context, test: ModelTest) -> Result:
     """The written model has exactly the links and joints the definition produces, every
     operation's mark (removed joints absent, set limits and types present, the robot's name,
     frames, cut joints, motors), and every mesh file it references."""
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    built = ctx.new.robot
+    built = ctx.built.robot
     problems = _mesh_problems(built)
     checked = 0
     if ctx.robot is not None:
@@ -101,14 +100,13 @@ def process_double_check(ctx: Context, test: ModelTest) -> Result:
         for kind, want, have in (("link", robot.links, built.links), ("joint", robot.joints, built.joints)):
             problems += [f"{kind} '{n}' of the definition is missing" for n in sorted(set(want) - set(have))]
             problems += [f"{kind} '{n}' is not in the definition" for n in sorted(set(have) - set(want))]
-        marks, checked = op_marks(ctx, built, robot)
+        marks, checked = op_marks(ctx.program.ops, built, robot)
         problems += marks
     reason = f"{checked} operations checked, {len(built.links)} links, {len(built.joints)} joints, mesh files"
     if ctx.robot is None:
         reason += " (the definition could not be applied: only mesh files checked)"
     if problems:
-        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
-        return failed(test.name, problems[0] + more,
+        return failed(test.name, first_of(problems),
                       figure=float(len(problems)), unit="problems", details=tuple(problems))
     return passed(test.name, reason, figure=0.0, unit="problems")
 
@@ -126,17 +124,13 @@ def _files(folder: Path) -> set[str]:
     return out
 
 
-@register("file_consistency")
+@register("file_consistency", needs="both")
 def file_consistency(ctx: Context, test: ModelTest) -> Result:
     """No file of the compare model's folder is missing from the output (meshes, PDFs,
     Graphviz files, README.md, manifest.xml and git files aside)."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    if ctx.old.path == ctx.old.folder:
+    if ctx.compare.path == ctx.compare.folder:
         return skipped(test.name, "the compare model is a single file, not a folder")
-    old, new = _files(ctx.old.folder), _files(ctx.new.folder)
+    old, new = _files(ctx.compare.folder), _files(ctx.built.folder)
     lost = sorted(old - new)
     added = sorted(new - old)
     details = (*(f"missing: {f}" for f in lost), *(f"added: {f}" for f in added))

@@ -8,13 +8,29 @@ passed. The protocol fails when a test failed and was not waived.
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 from xml.sax.saxutils import escape, quoteattr
 
 Status = Literal["passed", "failed", "waived", "skipped"]
+# Characters XML 1.0 cannot hold, even escaped (a library's console may print them).
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 _SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
+
+
+@dataclass(frozen=True, slots=True)
+class Tolerance:
+    """A bound a figure was held to: `|figure| ≤ value` in `unit`, always absolute (a
+    tolerance is never a fraction of the compared value). name: its key in `tolerances`."""
+
+    name: str
+    value: float
+    unit: str
+
+    def __str__(self) -> str:
+        return f"`{self.name}` ≤ {self.value:g}{' ' + self.unit if self.unit else ''}"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -24,7 +40,8 @@ class Result:
     name: the test's definition name (`compare_com`, …), with ` 2`, ` 3` for repeats.
     status: passed / failed / waived / skipped. reason: why, in one sentence.
     figure: the measured value the verdict rests on (the worst one), with `unit`.
-    tolerance: the name of the tolerance it was measured against, and its value.
+    tolerances: the bounds it was held to (absolute; two for a pose: distance and angle);
+    none for an exact comparison or a test without a figure.
     details: lines for the protocol (per link, per joint …), worst first.
     log: what a library printed meanwhile (PyBullet's console).
     """
@@ -34,8 +51,7 @@ class Result:
     reason: str = ""
     figure: float | None = None
     unit: str = ""
-    tolerance: str = ""
-    tolerance_value: float | None = None
+    tolerances: tuple[Tolerance, ...] = ()
     details: tuple[str, ...] = ()
     log: str = ""
 
@@ -121,7 +137,8 @@ class Protocol:
             "model": self.model, "failed": self.failed, "counts": self.counts(),
             "compare": self.compare, "waiver": self.waiver,
             "tests": [{"name": r.name, "status": r.status, "reason": r.reason, "figure": r.figure,
-                       "unit": r.unit, "tolerance": r.tolerance, "tolerance_value": r.tolerance_value,
+                       "unit": r.unit, "tolerances": [{"name": t.name, "value": t.value, "unit": t.unit,
+                                                       "kind": "absolute"} for t in r.tolerances],
                        "details": list(r.details), "log": r.log} for r in self.results],
         }
 
@@ -129,21 +146,22 @@ class Protocol:
         c = self.counts()
         out = ['<?xml version="1.0" encoding="UTF-8"?>',
                f'<testsuites name="mpc test" tests="{len(self.results)}" failures="{c["failed"]}">',
-               f'  <testsuite name={quoteattr(self.model)} tests="{len(self.results)}" '
+               f'  <testsuite name={_xml_attribute(self.model)} tests="{len(self.results)}" '
                f'failures="{c["failed"]}" skipped="{c["skipped"] + c["waived"]}" errors="0">']
         for r in self.results:
-            head = f'    <testcase classname={quoteattr(self.model)} name={quoteattr(r.name)}'
-            text = "\n".join([f"{_figure(r)} (tolerance {_tolerance(r)})", *r.details])
+            head = f'    <testcase classname={_xml_attribute(self.model)} name={_xml_attribute(r.name)}'
+            measured = [] if r.figure is None else [f"{_figure(r)} (tolerance {_tolerance(r) or 'none'})"]
+            text = "\n".join([*measured, *r.details])
             if r.status == "passed" and not r.log:
                 out.append(head + "/>")
                 continue
             out.append(head + ">")
             if r.status == "failed":
-                out.append(f"      <failure message={quoteattr(r.reason)}>{escape(text)}</failure>")
+                out.append(f"      <failure message={_xml_attribute(r.reason)}>{_xml_text(text)}</failure>")
             elif r.status in ("skipped", "waived"):
-                out.append(f"      <skipped message={quoteattr(r.status + ': ' + r.reason)}/>")
+                out.append(f"      <skipped message={_xml_attribute(r.status + ': ' + r.reason)}/>")
             if r.log:
-                out.append(f"      <system-out>{escape(r.log)}</system-out>")
+                out.append(f"      <system-out>{_xml_text(r.log)}</system-out>")
             out.append("    </testcase>")
         out += ["  </testsuite>", "</testsuites>"]
         return "\n".join(out) + "\n"
@@ -157,14 +175,31 @@ class Protocol:
         (folder / "test_protocol.junit.xml").write_text(self.junit(), encoding="utf-8")
 
 
+def first_of(problems: list[str]) -> str:
+    """The first problem, and how many more there are: a reason for the protocol's table."""
+    return problems[0] + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else "")
+
+
+def vector_text(v: object) -> str:
+    """A 3-vector for a reason: (0.1, -0.2, 0.3), four significant digits."""
+    return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"  # type: ignore[attr-defined]
+
+
+def _xml_text(text: str) -> str:
+    """`text` escaped for XML content, with characters XML cannot hold dropped."""
+    return escape(_NOT_XML.sub("", text))
+
+
+def _xml_attribute(text: str) -> str:
+    return quoteattr(_NOT_XML.sub("", text))
+
+
 def _figure(r: Result) -> str:
     return "" if r.figure is None else f"{r.figure:.6g}{' ' + r.unit if r.unit else ''}"
 
 
 def _tolerance(r: Result) -> str:
-    if not r.tolerance:
-        return ""
-    return r.tolerance if r.tolerance_value is None else f"`{r.tolerance}` = {r.tolerance_value:g}"
+    return ", ".join(map(str, r.tolerances)) + " (absolute)" if r.tolerances else ""
 
 
 def _cell(text: str) -> str:

@@ -8,10 +8,11 @@ A test that raises does not end the others: it fails with the exception as its r
 from __future__ import annotations
 
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 
 from mpc.checks import bullet, dynamics, masses, process, topology, validity  # noqa: F401  (registration)
-from mpc.checks.models import load_built, load_compare
+from mpc.checks.models import Model, load_built, load_compare
 from mpc.checks.protocol import Protocol, Result, failed
 from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
 from mpc.compiler.diagnostics import Sink
@@ -41,15 +42,16 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     if robot is None:
         quiet = Sink()  # the build reported these already
         robot = apply_program(program, quiet)
-    new, new_problem = load_built(program, built, robot)
+    new, new_problem = _load(load_built, program, built, robot)
     ctx = Context(program=program, plan=plan, sink=sink, new=new, new_problem=new_problem, robot=robot)
     protocol = Protocol(model=program.modelname)
     if plan.compare is not None:
-        ctx.old, ctx.old_problem = load_compare(plan.compare, workdir)
+        ctx.old, ctx.old_problem = _load(load_compare, plan.compare, workdir)
         target = plan.compare
         where = target.git or str(target.path)
         if ctx.old is None:
             sink.error(target.span, "E0704", ctx.old_problem)
+            protocol.compare = f"`{where}`, which could not be loaded"
         else:
             at = f" at commit `{ctx.old.commit[:12]}`" if ctx.old.commit else ""
             protocol.compare = f"`{where}`{at}"
@@ -67,6 +69,21 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     return protocol
 
 
+def _load(loader: Callable[..., tuple[Model | None, str]], *args: object) -> tuple[Model | None, str]:
+    """A model loader's answer; should it raise (a bug in mpc), the exception is the reason,
+    so that the tests still run and the protocol is still written."""
+    try:
+        return loader(*args)
+    except Exception as e:
+        return None, f"{_bug(e)}"
+
+
+def _bug(e: Exception) -> str:
+    where = traceback.extract_tb(e.__traceback__)[-1]
+    return (f"a bug in mpc, please report it: {type(e).__name__}: {e} at "
+            f"{Path(where.filename).name}:{where.lineno}")
+
+
 def _run(ctx: Context, test: ModelTest) -> Result:
     fn = (DYNAMICS_CHECKS if test.dynamics else TESTS).get(test.name)
     if fn is None:  # the schema knows it, no check implements it
@@ -74,6 +91,4 @@ def _run(ctx: Context, test: ModelTest) -> Result:
     try:
         return fn(ctx, test)
     except Exception as e:  # a bug in a check must not end the other tests
-        where = traceback.extract_tb(e.__traceback__)[-1]
-        return failed(test.name, f"the test itself failed (a bug in mpc, please report it): "
-                      f"{type(e).__name__}: {e} at {Path(where.filename).name}:{where.lineno}")
+        return failed(test.name, f"the test itself failed ({_bug(e)})")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mpc.checks.protocol import Result, failed, passed, verdict
+from mpc.checks.protocol import Result, failed, first_of, passed, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.program import ModelTest
 from mpc.ir.robot import Robot
@@ -44,11 +44,7 @@ def topological_self_consistency(ctx: Context, test: ModelTest) -> Result:
     """The model is a tree; against the compare model no link or joint was removed or
     renamed and no joint changed its type. Additions are reported, not failed."""
     name = test.name
-    missing = ctx.need_new(name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    new = ctx.new.robot
+    new = ctx.built.robot
     problems = tree_problems(new)
     details: list[str] = []
     if ctx.old is not None:
@@ -67,20 +63,16 @@ def topological_self_consistency(ctx: Context, test: ModelTest) -> Result:
     what = "a tree" + (" with no breaking change against the compare model" if ctx.old else
                        " (no compare model: only the tree was checked)" if ctx.plan.compare is None else "")
     if problems:
-        return failed(name, problems[0] + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""),
-                      figure=float(len(problems)), unit="problems", details=(*problems, *details))
+        return failed(name, first_of(problems), figure=float(len(problems)), unit="problems",
+                      details=(*problems, *details))
     return passed(name, what, figure=0.0, unit="problems", details=tuple(details))
 
 
-@register("compare_amount_joints")
+@register("compare_amount_joints", needs="both")
 def compare_amount_joints(ctx: Context, test: ModelTest) -> Result:
     """The same number of movable joints as the compare model."""
-    missing = ctx.need_both(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None and ctx.old is not None
-    count_new = sum(j.type in MOVABLE for j in ctx.new.robot.joints.values())
-    count_old = sum(j.type in MOVABLE for j in ctx.old.robot.joints.values())
+    count_new = sum(j.type in MOVABLE for j in ctx.built.robot.joints.values())
+    count_old = sum(j.type in MOVABLE for j in ctx.compare.robot.joints.values())
     return verdict(test.name, count_new == count_old,
-                   f"{count_new} movable joints, the compare model has {count_old}",
-                   figure=float(count_new - count_old), unit="joints", tolerance="exact", tolerance_value=0.0)
+                   f"{count_new} movable joints, the compare model has {count_old} (compared exactly)",
+                   figure=float(count_new - count_old), unit="joints")

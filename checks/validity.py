@@ -1,6 +1,8 @@
 """physical_validity (always run): is each link physically possible?
 
-- every movable joint moves a body with mass > 0 (its child with the fixed-joint descendants);
+- every movable joint carries mass > 0: its child or a link beyond it (a massless link between
+  two joints of a 2- or 3-DoF joint is fine; a joint that moves nothing makes the mass
+  matrix singular);
 - each inertia tensor (mass > 0) is positive definite and its principal moments satisfy the
   triangle inequality A + B ≥ C, with a tolerance relative to the largest moment (1e-6:
   what the six written digits of a URDF inertia can carry);
@@ -15,8 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mpc.checks.protocol import Result, failed, passed
+from mpc.checks.protocol import Result, failed, first_of, passed, vector_text
 from mpc.checks.registry import Context, register
+from mpc.checks.topology import MOVABLE
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.program import ModelTest
@@ -25,7 +28,6 @@ from mpc.ir.span import Span
 from mpc.ir.tree import child_joints
 
 RELATIVE = 1e-6
-MOVABLE = frozenset({"revolute", "continuous", "prismatic", "floating", "planar"})
 
 
 def principal_moments(i: Inertia) -> np.ndarray:
@@ -38,10 +40,10 @@ def inertia_problem(i: Inertia) -> str:
     moments = principal_moments(i)
     scale = max(float(np.max(np.abs(moments))), 1e-300)
     if moments[0] <= 0:
-        return f"inertia is not positive definite (principal moments {_vec(moments)})"
+        return f"inertia is not positive definite (principal moments {vector_text(moments)})"
     a, b, c = moments  # ascending: only a + b ≥ c can fail
     if a + b < c - RELATIVE * scale:
-        return (f"principal moments {_vec(moments)} violate the triangle inequality: "
+        return (f"principal moments {vector_text(moments)} violate the triangle inequality: "
                 f"{a:.4g} + {b:.4g} < {c:.4g}")
     return ""
 
@@ -85,14 +87,24 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     children = child_joints(robot)
 
-    def body_mass(link: str) -> float:
-        inertial = robot.links[link].inertial
-        own = inertial.mass if inertial else 0.0
-        return own + sum(body_mass(j.child) for j in children.get(link, []) if j.type == "fixed")
+    def carried_mass(link: str) -> float:
+        """The mass of the link and of every link beyond it (each link once, should the
+        joints not form a tree)."""
+        total, todo, seen = 0.0, [link], {link}
+        while todo:
+            at = todo.pop()
+            inertial = robot.links[at].inertial
+            total += max(inertial.mass, 0.0) if inertial else 0.0
+            for j in children.get(at, []):
+                if j.child in robot.links and j.child not in seen:
+                    seen.add(j.child)
+                    todo.append(j.child)
+        return total
 
     for joint in sorted(robot.joints.values(), key=lambda j: j.name):
-        if joint.type in MOVABLE and body_mass(joint.child) <= 0:
-            out.append((joint.child, f"moves with joint '{joint.name}' but has no mass"))
+        if joint.type in MOVABLE and joint.child in robot.links and carried_mass(joint.child) <= 0:
+            out.append((joint.child, f"moves with joint '{joint.name}' but neither it nor a link "
+                                     "beyond it has mass"))
     for name in sorted(robot.links):
         link = robot.links[name]
         inertial = link.inertial
@@ -114,35 +126,27 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
             lo, hi = box
             outside = float(np.max(np.maximum(lo - com, com - hi)))
             if outside > distance:
-                out.append((name, f"COM {_vec(com)} m lies {outside:.4g} m outside the collision "
-                                  f"bounding box {_vec(lo)}…{_vec(hi)} m"))
+                out.append((name, f"COM {vector_text(com)} m lies {outside:.4g} m outside the collision "
+                                  f"bounding box {vector_text(lo)}…{vector_text(hi)} m"))
     return out
 
 
 @register("physical_validity")
 def physical_validity(ctx: Context, test: ModelTest) -> Result:
-    missing = ctx.need_new(test.name)
-    if missing is not None:
-        return missing
-    assert ctx.new is not None
-    robot = ctx.new.robot
+    robot = ctx.built.robot
     found = findings(robot, ctx.tol.distance)
     details = tuple(f"{link}: {problem}" for link, problem in found)
     figure = float(len(found))
     if not found:
         return passed(test.name, f"{len(robot.links)} links: masses, inertias and COMs are possible",
-                      figure=0.0, unit="findings", tolerance="distance", tolerance_value=ctx.tol.distance)
-    more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
-    first = f"link '{found[0][0]}' {found[0][1]}{more}"
+                      figure=0.0, unit="findings", tolerances=ctx.bound("distance", "m"))
+    first = first_of([f"link '{link}' {problem}" for link, problem in found])
     if test.as_error:
-        return failed(test.name, first, figure=figure, unit="findings", tolerance="distance",
-                      tolerance_value=ctx.tol.distance, details=details)
+        return failed(test.name, first, figure=figure, unit="findings", tolerances=ctx.bound("distance", "m"),
+                      details=details)
     for link, problem in found:
-        span = robot.links[link].span or Span.of_file(str(ctx.new.path))
+        span = robot.links[link].span or Span.of_file(str(ctx.built.path))
         ctx.sink.warning(span, "W0701", f"link '{link}' {problem}")
     return passed(test.name, f"{len(found)} warnings: {first}", figure=figure, unit="findings",
-                  tolerance="distance", tolerance_value=ctx.tol.distance, details=details)
+                  tolerances=ctx.bound("distance", "m"), details=details)
 
-
-def _vec(v: np.ndarray) -> str:
-    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"

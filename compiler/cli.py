@@ -53,7 +53,8 @@ def _parser() -> argparse.ArgumentParser:
     test = sub.add_parser("test", help="compile a model definition and run its model tests")
     test.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
-    test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
+    test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
+                      "--built: where the protocol goes (default: the --built folder)")
     # -- pipeline runs and CI generation (compiler/pipeline/) --
     run = sub.add_parser("run", help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
     run.add_argument("pipeline", type=Path, help="the pipeline file")
@@ -185,10 +186,15 @@ def _test(args: argparse.Namespace) -> int:
         return 1
     with tempfile.TemporaryDirectory(prefix="mpc-test-") as work:
         protocol = run_model_tests(program, out, sink, workdir=Path(work), robot=robot)
-    protocol.write(out)
+    target = args.out if args.built is not None and args.out is not None else out  # -o with --built
     _print_diagnostics(sink, args.format)
     print(protocol.markdown())
-    print(f"wrote {out / 'test_protocol.md'}, test_protocol.json and test_protocol.junit.xml",
+    try:
+        protocol.write(target)
+    except OSError as e:
+        print(f"error: cannot write the test protocol into '{target}': {e.strerror or e}", file=sys.stderr)
+        return 1
+    print(f"wrote {target / 'test_protocol.md'}, test_protocol.json and test_protocol.junit.xml",
           file=sys.stderr)
     return 1 if protocol.failed else 0
 

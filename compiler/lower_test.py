@@ -6,6 +6,7 @@ It reads `test_data_file` (a small YAML file) but no model and no repository.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +64,9 @@ class _TestLowering:
             self.sink.error(c.key_span(key), "E0701", f"'{key}' needs a 'git' compare model; "
                             "'path' names a folder as it is")
             return None
+        waive = self.waiver(c.ignore_failing_tests_for, c.path is not None)
+        if waive is None:
+            return None
         path = None
         if c.path is not None:
             file = c.value_span("path").file
@@ -74,7 +78,26 @@ class _TestLowering:
         return CompareTarget(span=c.span, git=git, path=path, branch=c.branch or "", commit=c.commit or "",
                              model_in_repo=c.model_in_repo or "",
                              submechanisms_in_repo=c.submechanisms_in_repo or "",
-                             ignore_failing_tests_for=str(c.ignore_failing_tests_for or ""))
+                             ignore_failing_tests_for=waive)
+
+    def waiver(self, value: object, with_path: bool) -> str | None:
+        """`ignore_failing_tests_for`, lower case ("" when not given), or None after an error:
+        it names a commit of a git compare model, so it is 4 to 40 hex digits and needs `git`
+        (a shorter prefix would waive failures at one commit in sixteen or more)."""
+        if value is None or value == "":
+            return ""
+        span = self.section.compare_model.value_span("ignore_failing_tests_for")  # type: ignore[union-attr]
+        waive = str(value).strip().lower()
+        if with_path:
+            self.sink.error(span, "E0701", "'ignore_failing_tests_for' names a commit of a 'git' compare "
+                            "model; a 'path' has no commits")
+            return None
+        if not re.fullmatch(r"[0-9a-f]{4,40}", waive):
+            self.sink.error(span, "E0701", "'ignore_failing_tests_for' is a commit of the compare "
+                            "repository: "
+                            f"4 to 40 hex digits, quoted (e.g. \"82b92a86\"), got {value!r}")
+            return None
+        return waive
 
     def expected_mass(self) -> float | None:
         written = self.section.test_data_file
@@ -125,6 +148,10 @@ class _TestLowering:
             return None
         if name == "total_mass":
             value = self.number(arg, span, f"{what} expected mass")
+            if value is not None and value < 0:
+                self.sink.error(span, "E0703", f"{what}: the expected mass must not be negative, "
+                                f"got {value:g}")
+                return None
             return None if value is None else ModelTest(name=name, span=span, dynamics=dynamics, value=value)
         if name == "physical_validity":
             if arg not in ("error", "warning"):
@@ -164,6 +191,9 @@ class _TestLowering:
             arg = arg.get("links")
         if not isinstance(arg, list) or len(arg) != 2 or not all(isinstance(x, str) for x in arg):
             self.sink.error(test.span, "E0703", f"{what} needs two link names [left, right], got {arg!r}")
+            return None
+        if arg[0] == arg[1]:
+            self.sink.error(test.span, "E0703", f"{what} compares two different links; both are '{arg[0]}'")
             return None
         return ModelTest(name=test.name, span=test.span, dynamics=test.dynamics, links=tuple(arg),
                          plane=plane)

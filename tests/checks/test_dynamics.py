@@ -44,3 +44,42 @@ def test_continuous_joints_move_like_revolute_ones() -> None:
     tau_r = revolute.gravity_torques(revolute.configuration(values))
     assert tau_c == pytest.approx(tau_r, abs=1e-12)
     assert abs(tau_r["joint1"]) > 0.005  # not a trivial zero
+
+
+MIMIC_URDF = """\
+<robot name="gripper">
+  <link name="a"/>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/>
+    <limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+  <link name="b"><inertial><origin xyz="0 0.1 0.3"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="k" type="revolute"><origin xyz="0 0 1"/><parent link="b"/><child link="c"/>
+    <axis xyz="1 0 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+    <mimic joint="j" multiplier="2" offset="0.1"/></joint>
+  <link name="c"><inertial><origin xyz="0 0.2 0.5"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+</robot>
+"""
+
+
+def test_a_mimic_joint_follows_and_its_load_is_on_the_joint_it_follows(tmp_path) -> None:
+    """q_k = 2 q_j + 0.1; the torque that holds j is dV/dθ of the potential energy along the
+    coupled motion (a finite difference of Pinocchio's potential energy)."""
+    (tmp_path / "g.urdf").write_text(MIMIC_URDF)
+    robot = read(tmp_path / "g.urdf", Sink())
+    assert robot is not None
+    dyn = build(robot)
+    assert (dyn.joint_names(), dyn.actuated) == (["j"], ("j",))
+    theta = 0.4
+    q = dyn.configuration({"j": theta, "k": 5.0})  # k's own value is ignored: it follows j
+    np.testing.assert_allclose(q, [theta, 2 * theta + 0.1], atol=1e-12)
+
+    def potential(t: float) -> float:
+        return pin.computePotentialEnergy(dyn.model, dyn.data, np.array([t, 2 * t + 0.1]))
+
+    h = 1e-6
+    expected = (potential(theta + h) - potential(theta - h)) / (2 * h)
+    tau = dyn.gravity_torques(q)
+    assert list(tau) == ["j"]
+    assert tau["j"] == pytest.approx(expected, abs=1e-6)
+    assert abs(tau["j"] - pin.computeGeneralizedGravity(dyn.model, dyn.data, q)[0]) > 1.0  # k's load counts

@@ -212,3 +212,24 @@ def test_cassie_against_its_own_compiled_sdf(tmp_path: Path) -> None:
     protocol = run(tmp_path / "cassie.yml", tmp_path / "out", tmp_path / "work")
     assert set(statuses(protocol).values()) == {"passed"}, protocol.markdown()
     assert result(protocol, "compare_link_positions").figure < 1e-6
+
+
+def test_a_configuration_where_the_loop_cannot_close_fails_and_keeps_the_previous_one(tmp_path: Path) -> None:
+    """Crank and rocker both driven, at +0.5 and -0.5 rad: their tips are 1.04 m apart and the
+    2 m coupler cannot join them. move_hyrodyn_model fails with the residual; the checks after
+    it run at the configuration before it (both at 0.3), where the loop closes."""
+    definition = fourbar(tmp_path, "    tests:\n      - hyrodynChecks:\n"
+                         "          - move_hyrodyn_model: {crank_joint: 0.3, rocker_joint: 0.3}\n"
+                         "          - move_hyrodyn_model: {crank_joint: 0.5, rocker_joint: -0.5}\n"
+                         "          - symmetry_check: {links: [coupler, rocker_tip], plane: [1, 0, 0]}\n")
+    write(tmp_path / "fourbar.yml", definition.replace("    crank_joint:\n      active: true\n",
+                                                       "    crank_joint:\n      active: true\n"
+                                                       "    rocker_joint:\n      active: true\n"))
+    protocol = run(tmp_path / "fourbar.yml", tmp_path / "out", tmp_path / "work")
+    s = statuses(protocol)
+    assert (s["move_hyrodyn_model"], s["move_hyrodyn_model 2"]) == ("passed", "failed")
+    reason = result(protocol, "move_hyrodyn_model 2").reason
+    assert reason.startswith("the compiled model: the loops do not close at this configuration (residual ")
+    assert reason.endswith("): the actuated joints' values are not reachable")
+    # the coupler hangs on the crank's tip: (sin 0.3, 0, cos 0.3), mirrored in x
+    assert "'coupler' mirrored at (-0.2955, 0, 0.9553) m" in result(protocol, "symmetry_check").reason

@@ -79,11 +79,23 @@ def test_every_argument_form_and_the_ir_round_trip(tmp_path: Path, diags: Diags)
      "test 'symmetry_check': 'plane' is the normal of the mirror plane, three numbers not all zero, "
      "e.g. [0, 1, 0]"),
     ("    tolerances: {distance: -1}\n", "E0701", "tolerance 'distance' must not be negative, got -1"),
+    ("    tests:\n      - symmetry_check_masses: [upper, upper]\n", "E0703",
+     "test 'symmetry_check_masses' compares two different links; both are 'upper'"),
+    ("    tests:\n      - total_mass: -5\n", "E0703",
+     "test 'total_mass': the expected mass must not be negative, got -5"),
     ("    compare_model: {git: a.git, path: b}\n", "E0701",
      "compare_model needs either 'git' (a repository) or 'path' (a folder or model file), not both"),
     ("    compare_model: {path: b, commit: '1234'}\n", "E0701",
      "'commit' needs a 'git' compare model; 'path' names a folder as it is"),
     ("    test_data_file: nothing.yml\n", "E0702", "test_data_file 'nothing.yml' does not exist"),
+    ("    compare_model: {path: b, ignore_failing_tests_for: '82b92a86'}\n", "E0701",
+     "'ignore_failing_tests_for' names a commit of a 'git' compare model; a 'path' has no commits"),
+    ("    compare_model: {git: a.git, ignore_failing_tests_for: '8'}\n", "E0701",
+     "'ignore_failing_tests_for' is a commit of the compare repository: 4 to 40 hex digits, quoted "
+     "(e.g. \"82b92a86\"), got '8'"),
+    ("    compare_model: {git: a.git, ignore_failing_tests_for: master}\n", "E0701",
+     "'ignore_failing_tests_for' is a commit of the compare repository: 4 to 40 hex digits, quoted "
+     "(e.g. \"82b92a86\"), got 'master'"),
 ])
 def test_bad_settings_are_reported_where_they_are(tmp_path: Path, diags: Diags, test: str, code: str,
                                                   message: str) -> None:
@@ -91,3 +103,10 @@ def test_bad_settings_are_reported_where_they_are(tmp_path: Path, diags: Diags, 
     d = diags.take_error(code)
     assert d.message == message
     assert d.span.line >= 12  # inside the test section
+
+
+def test_a_waiver_is_lower_case_and_zero_tolerances_are_exact(tmp_path: Path, diags: Diags) -> None:
+    p = program(tmp_path, "    tolerances: {mass: 0, distance: 0}\n    compare_model: "
+                "{git: a.git, ignore_failing_tests_for: '82B92A86'}\n    tests: []\n", diags)
+    assert p.test.compare.ignore_failing_tests_for == "82b92a86"
+    assert (p.test.tolerances.mass, p.test.tolerances.distance) == (0.0, 0.0)

@@ -83,8 +83,15 @@ def test_a_moving_link_without_mass_and_a_com_outside_its_shapes(tmp_path: Path)
     robot = read(tmp_path / "f.urdf", Sink())
     assert robot is not None
     found = findings(robot, 0.003)
-    assert found[:2] == [("coupler", "moves with joint 'coupler_joint' but has no mass"),
+    assert found[:2] == [("coupler", "moves with joint 'coupler_joint' but neither it nor a link beyond "
+                                     "it has mass"),
                          ("coupler", "has collision shapes but no mass")]
     assert found[2][0] == "rocker"
     assert found[2][1].startswith("COM (0, 0, 1.5) m lies 0.5 m outside the collision bounding box")
     assert len(found) == 3
+
+
+def test_a_massless_link_between_joints_of_a_3_dof_joint_is_not_a_finding() -> None:
+    """example-robot-data's human: each ankle, wrist, hip and shoulder is three revolute joints
+    with massless `…_virtual` links between them; the mass is beyond them, so they are fine."""
+    assert flagged(ERD / "human_description/robots/human.urdf") == {}
