@@ -79,28 +79,22 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
     expanded = os.path.expandvars(settings.get("root", ".."))
-    root = _path(path.resolve().parent, expanded)
-    if root is None or not root.is_dir():
-        problem = ("is not a folder" if root.exists() else "does not exist") if root else "is not a path"
+    root = (path.resolve().parent / expanded).resolve()  # a NUL byte stopped source.load (E0106)
+    if not root.is_dir():
+        problem = "is not a folder" if root.exists() else "does not exist"
         unset = re.findall(r"\$\{?(\w+)", expanded)
         hint = (f"the environment variable {unset[0]} is not set" if unset
                 else "`root` is relative to the folder of the pipeline file")
         sink.error(doc.value_span(("pipeline", "root")), "E0640",
-                   f"the workspace root '{root or expanded.encode('unicode_escape').decode()}' {problem}",
+                   f"the workspace root '{root}' {problem}",
                    hint=hint)
         return None
     defaults = PipelineDefaults(doc)
     by_file: dict[Path, PlannedModel] = {}
-    unusable = False
     derived: dict[Path, list[tuple[Path, Span]]] = {}
     for i, written in enumerate(settings["model_definitions"]):
         span = doc.value_span(("pipeline", "model_definitions", i))
-        definition = _path(path.resolve().parent, written)
-        if definition is None:  # no name for a model, nor a folder for its output
-            shown = written.encode("unicode_escape").decode()
-            sink.error(span, "E0601", f"model definition '{shown}' is not a path")
-            unusable = True
-            continue
+        definition = (path.resolve().parent / written).resolve()
         if definition in by_file:
             sink.warning(span, "W0611", f"model definition '{written}' is listed twice; it is built once",
                          notes=((by_file[definition].span, "first listed here"),))
@@ -108,8 +102,6 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
         model, parents = _load_model(path, root, written, definition, span, defaults)
         by_file[definition] = model
         derived[definition] = parents
-    if unusable:
-        return None
     _link(by_file, derived)
     models: dict[str, PlannedModel] = {}
     for model in by_file.values():
@@ -174,18 +166,8 @@ def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span
             at = doc.value_span(("model", "input_models", key, "derived_base"))
             # Relative to the file that wrote it (a defaults file, or the definition).
             folder = Path(at.file).resolve().parent if at.file else definition.parent
-            parent = _path(folder, entry["derived_base"])
-            if parent is not None:  # else compiling the model reports it
-                parents.append((parent, at))
+            parents.append(((folder / entry["derived_base"]).resolve(), at))
     return model, parents
-
-
-def _path(folder: Path, written: str) -> Path | None:
-    """`written` resolved against `folder`; None when it cannot name a file (a NUL byte)."""
-    try:
-        return (folder / written).resolve()
-    except ValueError:
-        return None
 
 
 def _link(by_file: dict[Path, PlannedModel], derived: dict[Path, list[tuple[Path, Span]]]) -> None:

@@ -61,11 +61,11 @@ PIPELINES = {
                                       "   |         ^^^^^^^^^^^^^^^^\n"
                                       "  hint: the environment variable MPC_NOT_SET is not set"),
     "a root that is not a path": ('pipeline:\n  root: "a\\0b"\n  model_definitions: [p.yml]\n',
-                                  "pipeline.yml:2:9: error[E0640]: the workspace root 'a\\x00b' "
-                                  "is not a path"),
+                                  "pipeline.yml:2:9: error[E0106]: a NUL character in a string: "
+                                  "no file, link, joint or other name can hold one"),
     "an entry that is not a path": ('pipeline:\n  root: .\n  model_definitions: [p.yml, "q\\0.yml"]\n',
-                                    "pipeline.yml:3:30: error[E0601]: model definition 'q\\x00.yml' "
-                                    "is not a path"),
+                                    "pipeline.yml:3:30: error[E0106]: a NUL character in a string: "
+                                    "no file, link, joint or other name can hold one"),
     "a root that is a file": ("pipeline:\n  root: p.yml\n  model_definitions: [p.yml]\n",
                               "pipeline.yml:2:9: error[E0640]: the workspace root '{folder}/p.yml' "
                               "is not a folder"),
