@@ -14,9 +14,10 @@ import filecmp
 import hashlib
 import os
 import shutil
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.geometry import (
@@ -29,9 +30,13 @@ from mpc.ir.geometry import (
     ReflectMesh,
     ScaleMesh,
 )
+from mpc.ir.numbers import zero_small
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
+
+if TYPE_CHECKING:
+    from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
 ENGINE = "1"  # changes when the way meshes are computed changes, so old cache entries go unused
@@ -248,3 +253,18 @@ def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path
         if extra is None or not copy(extra, out, sink, export_span, robot):
             return None
     return files
+
+
+def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: Path,
+               sink: Sink) -> tuple[Robot, dict[MeshKey, str]] | None:
+    """Write the meshes of a urdf, sdf or mjcf export (`write`); the robot to write (numbers
+    near zero made 0 with `enforce_zero`) and where each mesh went, or None after an error."""
+    files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
+    if files is None:
+        return None
+    return (zero_small(robot) if export.enforce_zero else robot), files
+
+
+def namer(files: dict[MeshKey, str], prefix: str) -> Callable[[Mesh], str]:
+    """How a model file names each mesh: `prefix` and the mesh's path in the output."""
+    return lambda mesh: prefix + files[key(mesh)]

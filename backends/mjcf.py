@@ -48,7 +48,7 @@ from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import matrix_pose, pose_matrix
-from mpc.ir.numbers import EPSILON, zero_small
+from mpc.ir.numbers import EPSILON
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -473,12 +473,10 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
                    hint="use mesh_format stl or obj for an mjcf export")
         return
     _diagnose(robot, sink, export.span)
-    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
-    if files is None:
+    prepared = meshes.for_export(robot, export, out, sink)
+    if prepared is None:
         return
-    if export.enforce_zero:
-        robot = zero_small(robot)
+    robot, files = prepared
     formats = Formats(export.float_formats, MJCF_KEYS) if export.float_formats else None
-    text = to_string(robot, lambda mesh: "../" + files[meshes.key(mesh)], formats=formats,
-                     enforce_zero=export.enforce_zero)
+    text = to_string(robot, meshes.namer(files, "../"), formats=formats, enforce_zero=export.enforce_zero)
     write_path(out / "mjcf" / f"{export.filename or robot.name}.xml", text)

@@ -24,7 +24,6 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import link_in_root, matrix_pose
-from mpc.ir.numbers import zero_small
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -371,22 +370,16 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     """Write `out/sdf/<filename or robot.name>.sdf` and `out/sdf/model.config`, meshes under
     `out/meshes/`."""
     warn(robot, export.span, sink, export.version, export.include_cut_joints)
-    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
-    if files is None:
+    prepared = meshes.for_export(robot, export, out, sink)
+    if prepared is None:
         return
-    if export.enforce_zero:
-        robot = zero_small(robot)
-
+    robot, files = prepared
+    formats = Formats(export.float_formats, SDF_KEYS) if export.float_formats else None
     # Relative to the .sdf file: sdformat accepts it, and Gazebo resolves it from the
     # file's folder; model:// would need the meshes inside the model folder (out/sdf).
     # Or package:// paths (ros_pathes), which ROS's Gazebo resolves (backends/mesh_paths.py).
     for suffix, prefix in variants(export):
-
-        def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
-            return prefix + files[meshes.key(mesh)]
-
-        formats = Formats(export.float_formats, SDF_KEYS) if export.float_formats else None
-        text = to_string(robot, mesh_name, export.version, cut_joints=export.include_cut_joints,
-                         formats=formats)
+        text = to_string(robot, meshes.namer(files, prefix), export.version,
+                         cut_joints=export.include_cut_joints, formats=formats)
         write_path(out / "sdf" / f"{export.filename or robot.name}{suffix}.sdf", text)
     write_path(out / "sdf" / "model.config", model_config(robot, export.version))

@@ -16,8 +16,6 @@ from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import Mesh
-from mpc.ir.numbers import zero_small
 from mpc.ir.program import UrdfExport
 from mpc.ir.robot import Robot
 
@@ -41,16 +39,11 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
     if not check(robot, export, sink):
         return
-    files = meshes.write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
-    if files is None:
+    prepared = meshes.for_export(robot, export, out, sink)
+    if prepared is None:
         return
-    if export.enforce_zero:
-        robot = zero_small(robot)
+    robot, files = prepared
+    formats = Formats(export.float_formats, URDF_KEYS) if export.float_formats else None
     for suffix, prefix in variants(export):
-
-        def mesh_name(mesh: Mesh, prefix: str = prefix) -> str:
-            return prefix + files[meshes.key(mesh)]
-
-        formats = Formats(export.float_formats, URDF_KEYS) if export.float_formats else None
         write_path(out / "urdf" / f"{export.filename or robot.name}{suffix}.urdf",
-                   to_string(robot, mesh_name, formats))
+                   to_string(robot, meshes.namer(files, prefix), formats))
