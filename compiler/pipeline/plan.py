@@ -14,7 +14,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mpc.compiler import inherit, source
 from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
@@ -22,6 +22,9 @@ from mpc.compiler.pipeline import dag
 from mpc.compiler.pipeline.defaults import PipelineDefaults
 from mpc.compiler.source import Document
 from mpc.ir.span import Span
+
+if TYPE_CHECKING:
+    from mpc.compiler.schema.definition import PipelineSection
 
 
 @dataclass
@@ -51,14 +54,16 @@ class PlannedModel:
 
 @dataclass
 class Plan:
-    """A loaded pipeline file: its path, document, settings (the `pipeline` mapping), the
-    workspace root and the models in the file's order."""
+    """A loaded pipeline file: its path, document, settings (the `pipeline` mapping as
+    written), the same validated (section), the workspace root and the models in the file's
+    order."""
 
     file: Path
     doc: Document
     settings: dict[str, Any]
     root: Path
     models: dict[str, PlannedModel]
+    section: PipelineSection | None = None
 
     @property
     def defaults(self) -> PipelineDefaults:
@@ -74,7 +79,8 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     from mpc.compiler import schema
 
     doc = source.load(path, sink)
-    if doc is None or schema.validate_pipeline(doc, sink) is None:
+    pipeline = schema.validate_pipeline(doc, sink) if doc is not None else None
+    if doc is None or pipeline is None:
         return None
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
@@ -108,7 +114,7 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
         _check_name(model, models)
         models.setdefault(model.name, model)
     _break_cycles(models)
-    return Plan(path, doc, settings, root, models)
+    return Plan(path, doc, settings, root, models, pipeline.pipeline)
 
 
 # What `mpc check pipeline.yml` reports of planning; checking each definition reports the

@@ -218,7 +218,7 @@ class Runner:
         job = StageJob(model=name, definition=model.definition, out=self.store.output(name),
                        staging=self.store.staging(name) / "out", workdir=self.store.workdir(name),
                        pipeline=self.plan.settings, root=self.plan.root, options=self.options,
-                       pipeline_file=self.plan.file)
+                       pipeline_file=self.plan.file, pipeline_section=self.plan.section)
         done = self.store.state(name).get("stages", {})
         for stage in cached:
             kept = done.get(stage, {})

@@ -22,6 +22,7 @@ from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
 
 if TYPE_CHECKING:
     from mpc.compiler.driver import Options
+    from mpc.compiler.schema.definition import PipelineSection
     from mpc.ir.program import Program
     from mpc.ir.robot import Robot
 
@@ -65,7 +66,8 @@ class StageJob:
     staging: where compile writes. workdir: a scratch folder of this model (kept until the
         next run of the model, e.g. for logs and clones).
     pipeline: the `pipeline` mapping of pipeline.yml as written (validated); root: its
-        workspace root, resolved; pipeline_file: that file.
+        workspace root, resolved; pipeline_file: that file; pipeline_section: the mapping
+        validated.
     options: compile options (packages, the pipeline's defaults hook).
     sink: where the running stage reports (a fresh one per stage).
     program, robot: set by compile (or, when compile is cached, program by `ensure_program`).
@@ -81,6 +83,7 @@ class StageJob:
     root: Path
     options: Options
     pipeline_file: Path | None = None
+    pipeline_section: PipelineSection | None = None
     sink: Sink = field(default_factory=Sink)
     built: Path | None = None
     program: Program | None = None
@@ -171,17 +174,13 @@ def test_stage(job: StageJob) -> StageOutcome:
 
 def deploy_stage(job: StageJob) -> StageOutcome:
     """Deploy this run's build (deploy/) with the pipeline's settings and the test protocol."""
-    from mpc.compiler import schema, source
     from mpc.deploy import DeploySettings, deploy_model
 
-    if not ensure_program(job) or job.pipeline_file is None:
+    if not ensure_program(job) or job.pipeline_file is None or job.pipeline_section is None:
         return StageOutcome("failed", first_error(job.sink.diagnostics))
     assert job.program is not None and job.built is not None
-    doc = source.load(job.pipeline_file, job.sink)
-    pipeline = schema.validate_pipeline(doc, job.sink) if doc is not None else None
-    if pipeline is None:
-        return StageOutcome("failed", first_error(job.sink.diagnostics))
-    settings = DeploySettings.from_pipeline(pipeline.pipeline, job.pipeline_file.resolve().parent, job.sink)
+    settings = DeploySettings.from_pipeline(job.pipeline_section, job.pipeline_file.resolve().parent,
+                                            job.sink)
     tested = job.results.get("test")
     tests = tested.details if tested is not None else {}
     result = deploy_model(job.program, job.built, settings, job.sink,
