@@ -58,7 +58,7 @@ def lower_deployment(section: DeploymentSection, sink: Sink) -> Deployment:
         mirror = DeployMirror(repo=m.repo, span=m.span, branch=m.branch, submodules=m.submodules,
                               merge_request=m.merge_request, mr_title=m.mr_title, mr_target=m.mr_target,
                               mr_mention=None if m.mr_mention is None else tuple(m.mr_mention))
-    given = section.model_fields_set
+    given = section.given
     return Deployment(
         span=section.span,
         do_not_deploy=section.do_not_deploy if "do_not_deploy" in given else None,

@@ -116,17 +116,17 @@ class EditLowering:
     def refuse(self, d: Node, where: str, keys: tuple[str, ...]) -> None:
         """Report keys that mean nothing in this place (instead of ignoring them)."""
         for key in keys:
-            if key in d.model_fields_set:
+            if key in d.given:
                 self.sink.error(d.key_span(key), "E0313", f"'{key}' has no meaning in {where}")
 
     def scoped(self, editing: Any, where: str, scope: str) -> None:
         """Name editing of one kind of name: the keys of other kinds would do nothing, nor the
         flags of an assembly entry's name_editing, which rename by the tree."""
         flags = {"joint_equals_link_name", "append_link_suffix"}
-        for key in sorted(editing.model_fields_set & flags):
+        for key in sorted(editing.given & flags):
             self.sink.error(editing.key_span(key), "E0313", f"'{key}' has no meaning in {where}; "
                             "it is a key of an assemble entry's name_editing")
-        for key in editing.model_fields_set - flags:
+        for key in editing.given - flags:
             kind = key.split("_", 1)[0]
             if "_" in key and kind in ("link", "joint", "collision", "visual", "submechanism") \
                     and kind != scope:
@@ -387,7 +387,7 @@ class EditLowering:
                 links += [s.around] if getattr(s, "around", None) else []
                 self.add(AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
                                          links=tuple(dict.fromkeys(links)),
-                                         definition=s.model_dump(exclude_defaults=True)))
+                                         definition=s.to_data()))
         if m.submechanisms or m.exoskeletons:
             span = m.key_span("submechanisms" if m.submechanisms else "exoskeletons")
             self.add(CompleteSubmechanisms(span=span))

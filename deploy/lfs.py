@@ -19,4 +19,5 @@ def track(git: Git, patterns: tuple[str, ...]) -> None:
     if (git.folder / ".gitattributes").is_symlink():  # kept from the remote: never written through
         raise DeployError("E0804", "'.gitattributes' is a symbolic link; git LFS would write through it")
     git("lfs", "install", "--local", code="E0808")
-    git("lfs", "track", *patterns, code="E0808")
+    for pattern in patterns:  # one at a time: given several, git-lfs writes them in any order
+        git("lfs", "track", pattern, code="E0808")

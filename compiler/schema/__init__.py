@@ -1,4 +1,4 @@
-"""The schema of the definition language: pydantic AST nodes that keep their spans.
+"""The schema of the definition language: AST nodes that keep their spans.
 
 One module per part: `base` (nodes, screening, error mapping), `assembly`
 (input_models, assemble), `exports`, `editing` (materials, frames, joints,

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import Discriminator, Field, Tag
-
-from mpc.compiler.schema.base import Expr, Node, OneOrMore, OpenNode, Vec3
+from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, OpenNode, Vec3
 from mpc.compiler.schema.editing import ConstraintAxis
 
 SINGLE_LINK_SENSORS = ("Joint6DOF", "CameraSensor", "RotatingRaySensor", "IMU", "GPS")
@@ -36,16 +34,8 @@ class SensorDef(OpenNode):
     orientation_offset: Annotated[list[Expr], Field(min_length=3, max_length=4)] | None = None
 
 
-def _shape(value: Any) -> str:
-    return "list" if isinstance(value, list) else "other"
-
-
 # The section is a list of sensors or a mapping type → sensor(s); validated as the form it has.
-SensorsSection = Annotated[
-    Annotated[list[SensorDef], Tag("list")]
-    | Annotated[dict[SensorType, SensorDef | list[SensorDef]], Tag("other")],
-    Discriminator(_shape),
-]
+SensorsSection = list[SensorDef] | dict[SensorType, SensorDef | list[SensorDef]]
 
 
 def sensor_entries(section: SensorsSection) -> list[tuple[str | None, SensorDef]]:
@@ -63,7 +53,6 @@ class PoseDef(OpenNode):
 
     SECTION: ClassVar[str] = "a pose"
     ENTRIES: ClassVar[Any] = Expr
-    __pydantic_extra__: dict[str, Expr]
     default: Expr | None = Field(None, alias="$default")
 
 
@@ -117,8 +106,7 @@ class PostProcessing(Node):
     """A command run after export: an argument list, or a string run by a shell when `shell`."""
 
     SECTION: ClassVar[str] = "a post_processing command"
-    cmd: Annotated[Annotated[str, Tag("other")] | Annotated[list[str], Field(min_length=1), Tag("list")],
-                   Discriminator(_shape)]
+    cmd: str | Annotated[list[str], Field(min_length=1)]
     cwd: str | None = None
     shell: bool = False
     executable: str | None = None

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import BeforeValidator, Field, WithJsonSchema, model_validator
-
-from mpc.compiler.schema.base import Expr, Node, OneOrMore, Vec3
+from mpc.compiler.schema.base import Before, Expr, Field, JsonSchema, Node, OneOrMore, Vec3
 
 JointTypeName = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar",
                         "ball", "universal", "screw", "revolute2"]
@@ -20,8 +18,8 @@ def _dict_or_list_of_dicts(value: Any) -> Any:
 
 
 _STR_MAP = {"type": "object", "additionalProperties": {"type": "string"}}
-Replacements = Annotated[list[dict[str, str]], BeforeValidator(_dict_or_list_of_dicts),
-                         WithJsonSchema({"anyOf": [_STR_MAP, {"type": "array", "items": _STR_MAP}]})]
+Replacements = Annotated[list[dict[str, str]], Before(_dict_or_list_of_dicts),
+                         JsonSchema({"anyOf": [_STR_MAP, {"type": "array", "items": _STR_MAP}]})]
 
 
 class Repo(Node):
@@ -45,13 +43,12 @@ class InputModel(Node):
     repo: Repo | None = None
     is_human: bool = False
 
-    @model_validator(mode="after")
-    def _one_source(self) -> InputModel:
+    def problem(self) -> str | None:
         given = [k for k in ("basefile", "derived_base", "repo") if getattr(self, k) is not None]
         if len(given) != 1:
-            raise ValueError("an input model needs exactly one of 'basefile', 'derived_base' or "
-                             f"'repo', got {' and '.join(given) or 'none'}")
-        return self
+            return ("an input model needs exactly one of 'basefile', 'derived_base' or "
+                    f"'repo', got {' and '.join(given) or 'none'}")
+        return None
 
 
 class NameEditing(Node):
@@ -138,6 +135,3 @@ class Assemble(_Part):
 
     SECTION: ClassVar[str] = "assemble"
 
-
-AssembleChild.model_rebuild()
-Assemble.model_rebuild()

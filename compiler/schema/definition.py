@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar
 
-from pydantic import Field
-
 from mpc.compiler.diagnostics import Sink
 from mpc.compiler.schema.annotations import (
     AnnotationsSection,
@@ -16,7 +14,7 @@ from mpc.compiler.schema.annotations import (
     Submechanism,
 )
 from mpc.compiler.schema.assembly import Assemble, InputModel
-from mpc.compiler.schema.base import Expr, Node, OneOrMore, validate_as
+from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, validate_as
 from mpc.compiler.schema.editing import (
     CollisionsSection,
     FramesSection,

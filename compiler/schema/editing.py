@@ -8,10 +8,8 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import BeforeValidator, Field
-
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
-from mpc.compiler.schema.base import Expr, Node, OneOrMore, OpenNode, Vec3, str_or_list
+from mpc.compiler.schema.base import Before, Expr, Field, Node, OneOrMore, OpenNode, Vec3, str_or_list
 
 Color = Annotated[list[Expr], Field(min_length=3, max_length=4)]
 
@@ -83,7 +81,6 @@ class FramesSection(OpenNode):
 
     SECTION: ClassVar[str] = "frames"
     ENTRIES: ClassVar[type | None] = FrameDef
-    __pydantic_extra__: dict[str, FrameDef]
     default: FrameDef | None = Field(None, alias="$default")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
 
@@ -152,7 +149,7 @@ class JointDef(OpenNode):
     constraint_axes: list[ConstraintAxis] | None = None
     move_joint_axis_to_intersection: Annotated[list[str], Field(min_length=2, max_length=2)] | None = None
     mimic: MimicDef | None = None
-    movement_depends_on: Annotated[list[MimicDef], BeforeValidator(
+    movement_depends_on: Annotated[list[MimicDef], Before(
         lambda v: [v] if isinstance(v, dict) else v)] | None = None
     active: bool | MotorDef | None = None
     motor: MotorDef | None = None
@@ -164,7 +161,6 @@ class JointsSection(OpenNode):
 
     SECTION: ClassVar[str] = "joints"
     ENTRIES: ClassVar[type | None] = JointDef
-    __pydantic_extra__: dict[str, JointDef]
     default: JointDef | None = Field(None, alias="$default")
     replace_joint_types: dict[JointTypeName, JointTypeName] | None = Field(
         None, alias="$replace_joint_types")
@@ -173,7 +169,7 @@ class JointsSection(OpenNode):
     backup: Limits | None = Field(None, alias="$backup")
 
 
-RemoveWhat = Annotated[bool | list[str], BeforeValidator(
+RemoveWhat = Annotated[bool | list[str], Before(
     lambda v: str_or_list(v) if isinstance(v, str) else v)]
 ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
 
@@ -197,7 +193,6 @@ class CollisionsSection(OpenNode):
 
     SECTION: ClassVar[str] = "collisions"
     ENTRIES: ClassVar[type | None] = CollisionDef
-    __pydantic_extra__: dict[str, CollisionDef]
     default: CollisionDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
@@ -221,7 +216,6 @@ class VisualsSection(OpenNode):
 
     SECTION: ClassVar[str] = "visuals"
     ENTRIES: ClassVar[type | None] = VisualDef
-    __pydantic_extra__: dict[str, VisualDef]
     default: VisualDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import BeforeValidator, Field
-
-from mpc.compiler.schema.base import Expr, Node, OneOrMore
+from mpc.compiler.schema.base import Before, Expr, Node, OneOrMore
 
 
 class _Export(Node):
@@ -21,7 +19,7 @@ class _Kinematic(_Export):
 
     ALIASES: ClassVar[dict[str, str]] = {"add_floatingbase": "add_floating_base"}
     mesh_format: MeshFormat = "input_type"
-    additional_meshes: Annotated[list[MeshFormat], Field()] | MeshFormat | None = None
+    additional_meshes: list[MeshFormat] | MeshFormat | None = None
     link_in_smurf: bool = False
     include_cut_joints: bool = False
     filename_suffix: str = ""
@@ -43,7 +41,7 @@ class SdfExport(_Kinematic):
     SECTION: ClassVar[str] = "an sdf export"
     type: Literal["sdf"]
     # 1.9 unquoted is a number in YAML; it means the version all the same.
-    version: Annotated[Literal["1.6", "1.7", "1.9"], BeforeValidator(
+    version: Annotated[Literal["1.6", "1.7", "1.9"], Before(
         lambda v: str(v) if isinstance(v, float) else v)] = "1.9"
 
 
@@ -120,9 +118,6 @@ class SubmodelExport(_Export):
     export_config: list[ExportEntry] | None = None
 
 
-ExportEntry = Annotated[
-    UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | JointLimitsExport | KccdExport
-    | SubmodelExport,
-    Field(discriminator="type"),
-]
-SubmodelExport.model_rebuild()
+# Told apart by `type` (compiler/schema/base.py: TaggedType).
+ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | JointLimitsExport
+               | KccdExport | SubmodelExport)

@@ -4,10 +4,8 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import AfterValidator
-
 from mpc.compiler.diagnostics import did_you_mean
-from mpc.compiler.schema.base import Expr, Node, OneOrMore
+from mpc.compiler.schema.base import After, Expr, Node, OneOrMore
 
 TESTS = frozenset({
     "topological_self_consistency", "process_double_check", "file_consistency", "load_in_pybullet",
@@ -43,7 +41,7 @@ def _test_item(item: Any) -> Any:
     return item
 
 
-TestList = list[Annotated[str | dict[str, Any], AfterValidator(_test_item)]]
+TestList = list[Annotated[str | dict[str, Any], After(_test_item)]]
 
 
 class Tolerances(Node):

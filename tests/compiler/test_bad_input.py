@@ -93,12 +93,12 @@ def test_unknown_export_type_and_mesh_format(tmp_path: Path, diags: Diags) -> No
     arm(tmp_path)
     text = definition("arm.urdf", "stll") + "    - type: urdff\n"
     _compile(tmp_path, diags, text)
-    typo = diags.take_error("E0203")
-    assert (typo.message, _where(typo)) == ("unknown export type 'urdff'; did you mean 'urdf'?", (12, 13))
-    fmt = diags.take_error("E0203")
+    fmt = diags.take_error("E0203")  # reported in the order of the document
     assert fmt.message == ("'mesh_format' must be one of 'stl', 'obj', 'dae', 'bobj', 'mars_obj' or "
                            "'input_type', got 'stll'; did you mean 'stl'?")
     assert _where(fmt) == (11, 20)
+    typo = diags.take_error("E0203")
+    assert (typo.message, _where(typo)) == ("unknown export type 'urdff'; did you mean 'urdf'?", (12, 13))
 
 
 def test_assemble_model_that_is_no_input(tmp_path: Path, diags: Diags) -> None:
