@@ -88,3 +88,14 @@ def test_usage_errors_exit_2() -> None:
     assert mpc().returncode == 2
     assert mpc("compile").returncode == 2
     assert mpc("compile", "x.yml", "--package", "nodir").returncode == 2
+
+
+def test_check_imports_no_heavy_library() -> None:
+    """`mpc check` runs on every save in editors: YAML, the schema and URDF names, nothing more."""
+    heavy = ("pinocchio", "pybullet", "trimesh", "numpy", "scipy", "lark", "pydantic", "git")
+    probe = ("import sys\nfrom mpc.compiler.cli import main\n"
+             f"code = main(['check', {str(ROOT / 'examples/talos.yml')!r}])\n"
+             f"print(code, [m for m in {heavy!r} if m in sys.modules])\n")
+    run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert run.stderr == ""
+    assert run.stdout.splitlines()[-1] == "0 []"
