@@ -10,7 +10,6 @@ function Robot → Robot). An op whose `apply` is not written yet says so throug
 
 from __future__ import annotations
 
-import importlib
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -160,13 +159,14 @@ def __getattr__(name: str) -> Any:
     module = _MODULE_OF.get(name)
     if module is None:
         raise AttributeError(f"module 'mpc.ir.ops' has no attribute '{name}'")
-    return getattr(importlib.import_module(f"mpc.ir.ops.{module}"), name)
+    # __import__ rather than importlib.import_module: it shows in `python -X importtime`.
+    return getattr(__import__(f"{__name__}.{module}", fromlist=[name]), name)
 
 
 def import_all() -> dict[str, type[Op]]:
     """OPS with every op in it."""
     for module in _MODULES:
-        importlib.import_module(f"mpc.ir.ops.{module}")
+        __import__(f"{__name__}.{module}")
     return OPS
 
 
