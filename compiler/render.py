@@ -54,7 +54,6 @@ def as_json(diagnostics: Iterable[Diagnostic]) -> str:
     """A JSON list of objects with code, severity, message, span, notes and hint."""
     import json  # only for --format json: `mpc check` would import it for nothing
 
-
     def span(s: Span | None) -> dict[str, object] | None:
         if s is None:
             return None
