@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.backends import meshes
 from mpc.backends.float_formats import URDF_KEYS, Formats
-from mpc.backends.mesh_paths import variants
 from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
@@ -37,6 +35,9 @@ def check(robot: Robot, export: UrdfExport, sink: Sink) -> bool:
 
 def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     """Write the URDF of `robot` and its meshes under `out`, as `export` asks."""
+    from mpc.backends import meshes  # hashlib, filecmp: `mpc check` only reads URDF
+    from mpc.backends.mesh_paths import variants
+
     if not check(robot, export, sink):
         return
     prepared = meshes.for_export(robot, export, out, sink)

@@ -10,7 +10,6 @@ reads back exactly. Attributes the source did not write are not written.
 from __future__ import annotations
 
 from collections.abc import Callable
-from xml.sax.saxutils import escape
 
 from mpc.backends.float_formats import Formats
 from mpc.backends.xml import fmt_float, fmt_floats
@@ -20,12 +19,18 @@ from mpc.ir.robot import Collision, Inertial, Joint, Link, Material, Pose, Robot
 from mpc.ir.tree import depth_first
 
 MeshNamer = Callable[[Mesh], str]
-_ATTR_ESCAPES = {'"': "&quot;", "\n": "&#10;", "\t": "&#9;"}
 IND = "  "
 
 
+def _escape(v: str) -> str:
+    """What xml.sax.saxutils.escape(v, {'"': "&quot;", "\\n": "&#10;", "\\t": "&#9;"}) gives; saxutils imports
+    urllib.request and http.client, which `mpc check` (it imports this module through urdf.py) never uses."""
+    return (v.replace("&", "&amp;").replace(">", "&gt;").replace("<", "&lt;").replace('"', "&quot;")
+            .replace("\n", "&#10;").replace("\t", "&#9;"))
+
+
 def _attrs(pairs: list[tuple[str, str | None]] | Attrs) -> str:
-    return "".join(f' {k}="{escape(v, _ATTR_ESCAPES)}"' for k, v in pairs if v is not None)
+    return "".join(f' {k}="{_escape(v)}"' for k, v in pairs if v is not None)
 
 
 def _num(x: float | None) -> str | None:

@@ -63,7 +63,7 @@ class XmlSource:
         elements = [e for e in root.iter() if isinstance(e.tag, str)]
         if len(starts) == len(elements):
             for el, (offset, tag) in zip(elements, starts, strict=True):
-                if tag.rsplit(":", 1)[-1] == etree.QName(el).localname:
+                if tag.rsplit(":", 1)[-1] == _localname(el):
                     src._offsets[el] = offset
         return src
 
@@ -87,8 +87,13 @@ class XmlSource:
                 end_line, end_col = self._pos(m.end(2))
                 return Span(self.file, line, col, end_line, end_col)
         line, col = self._pos(offset)
-        tag_end = offset + 1 + len(str(etree.QName(el).localname))
+        tag_end = offset + 1 + len(_localname(el))
         return Span(self.file, line, col, line, col + (tag_end - offset))
+
+
+def _localname(el: etree._Element) -> str:
+    """etree.QName(el).localname, without building a QName (`{namespace}name` → `name`)."""
+    return str(el.tag).rpartition("}")[2]
 
 
 def load(path: Path, sink: Sink, kind: str, file: str | None = None) -> XmlSource | None:

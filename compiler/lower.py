@@ -27,13 +27,11 @@ from mpc.compiler.schema.base import Node
 from mpc.ir.naming import LINK_SUFFIX, SCOPES, NameRule, bad_pattern, edit_name, takes_link_suffix
 from mpc.ir.ops import (
     ROOT,
-    ApplyScale,
     Attach,
     EditNames,
     LoadModel,
     Mirror,
     Op,
-    ReduceMeshes,
     RemoveBeyond,
     SetRobotName,
     TakeLeaf,
@@ -281,6 +279,10 @@ class _Lowering:
     def mesh_ops(self) -> None:
         """`apply_scale` and `reduce_meshes`, after every edit (they act on the final meshes)."""
         m = self.model
+        if not m.apply_scale and m.reduce_meshes is None:
+            return
+        from mpc.ir.ops.meshes import ApplyScale, ReduceMeshes  # imported only for a definition that asks
+
         if m.apply_scale:
             self.ops.append(ApplyScale(span=m.key_span("apply_scale")))
         if m.reduce_meshes is not None:

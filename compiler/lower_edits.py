@@ -14,37 +14,12 @@ from typing import TYPE_CHECKING, Any
 from mpc.compiler.schema.annotations import MULTI_LINK_SENSORS, SINGLE_LINK_SENSORS, sensor_entries
 from mpc.compiler.schema.base import Node
 from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
-from mpc.ir.ops import (
-    AddAnnotations,
-    AddCutJoint,
-    AddFrame,
-    AddPose,
-    AddSensor,
-    AddSubmechanism,
-    AnnotateLinks,
-    AutoBitmask,
-    CompleteSubmechanisms,
-    EditCollisions,
-    EditJoint,
-    EditMaterial,
-    EditNames,
-    EditVisuals,
-    EstimateMissingComs,
-    JointDefaults,
-    MakeRoot,
-    MoveJointAxisToIntersection,
-    RemoveJoint,
-    ReparentLink,
-    ReplaceJointTypes,
-    SetMotor,
-    SubmechanismsFile,
-    TransformFrame,
-    TransformLink,
-)
-from mpc.ir.ops.joints import Dependency, JointValues
+from mpc.ir import ops
 
 if TYPE_CHECKING:
     from mpc.compiler.lower import _Lowering
+    from mpc.ir.ops import SetMotor
+    from mpc.ir.ops.joints import JointValues
 
 _LIMIT_KEYS = {"min": "lower", "max": "upper", "eff": "effort", "vel": "velocity", "friction": "friction",
                "damping": "damping", "spring_stiffness": "spring_stiffness",
@@ -100,16 +75,17 @@ class EditLowering:
         for name, pose in m.poses.items():
             positions = {j: self.lw.num_value(v, pose.value_span(j), f"pose '{name}' joint '{j}'")
                          for j, v in pose.entries.items()}
-            self.add(AddPose(span=pose.span, name=name, positions=positions,  # type: ignore[arg-type]
-                             default=self.lw.num(pose, "default", f"pose '{name}' $default"),
-                             spans={f"positions/{j}": pose.key_span(j) for j in positions}))
+            self.add(ops.AddPose(span=pose.span, name=name, positions=positions,  # type: ignore[arg-type]
+                                 default=self.lw.num(pose, "default", f"pose '{name}' $default"),
+                                 spans={f"positions/{j}": pose.key_span(j) for j in positions}))
         if m.annotations is not None:
             for category, content in m.annotations.named_annotations.items():
-                self.add(AddAnnotations(span=m.annotations.key_span("named_annotations"),
-                                        category=category, content=content))
+                self.add(ops.AddAnnotations(span=m.annotations.key_span("named_annotations"),
+                                            category=category, content=content))
             if m.annotations.general_annotations:
-                self.add(AddAnnotations(span=m.annotations.key_span("general_annotations"),
-                                        category="annotations", content=m.annotations.general_annotations))
+                self.add(ops.AddAnnotations(span=m.annotations.key_span("general_annotations"),
+                                            category="annotations",
+                                            content=m.annotations.general_annotations))
 
     # -- materials and frames -------------------------------------------------------------
 
@@ -136,11 +112,12 @@ class EditLowering:
     def material(self, name: str, d: Any) -> None:
         colours = {k: self.lw.vec(d, k, f"material '{name}' {k}") for k in
                    ("diffuse", "ambient", "specular", "emissive")}
-        self.add(EditMaterial(span=d.span, name=name, **colours, texture=d.texture,
-                              normal_texture=d.normalTexture,
-                              shininess=self.lw.num(d, "shininess", f"material '{name}' shininess"),
-                              transparency=self.lw.num(d, "transparency", f"material '{name}' transparency"),
-                              annotations=d.entries))
+        self.add(ops.EditMaterial(span=d.span, name=name, **colours, texture=d.texture,
+                                  normal_texture=d.normalTexture,
+                                  shininess=self.lw.num(d, "shininess", f"material '{name}' shininess"),
+                                  transparency=self.lw.num(d, "transparency",
+                                                           f"material '{name}' transparency"),
+                                  annotations=d.entries))
 
     def frames(self) -> None:
         section = self.model.frames
@@ -154,7 +131,7 @@ class EditLowering:
             self.sink.error(d.key_span("make_root"), "E0313", f"make_root on '{name}': only one "
                             f"link can be the root, and '{roots[0][0]}' is made root already")
         if roots:
-            self.add(MakeRoot(span=roots[0][1].key_span("make_root"), link=roots[0][0]))
+            self.add(ops.MakeRoot(span=roots[0][1].key_span("make_root"), link=roots[0][0]))
         if section.default is not None:
             self.refuse(section.default, "frames $default", _NOT_IN_FRAME_DEFAULT)
             self.link_edits("", section.default, all_links=True)
@@ -166,12 +143,12 @@ class EditLowering:
         for name, d in entries.items():
             if d.name_editing is not None:
                 self.scoped(d.name_editing, f"frames.{name}.name_editing", "link")
-                self.add(EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
-                                   kinds=("link",), only=(name,)))
+                self.add(ops.EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
+                                       kinds=("link",), only=(name,)))
         if section.name_editing is not None:
             self.scoped(section.name_editing, "frames.$name_editing", "link")
-            self.add(EditNames(span=section.name_editing.span, kinds=("link",),
-                               rules=self.lw.name_rules(section.name_editing)))
+            self.add(ops.EditNames(span=section.name_editing.span, kinds=("link",),
+                                   rules=self.lw.name_rules(section.name_editing)))
 
     def new_frame(self, name: str, d: FrameDef) -> None:
         j = d.joint
@@ -184,35 +161,37 @@ class EditLowering:
         xyz = self.lw.vec(src, "xyz", f"frame '{name}' xyz") or (0.0, 0.0, 0.0)
         rpy = self.lw.vec(src, "rpy", f"frame '{name}' rpy") or (0.0, 0.0, 0.0)
         joint = (j.name if j is not None else d.jointname) or name
-        self.add(AddFrame(span=d.span, link=name, parent=parent or "", joint=joint,  # type: ignore[arg-type]
-                          type=(j.type if j is not None else d.type) or "fixed", xyz=xyz, rpy=rpy,
-                          axis=self.lw.vec(src, "axis", f"frame '{name}' axis"),
-                          mass=self.lw.num(d, "mass", f"frame '{name}' mass"), annotations=d.entries,
-                          spans={"parent": src.value_span("parent"), "link": d.span}))
+        self.add(ops.AddFrame(span=d.span, link=name, parent=parent or "", joint=joint,  # type: ignore[arg-type]
+                              type=(j.type if j is not None else d.type) or "fixed", xyz=xyz, rpy=rpy,
+                              axis=self.lw.vec(src, "axis", f"frame '{name}' axis"),
+                              mass=self.lw.num(d, "mass", f"frame '{name}' mass"), annotations=d.entries,
+                              spans={"parent": src.value_span("parent"), "link": d.span}))
 
     def link_edits(self, name: str, d: FrameDef, *, all_links: bool, is_new: bool = False) -> None:
         links = () if all_links else (name,)
         spans = {"link": d.span, "links": d.span, "parent": d.value_span("reparent_to"),
                  "material": d.value_span("material")}
-        for key, op in (("transform_link", TransformLink), ("transform_frame", TransformFrame)):
+        for key, op in (("transform_link", ops.TransformLink), ("transform_frame", ops.TransformFrame)):
             t = getattr(d, key)
             if t is not None and not all_links:
                 self.add(op(span=d.key_span(key), link=name, spans=spans,
                             xyz=self.lw.vec(t, "xyz", f"{key} of '{name}'") or (0.0, 0.0, 0.0),
                             rpy=self.lw.vec(t, "rpy", f"{key} of '{name}'") or (0.0, 0.0, 0.0)))
         if d.reparent_to is not None and not all_links:
-            self.add(ReparentLink(span=d.key_span("reparent_to"), link=name, parent=d.reparent_to,
-                                  spans=spans))
+            self.add(ops.ReparentLink(span=d.key_span("reparent_to"), link=name, parent=d.reparent_to,
+                                      spans=spans))
         if d.estimate_missing_coms:
-            self.add(EstimateMissingComs(span=d.key_span("estimate_missing_coms"), links=links,
-                                         spans=spans))
+            self.add(ops.EstimateMissingComs(span=d.key_span("estimate_missing_coms"), links=links,
+                                             spans=spans))
         if (d.entries and not is_new) or d.material:
-            self.add(AnnotateLinks(span=d.span, links=links, material=d.material,
-                                   annotations={} if is_new else d.entries, spans=spans))
+            self.add(ops.AnnotateLinks(span=d.span, links=links, material=d.material,
+                                       annotations={} if is_new else d.entries, spans=spans))
 
     # -- joints ----------------------------------------------------------------------------
 
     def values(self, d: Any, what: str) -> JointValues:
+        from mpc.ir.ops.joints import JointValues
+
         return JointValues(**{field: self.lw.num(d, key, f"{what} {key}")
                               for key, field in _LIMIT_KEYS.items() if hasattr(d, key)})
 
@@ -221,8 +200,8 @@ class EditLowering:
         assert section is not None
         entries: dict[str, JointDef] = section.entries
         if section.replace_joint_types:
-            self.add(ReplaceJointTypes(span=section.key_span("$replace_joint_types"),
-                                       mapping=tuple(section.replace_joint_types.items())))
+            self.add(ops.ReplaceJointTypes(span=section.key_span("$replace_joint_types"),
+                                           mapping=tuple(section.replace_joint_types.items())))
         for name, d in entries.items():
             if d.cut_joint:
                 self.cut_joint(name, d)
@@ -230,28 +209,28 @@ class EditLowering:
             self.refuse(section.default, "joints $default", _NOT_IN_JOINT_DEFAULT)
             listed = () if section.all else tuple(n for n, d in entries.items()
                                                   if not d.cut_joint and not d.remove)
-            self.add(JointDefaults(span=section.key_span("$default"), joints=listed,
-                                   values=self.values(section.default, "joints $default"),
-                                   annotations=section.default.entries,
-                                   spans={"joints": section.key_span("$default")}))
+            self.add(ops.JointDefaults(span=section.key_span("$default"), joints=listed,
+                                       values=self.values(section.default, "joints $default"),
+                                       annotations=section.default.entries,
+                                       spans={"joints": section.key_span("$default")}))
         if section.backup is not None:
-            self.add(JointDefaults(span=section.key_span("$backup"), backup=True,
-                                   values=self.values(section.backup, "joints $backup")))
+            self.add(ops.JointDefaults(span=section.key_span("$backup"), backup=True,
+                                       values=self.values(section.backup, "joints $backup")))
         for name, d in entries.items():
             if not d.cut_joint and not d.remove:
                 self.joint_edits(name, d)
         for name, d in entries.items():
             if d.remove:
-                self.add(RemoveJoint(span=d.key_span("remove"), joint=name, spans={"joint": d.span}))
+                self.add(ops.RemoveJoint(span=d.key_span("remove"), joint=name, spans={"joint": d.span}))
         for name, d in entries.items():
             if d.name_editing is not None:
                 self.scoped(d.name_editing, f"joints.{name}.name_editing", "joint")
-                self.add(EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
-                                   kinds=("joint",), only=(name,)))
+                self.add(ops.EditNames(span=d.name_editing.span, rules=self.lw.name_rules(d.name_editing),
+                                       kinds=("joint",), only=(name,)))
         if section.name_editing is not None:
             self.scoped(section.name_editing, "joints.$name_editing", "joint")
-            self.add(EditNames(span=section.name_editing.span, kinds=("joint",),
-                               rules=self.lw.name_rules(section.name_editing)))
+            self.add(ops.EditNames(span=section.name_editing.span, kinds=("joint",),
+                                   rules=self.lw.name_rules(section.name_editing)))
 
     def cut_joint(self, name: str, d: JointDef) -> None:
         if d.parent is None or d.child is None:
@@ -260,11 +239,13 @@ class EditLowering:
             return
         axes = tuple((a.name, self.lw.vec(a, "axis", f"cut joint '{name}' axis") or (0.0, 0.0, 0.0))
                      for a in d.constraint_axes or [])
-        self.add(AddCutJoint(span=d.span, joint=name, parent=d.parent, child=d.child,
-                             type=d.type or "fixed", constraint_axes=axes,  # type: ignore[arg-type]
-                             annotations=d.entries, spans=_spans(d, "parent", "child")))
+        self.add(ops.AddCutJoint(span=d.span, joint=name, parent=d.parent, child=d.child,
+                                 type=d.type or "fixed", constraint_axes=axes,  # type: ignore[arg-type]
+                                 annotations=d.entries, spans=_spans(d, "parent", "child")))
 
     def joint_edits(self, name: str, d: JointDef) -> None:
+        from mpc.ir.ops.joints import Dependency
+
         what = f"joint '{name}'"
         deps = tuple(Dependency(joint=x.joint, multiplier=self.lw.num(x, "multiplier", what) or 0.0,
                                 offset=self.lw.num(x, "offset", what) or 0.0)
@@ -276,16 +257,16 @@ class EditLowering:
                                offset=self.lw.num(d.mimic, "offset", f"{what} mimic") or 0.0)
         spans = {"joint": d.span, "mimic": d.value_span("mimic") if d.mimic else
                  d.value_span("movement_depends_on")}
-        self.add(EditJoint(span=d.span, joint=name, values=self.values(d, what), type=d.type,
-                           axis=self.lw.vec(d, "axis", f"{what} axis"),  # type: ignore[arg-type]
-                           mimic=mimic, depends_on=deps, annotations=d.entries, spans=spans))
+        self.add(ops.EditJoint(span=d.span, joint=name, values=self.values(d, what), type=d.type,
+                               axis=self.lw.vec(d, "axis", f"{what} axis"),  # type: ignore[arg-type]
+                               mimic=mimic, depends_on=deps, annotations=d.entries, spans=spans))
         motor = self.motor(name, d)
         if motor is not None:
             self.add(motor)
         if d.move_joint_axis_to_intersection:
             a, b = d.move_joint_axis_to_intersection
             key = "move_joint_axis_to_intersection"
-            self.add(MoveJointAxisToIntersection(
+            self.add(ops.MoveJointAxisToIntersection(
                 span=d.key_span(key), joint=name, a=a, b=b,
                 spans={"a": self.lw.item_span(d, key, 0), "b": self.lw.item_span(d, key, 1)}))
 
@@ -305,8 +286,8 @@ class EditLowering:
                 settings.update(m.entries)
                 motor_name = m.name or motor_name
         key = "active" if d.active not in (None, False) else "motor"
-        return SetMotor(span=d.key_span(key), joint=name, name=motor_name, settings=settings,
-                        spans={"joint": d.span})
+        return ops.SetMotor(span=d.key_span(key), joint=name, name=motor_name, settings=settings,
+                            spans={"joint": d.span})
 
     # -- collisions, visuals ---------------------------------------------------------------
 
@@ -315,13 +296,13 @@ class EditLowering:
         assert section is not None
         if section.name_editing is not None:
             self.scoped(section.name_editing, "collisions.$name_editing", "collision")
-            self.add(EditNames(span=section.name_editing.span, kinds=("collision",),
-                               rules=self.lw.name_rules(section.name_editing)))
+            self.add(ops.EditNames(span=section.name_editing.span, kinds=("collision",),
+                                   rules=self.lw.name_rules(section.name_editing)))
         todo = [("", section.default)] if section.default is not None else []
         todo += list(section.entries.items())
         for target, d in todo:
             remove = self.removal(d, f"collisions of '{target or '$default'}'")
-            self.add(EditCollisions(
+            self.add(ops.EditCollisions(
                 span=d.span, target=target, exclude=tuple(section.exclude) if not target else (),
                 remove=remove, shape=d.shape, oriented=d.oriented, replace=section.apply_primitives,
                 scale=self.lw.num(d, "scale", f"collision '{target}' scale") or 1.0, join=d.join,
@@ -335,8 +316,8 @@ class EditLowering:
             spans = {f"pair/{a}": section.key_span(k) for k in pairs for a, _ in pairs[k]}
             spans.update({f"pair/{a}/{b}": self.lw.pair_span(section, k, a, b)
                           for k in pairs for a, b in pairs[k]})
-            self.add(AutoBitmask(span=section.key_span("auto_bitmask"), spans=spans,
-                                 never=pairs["no_collision_between"], always=pairs["collision_between"]))
+            self.add(ops.AutoBitmask(span=section.key_span("auto_bitmask"), spans=spans,
+                                     never=pairs["no_collision_between"], always=pairs["collision_between"]))
         else:
             for key in pairs:
                 if pairs[key]:
@@ -348,12 +329,12 @@ class EditLowering:
         assert section is not None
         if section.name_editing is not None:
             self.scoped(section.name_editing, "visuals.$name_editing", "visual")
-            self.add(EditNames(span=section.name_editing.span, kinds=("visual",),
-                               rules=self.lw.name_rules(section.name_editing)))
+            self.add(ops.EditNames(span=section.name_editing.span, kinds=("visual",),
+                                   rules=self.lw.name_rules(section.name_editing)))
         todo = [("", section.default)] if section.default is not None else []
         todo += list(section.entries.items())
         for target, d in todo:
-            self.add(EditVisuals(
+            self.add(ops.EditVisuals(
                 span=d.span, targets=(target,) if target else (),
                 exclude=tuple(section.exclude) if not target else (),
                 remove=self.removal(d, f"visuals of '{target or '$default'}'"), material=d.material,
@@ -375,7 +356,7 @@ class EditLowering:
             if not path.is_file():
                 self.sink.error(m.value_span("submechanisms_file"), "E0601",
                                 f"submechanisms_file '{path}' does not exist")
-            self.add(SubmechanismsFile(span=m.value_span("submechanisms_file"), path=str(path)))
+            self.add(ops.SubmechanismsFile(span=m.value_span("submechanisms_file"), path=str(path)))
         for exo, items in lists:
             for s in items:
                 joints = []
@@ -385,12 +366,12 @@ class EditLowering:
                 links = [b for lc in getattr(s, "loop_constraints", [])
                          for b in (lc.predecessor_body, lc.successor_body)]
                 links += [s.around] if getattr(s, "around", None) else []
-                self.add(AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
-                                         links=tuple(dict.fromkeys(links)),
-                                         definition=s.to_data()))
+                self.add(ops.AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
+                                             links=tuple(dict.fromkeys(links)),
+                                             definition=s.to_data()))
         if m.submechanisms or m.exoskeletons:
             span = m.key_span("submechanisms" if m.submechanisms else "exoskeletons")
-            self.add(CompleteSubmechanisms(span=span))
+            self.add(ops.CompleteSubmechanisms(span=span))
 
     def sensors(self) -> None:
         assert self.model.sensors is not None
@@ -410,7 +391,7 @@ class EditLowering:
                 self.sink.error(d.span, "E0316", f"{kind} sensor '{d.name}' needs 'targets' "
                                 "(a list, or All)")
                 continue
-            self.add(AddSensor(
+            self.add(ops.AddSensor(
                 span=d.span, type=kind, name=d.name, link=d.link, joint=d.joint, frame=d.frame,
                 targets=tuple(d.targets or ()), targets_kind="link" if kind.startswith("Node") else "joint",
                 position_offset=self.lw.vec(d, "position_offset", f"sensor '{d.name}' position_offset"),

@@ -6,7 +6,6 @@ file it cannot read (it then prints the header line alone).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
@@ -53,6 +52,7 @@ def gcc(diagnostics: Iterable[Diagnostic]) -> str:
 
 def as_json(diagnostics: Iterable[Diagnostic]) -> str:
     """A JSON list of objects with code, severity, message, span, notes and hint."""
+    import json  # only for --format json: `mpc check` would import it for nothing
 
     def span(s: Span | None) -> dict[str, object] | None:
         if s is None:

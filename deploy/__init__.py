@@ -10,7 +10,9 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["DeployResult", "DeploySettings", "deploy_model"]
+__all__ = ["FORGES", "DeployResult", "DeploySettings", "deploy_model"]
+
+FORGES = ("gitlab", "github", "none")  # how merge requests are made (a pipeline's `forge`, deploy/forges.py)
 
 
 def __getattr__(name: str) -> Any:

@@ -10,8 +10,7 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler import render
 from mpc.compiler.diagnostics import Severity, Sink
-from mpc.deploy.forges import FORGES
-from mpc.deploy.gitcmd import scrub
+from mpc.deploy import FORGES
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
@@ -99,6 +98,8 @@ def _settings(args: argparse.Namespace, sink: Sink) -> DeploySettings | None:
 
 
 def _report(result: DeployResult, indent: str) -> None:
+    from mpc.deploy.gitcmd import scrub
+
     where = f"branch '{result.branch}' of '{scrub(result.remote or '')}'"
     if result.skipped:
         print(f"{indent}'{result.modelname}' is not deployed (do_not_deploy)")

@@ -16,7 +16,6 @@ from typing import Protocol
 from mpc.deploy.gitcmd import scrub
 
 # A push option travels as one pkt-line (at most 65516 bytes); keep well below.
-FORGES = ("gitlab", "github", "none")  # how merge requests are made (a pipeline's `forge`)
 MAX_OPTION_BYTES = 60000
 _GITLAB_MR_URL = re.compile(r"remote:\s+(https?://\S+/merge_requests/\d+)")
 

@@ -20,8 +20,10 @@ from pathlib import Path, PurePath
 from typing import Any, Literal, Union, get_args, get_origin
 
 from mpc.compiler.diagnostics import did_you_mean
-from mpc.ir.ops import OPS
+from mpc.ir.ops import OPS, import_all
 from mpc.ir.span import Span
+
+import_all()  # the IR text names every op: import the op modules `mpc check` does not need
 
 SEQUENCES = (tuple, list, frozenset, set, abc.Sequence, abc.MutableSequence, abc.Set, abc.MutableSet,
              abc.Collection, abc.Iterable)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.names import Kind, Names
@@ -94,47 +94,81 @@ class Op:
         raise NotImplementedError
 
 
-# The op modules register their classes in OPS when imported.
-from mpc.ir.ops.annotate import (  # noqa: E402
-    AddAnnotations,
-    AddPose,
-    AddSensor,
-    AddSubmechanism,
-    AutoBitmask,
-    CompleteSubmechanisms,
-    EditCollisions,
-    EditMaterial,
-    EditVisuals,
-    SubmechanismsFile,
-)
-from mpc.ir.ops.assembly import (  # noqa: E402
-    Attach,
-    EditNames,
-    LoadModel,
-    Mirror,
-    RemoveBeyond,
-    TakeLeaf,
-)
-from mpc.ir.ops.frames import (  # noqa: E402
-    AddFrame,
-    AnnotateLinks,
-    EstimateMissingComs,
-    MakeRoot,
-    ReparentLink,
-    TransformFrame,
-    TransformLink,
-)
-from mpc.ir.ops.joints import (  # noqa: E402
-    AddCutJoint,
-    EditJoint,
-    JointDefaults,
-    MoveJointAxisToIntersection,
-    RemoveJoint,
-    ReplaceJointTypes,
-    SetMotor,
-)
-from mpc.ir.ops.meshes import ApplyScale, ReduceMeshes  # noqa: E402
-from mpc.ir.ops.robot import SetRobotName  # noqa: E402
+# The op classes live in the modules below and register in OPS when their module is imported.
+# A module is imported when one of its names is first asked for (`from mpc.ir.ops import AddFrame`,
+# `ops.AddFrame`), so that `mpc check` imports only the ops a definition uses; `import_all` imports
+# every one (the IR text printer and parser know every op).
+_MODULES = {
+    "annotate": ("AddAnnotations", "AddPose", "AddSensor", "AddSubmechanism", "AutoBitmask",
+                 "CompleteSubmechanisms", "EditCollisions", "EditMaterial", "EditVisuals",
+                 "SubmechanismsFile"),
+    "assembly": ("Attach", "EditNames", "LoadModel", "Mirror", "RemoveBeyond", "TakeLeaf"),
+    "frames": ("AddFrame", "AnnotateLinks", "EstimateMissingComs", "MakeRoot", "ReparentLink",
+               "TransformFrame", "TransformLink"),
+    "joints": ("AddCutJoint", "EditJoint", "JointDefaults", "MoveJointAxisToIntersection", "RemoveJoint",
+               "ReplaceJointTypes", "SetMotor"),
+    "meshes": ("ApplyScale", "ReduceMeshes"),
+    "robot": ("SetRobotName",),
+}
+_MODULE_OF = {name: module for module, names in _MODULES.items() for name in names}
+
+if TYPE_CHECKING:
+    from mpc.ir.ops.annotate import (
+        AddAnnotations,
+        AddPose,
+        AddSensor,
+        AddSubmechanism,
+        AutoBitmask,
+        CompleteSubmechanisms,
+        EditCollisions,
+        EditMaterial,
+        EditVisuals,
+        SubmechanismsFile,
+    )
+    from mpc.ir.ops.assembly import (
+        Attach,
+        EditNames,
+        LoadModel,
+        Mirror,
+        RemoveBeyond,
+        TakeLeaf,
+    )
+    from mpc.ir.ops.frames import (
+        AddFrame,
+        AnnotateLinks,
+        EstimateMissingComs,
+        MakeRoot,
+        ReparentLink,
+        TransformFrame,
+        TransformLink,
+    )
+    from mpc.ir.ops.joints import (
+        AddCutJoint,
+        EditJoint,
+        JointDefaults,
+        MoveJointAxisToIntersection,
+        RemoveJoint,
+        ReplaceJointTypes,
+        SetMotor,
+    )
+    from mpc.ir.ops.meshes import ApplyScale, ReduceMeshes
+    from mpc.ir.ops.robot import SetRobotName
+
+
+def __getattr__(name: str) -> Any:
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'mpc.ir.ops' has no attribute '{name}'")
+    # __import__ rather than importlib.import_module: it shows in `python -X importtime`.
+    return getattr(__import__(f"{__name__}.{module}", fromlist=[name]), name)
+
+
+def import_all() -> dict[str, type[Op]]:
+    """OPS with every op in it."""
+    for module in _MODULES:
+        __import__(f"{__name__}.{module}")
+    return OPS
+
 
 __all__ = [
     "OPS",
@@ -176,4 +210,5 @@ __all__ = [
     "TakeLeaf",
     "TransformFrame",
     "TransformLink",
+    "import_all",
 ]
