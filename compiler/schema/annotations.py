@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, OpenNode, Vec3
+from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, Vec3
 from mpc.compiler.schema.editing import ConstraintAxis
 
 SINGLE_LINK_SENSORS = ("Joint6DOF", "CameraSensor", "RotatingRaySensor", "IMU", "GPS")
@@ -15,7 +15,7 @@ SensorType = Literal["Joint6DOF", "CameraSensor", "RotatingRaySensor", "IMU", "G
                      "NodeRotation", "NodeContact", "NodeContactForce", "NodeCOM"]
 
 
-class SensorDef(OpenNode):
+class SensorDef(Node):
     """A sensor: single-link types name a `link` (or `joint`), multi-link types `targets`.
 
     type: required in the list form; in the mapping form (`sensors: {IMU: {...}}`) it is
@@ -48,7 +48,7 @@ def sensor_entries(section: SensorsSection) -> list[tuple[str | None, SensorDef]
     return out
 
 
-class PoseDef(OpenNode):
+class PoseDef(Node):
     """A named joint configuration: joint → position; `$default` fills the other joints."""
 
     SECTION: ClassVar[str] = "a pose"

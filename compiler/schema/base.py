@@ -30,6 +30,7 @@ dropped from it rather than failing its neighbours.
 from __future__ import annotations
 
 import inspect
+import sys
 import types
 import typing
 from collections.abc import Callable
@@ -185,16 +186,12 @@ class Node:
         return all(getattr(self, n) == getattr(other, n) for n in
                    (f.name for f in self.fields().values())) and self._extra == other._extra  # type: ignore[attr-defined]
 
-    __hash__ = object.__hash__
+    __hash__ = None  # type: ignore[assignment]  # equal by value, and lists are not hashable
 
     def __repr__(self) -> str:
         items = [f"{f.name}={getattr(self, f.name)!r}" for f in self.fields().values()]
         items += [f"{k!r}: {v!r}" for k, v in self._extra.items()]
         return f"{type(self).__name__}({', '.join(items)})"
-
-
-class OpenNode(Node):
-    """A node that keeps undeclared keys (entries or annotations)."""
 
 
 def _plain(value: Any) -> Any:
@@ -207,12 +204,27 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _annotations(cls: type) -> dict[str, Any]:
+    """The field annotations of a class and its bases, unevaluated (strings, under
+    `from __future__ import annotations`), without class variables and private names."""
+    out: dict[str, Any] = {}
+    for c in reversed(cls.__mro__):
+        for name, hint in inspect.get_annotations(c).items():
+            if not name.startswith("_") and not str(hint).startswith(("ClassVar", "typing.ClassVar")):
+                out[name] = (hint, c)
+    return out
+
+
+def _evaluate(hint: Any, owner: type) -> Any:
+    """An annotation's value, in the module that declares it (typing.get_type_hints does the
+    same for every annotation of the class, class variables too, at several times the cost)."""
+    return eval(hint, vars(sys.modules[owner.__module__])) if isinstance(hint, str) else hint
+
+
 def _resolve(cls: type[Node]) -> dict[str, FieldSpec]:
-    hints = typing.get_type_hints(cls, include_extras=True)
     out: dict[str, FieldSpec] = {}
-    for name, hint in hints.items():
-        if name.startswith("_") or typing.get_origin(hint) is ClassVar:
-            continue
+    for name, (text, owner) in _annotations(cls).items():
+        hint = _evaluate(text, owner)
         declared = getattr(cls, name, _REQUIRED)
         info = declared if isinstance(declared, Field) else Field(declared)
         type_ = compile_type(hint)
@@ -232,9 +244,6 @@ class Type:
     """A checked type: validates a value at a path, reporting problems through `Walk`."""
 
     wanted = "of another form"  # "must be <wanted>" in messages
-    before: Callable[[Any], Any] | None = None
-    after: Callable[[Any], Any] | None = None
-    json: dict[str, Any] | None = None
 
     def fits(self, value: Any) -> bool:
         """Whether the value has this type's shape (which union member it is meant for)."""
@@ -447,9 +456,9 @@ class TaggedType(Type):
 
     @property
     def tags(self) -> dict[str, type[Node]]:
-        """tag → node class (resolved on first use: the members may contain this union)."""
+        """tag → node class (on first use: the members may contain this union)."""
         if self._tags is None:
-            self._tags = {tag: m for m in self.members for tag in m.fields()["type"].type.values}
+            self._tags = {tag: m for m in self.members for tag in typing.get_args(_type_literal(m))}
         return self._tags
 
     def fits(self, value: Any) -> bool:
@@ -592,15 +601,18 @@ def compile_type(tp: Any) -> Type:
 
 def _union(members: list[Any]) -> Type:
     """Nodes with a `type` literal each are told apart by it; others by their shape."""
-    if all(isinstance(m, type) and issubclass(m, Node) and _declares_type_literal(m) for m in members):
+    if all(isinstance(m, type) and issubclass(m, Node) and _type_literal(m) for m in members):
         return TaggedType(members)
     return UnionType([compile_type(m) for m in members])
 
 
-def _declares_type_literal(cls: type[Node]) -> bool:
-    """Whether the class itself declares `type: Literal[…]` (read without resolving it)."""
+def _type_literal(cls: type[Node]) -> Any:
+    """The class's own `type: Literal[…]` annotation, or None; evaluated alone, since the
+    rest of the class may refer to the union being compiled."""
     hint = inspect.get_annotations(cls).get("type")
-    return typing.get_origin(hint) is Literal or str(hint).startswith("Literal[")
+    if hint is None or not str(hint).startswith(("Literal[", "typing.Literal[")):
+        return None
+    return _evaluate(hint, cls)
 
 
 # -- the walk --------------------------------------------------------------------------------
@@ -659,10 +671,10 @@ class Walk:
         extra: dict[str, Any] = {}
         failed = False
         for key, value in data.items():
-            key_path = self.written((*path, key))
             name = cls.ALIASES.get(key, key)
             if name in fields:
                 if name != key:
+                    key_path = self.written((*path, key))
                     if name in data:
                         self.error(self.doc.span(key_path), "E0204",
                                    f"'{key}' and '{name}' in {cls.SECTION} mean the same; give one")
@@ -674,12 +686,12 @@ class Walk:
             elif cls.ANNOTATIONS and not key.startswith("$"):
                 typo = next((k for k in fields if _one_edit(key, k)), None)
                 if typo is not None:
-                    self.warning(self.doc.span(key_path), "W0201", f"'{key}' in {cls.SECTION} is kept "
-                                 f"as an annotation; did you mean '{typo}'?")
+                    self.warning(self.doc.span(self.written((*path, key))), "W0201",
+                                 f"'{key}' in {cls.SECTION} is kept as an annotation; did you mean '{typo}'?")
                 extra[key] = value
             else:
                 pool = {k for k in fields if k.startswith("$")} if key.startswith("$") else set(fields)
-                self.error(self.doc.span(key_path), "E0201",
+                self.error(self.doc.span(self.written((*path, key))), "E0201",
                            f"unknown key '{key}' in {cls.SECTION}{did_you_mean(key, pool)}")
         values: dict[str, Any] = {}
         for key, f in fields.items():

@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Annotated, ClassVar, Literal
 
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
-from mpc.compiler.schema.base import Before, Expr, Field, Node, OneOrMore, OpenNode, Vec3, str_or_list
+from mpc.compiler.schema.base import Before, Expr, Field, Node, OneOrMore, Vec3, str_or_list
 
 Color = Annotated[list[Expr], Field(min_length=3, max_length=4)]
 
@@ -22,7 +22,7 @@ class Transform(Node):
     rpy: Vec3 = [0, 0, 0]
 
 
-class MaterialDef(OpenNode):
+class MaterialDef(Node):
     """Edit or create a material."""
 
     SECTION: ClassVar[str] = "a material"
@@ -52,7 +52,7 @@ class NewFrameJoint(Node):
     axis: Vec3 | None = None
 
 
-class FrameDef(OpenNode):
+class FrameDef(Node):
     """Operations and annotations of one link; a name not in the robot is a new frame."""
 
     SECTION: ClassVar[str] = "a frame"
@@ -76,7 +76,7 @@ class FrameDef(OpenNode):
     mass: Expr | None = None
 
 
-class FramesSection(OpenNode):
+class FramesSection(Node):
     """`frames` (alias `links`): per-link operations, `$default` for every link."""
 
     SECTION: ClassVar[str] = "frames"
@@ -95,7 +95,7 @@ class MimicDef(Node):
     offset: Expr = 0
 
 
-class MotorDef(OpenNode):
+class MotorDef(Node):
     """A motor on a joint: name (default `<joint>_motor`), controller gains, annotations."""
 
     SECTION: ClassVar[str] = "a motor"
@@ -125,7 +125,7 @@ class Limits(Node):
     vel: Expr | None = None
 
 
-class JointDef(OpenNode):
+class JointDef(Node):
     """Settings of one joint; a `cut_joint` that does not exist yet is a loop closure."""
 
     SECTION: ClassVar[str] = "a joint"
@@ -156,7 +156,7 @@ class JointDef(OpenNode):
     name_editing: NameEditing | None = None
 
 
-class JointsSection(OpenNode):
+class JointsSection(Node):
     """`joints`: per-joint settings plus section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "joints"
@@ -174,7 +174,7 @@ RemoveWhat = Annotated[bool | list[str], Before(
 ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
 
 
-class CollisionDef(OpenNode):
+class CollisionDef(Node):
     """Operations and annotations of a link's collisions (or of one collision by name)."""
 
     SECTION: ClassVar[str] = "a collision entry"
@@ -188,7 +188,7 @@ class CollisionDef(OpenNode):
     ccfm: Expr | None = None
 
 
-class CollisionsSection(OpenNode):
+class CollisionsSection(Node):
     """`collisions`: per-link (or per-collision) entries, bitmasks, section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "collisions"
@@ -202,7 +202,7 @@ class CollisionsSection(OpenNode):
     collision_between: dict[str, OneOrMore] = {}
 
 
-class VisualDef(OpenNode):
+class VisualDef(Node):
     """Operations and annotations of a link's visuals."""
 
     SECTION: ClassVar[str] = "a visual entry"
@@ -211,7 +211,7 @@ class VisualDef(OpenNode):
     material: str | None = None
 
 
-class VisualsSection(OpenNode):
+class VisualsSection(Node):
     """`visuals`: per-link entries and section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "visuals"
