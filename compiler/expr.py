@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.compiler.source import source_line
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:
@@ -34,7 +35,7 @@ FUNCTIONS: dict[str, tuple[int, int | None, Callable[..., float]]] = {
 # Nodes. `start`/`end` are 0-based offsets into the expression text (end exclusive);
 # the evaluator turns them into file spans, since the parser never sees the file.
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Num:
     """A number literal; value: its float value."""
 
@@ -43,7 +44,7 @@ class Num:
     end: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Name:
     """A bare name; id: as written (only the constants in CONSTANTS evaluate)."""
 
@@ -52,7 +53,7 @@ class Name:
     end: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Unary:
     """A sign applied to an operand; op: '+' or '-'."""
 
@@ -62,7 +63,7 @@ class Unary:
     end: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Binary:
     """left op right; op: one of + - * / **."""
 
@@ -73,7 +74,7 @@ class Binary:
     end: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Call:
     """func(args...); func: the name as written, args: the argument expressions in order."""
 
@@ -148,7 +149,7 @@ def _describe(value: object) -> str:
     return {type(None): "null", dict: "a mapping", list: "a list"}.get(type(value), type(value).__name__)
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class _Where:
     """Maps offsets in an expression's text onto the file; col: where the text starts, if known."""
 

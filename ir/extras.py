@@ -7,8 +7,9 @@ They travel with the robot value and are written by the formats that can hold th
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from mpc.ir.record import record
 from mpc.ir.robot import Pose
 from mpc.ir.span import Span
 
@@ -16,7 +17,7 @@ Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Motor:
     """A motor driving `joint`; settings: controller gains and limits as written (p, i, d, …)."""
 
@@ -25,7 +26,7 @@ class Motor:
     settings: Annotations = field(default_factory=dict)
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Sensor:
     """A sensor of `type` on `link` (or `joint`), or over `targets` (joints or links)."""
 
@@ -40,7 +41,7 @@ class Sensor:
     annotations: Annotations = field(default_factory=dict)
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class CutJoint:
     """A loop-closure joint between two links of the tree (not part of the tree).
 
@@ -58,7 +59,7 @@ class CutJoint:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Submechanism:
     """A submechanism or exoskeleton (HyRoDyn's terms): its definition as written."""
 

@@ -8,15 +8,15 @@ dropping it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal
 
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 RefKind = Literal["link", "joint"]
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class FragmentRef:
     """One place in a fragment that names a link or joint.
 
@@ -32,7 +32,7 @@ class FragmentRef:
     name: str
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Fragment:
     """An XML element kept verbatim.
 

@@ -7,16 +7,16 @@ backends materialise each distinct chain once, at emission.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 Vec3 = tuple[float, float, float]
 Attrs = tuple[tuple[str, str], ...]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Box:
     """A box centred at its origin. size: edge lengths along x, y, z in metres."""
 
@@ -24,7 +24,7 @@ class Box:
     extra_attrs: Attrs = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Cylinder:
     """A cylinder along z, centred at its origin. radius and length in metres."""
 
@@ -33,7 +33,7 @@ class Cylinder:
     extra_attrs: Attrs = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Sphere:
     """A sphere centred at its origin. radius in metres."""
 
@@ -41,7 +41,7 @@ class Sphere:
     extra_attrs: Attrs = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class MeshSource:
     """Where a mesh file comes from.
 
@@ -61,7 +61,7 @@ class MeshSource:
         return name.rsplit(".", 1)[-1].lower() if "." in name else ""
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ReflectMesh:
     """Mesh op: reflect the mesh's vertices along one of its axes (0 x, 1 y, 2 z).
 
@@ -72,12 +72,12 @@ class ReflectMesh:
     axis: int
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ConvexHull:
     """Mesh op: replace the mesh by its convex hull."""
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class JoinShapes:
     """Mesh op: the mesh becomes the union of `parts`, each a shape with its pose (xyz, rpy)
     in this mesh's frame. The source file then only names the result."""
@@ -85,7 +85,7 @@ class JoinShapes:
     parts: tuple[tuple[Geometry, Vec3, Vec3], ...]
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ReduceMesh:
     """Mesh op: quadric decimation to `faces` faces, or to `ratio` of them (one is given)."""
 
@@ -93,14 +93,14 @@ class ReduceMesh:
     ratio: float | None = None
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ScaleMesh:
     """Mesh op: scale the vertices (`apply_scale` bakes an element's scale into its file)."""
 
     scale: Vec3
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ConvexPart:
     """Mesh op: part `index` of the convex decomposition (coacd) of the mesh so far, scaled
     by `scale` (the element's scale moves here: the element that uses the part has none)."""
@@ -112,7 +112,7 @@ class ConvexPart:
 MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh | ConvexPart
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Mesh:
     """A triangle mesh.
 

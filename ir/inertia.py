@@ -3,15 +3,14 @@ the composite of several bodies (parallel-axis theorem)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from mpc.ir.kinematics import pose_matrix
+from mpc.ir.record import record
 from mpc.ir.robot import Inertia, Inertial, Pose
 
 
-@dataclass(frozen=True)
+@record
 class Body:
     """mass (kg); com: p_LoBcm_L (m); I: the inertia about the COM, in frame L (kg·m²)."""
 

@@ -8,16 +8,17 @@ the tree (each joint's parent and child) because cuts and attachments need it.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from typing import Literal
 
+from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
 Kind = Literal["link", "joint", "collision", "visual", "material", "motor", "sensor", "pose",
                "submechanism"]
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Names:
     """The names of a robot.
 

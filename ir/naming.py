@@ -8,15 +8,16 @@ order, then the prefix and the suffix — neither is added twice (Phobos's meani
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import Literal
+
+from mpc.ir.record import record
 
 Scope = Literal["all", "link", "joint", "collision", "visual", "submechanism"]
 SCOPES: tuple[Scope, ...] = ("all", "link", "joint", "collision", "visual", "submechanism")
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class NameRule:
     """One scope's editing: replacements (pattern, replacement) in order, then prefix, suffix."""
 

@@ -7,15 +7,16 @@ The compiler's output and the input of the apply and emit phases. `mpc compile
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Literal
 
 from mpc.ir.ops import Op
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class RepoRef:
     """A model in a git repository: url, a commit (or branch), the file inside it."""
 
@@ -26,7 +27,7 @@ class RepoRef:
     submechanisms_in_repo: str | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Input:
     """An input model.
 
@@ -50,7 +51,7 @@ class Input:
     smurf_data: bool = True
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class UrdfExport:
     """A `type: urdf` entry of export_config.
 
@@ -87,7 +88,7 @@ class UrdfExport:
     type: Literal["urdf"] = "urdf"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class SdfExport:
     """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`; `link_in_smurf`,
     `ros_package`, `additional_meshes`, `enforce_zero`, `copy_package` (`_ros.sdf`,
@@ -110,7 +111,7 @@ class SdfExport:
     type: Literal["sdf"] = "sdf"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class MjcfExport:
     """A `type: mjcf` entry: MuJoCo's format; meshes in `mesh_format` (stl or obj: MuJoCo
     reads no DAE); `additional_meshes`, `enforce_zero`, `correct_inertials` as for URDF, and
@@ -129,7 +130,7 @@ class MjcfExport:
     type: Literal["mjcf"] = "mjcf"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class PdfExport:
     """A `type: pdf` entry: the kinematic tree as a graph (Graphviz source and PDF)."""
 
@@ -140,7 +141,7 @@ class PdfExport:
     type: Literal["pdf"] = "pdf"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class JointLimitsExport:
     """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED, ABSTRACT or
     names), written to `file_name`. joints_of: the submodel whose movable joints are listed
@@ -155,7 +156,7 @@ class JointLimitsExport:
     type: Literal["joint_limits"] = "joint_limits"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class SubmodelExport:
     """A `type: submodel` entry: the part of the robot that the exports naming it (their
     `submodel` field) write, into `submodels/<name>/` (ir/submodel.py).
@@ -188,7 +189,7 @@ class SubmodelExport:
     type: Literal["submodel"] = "submodel"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class RosPackageExport:
     """The ROS 2 package files (`package.xml`, `CMakeLists.txt`, `config/init_positions_*.yml`),
     added after the other exports when one of them writes `package://` paths.
@@ -204,7 +205,7 @@ class RosPackageExport:
     type: Literal["ros_package"] = "ros_package"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class CommandExport:
     """A `post_processing` command, run after the files are written (backends/commands.py).
 
@@ -221,7 +222,7 @@ class CommandExport:
     type: Literal["command"] = "command"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class SmurfExport:
     """The SMURF of one output folder (the model's, or a submodel's): `smurf/<name>.smurf`
     and `smurf/<name>_<category>.yml` (backends/smurf.py). Always written.
@@ -248,7 +249,7 @@ class SmurfExport:
     type: Literal["smurf"] = "smurf"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class KccdExport:
     """A `type: kccd` entry: the collision model KCCD reads (backends/kccd.py).
 
@@ -295,7 +296,7 @@ Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 # -- the `test` section (checks/) ---------------------------------------------------------
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Tolerances:
     """Tolerances of the model tests: `mass` (kg), `distance` (m), `rad` (angles and, for
     lack of a better one, torques are measured against `default`)."""
@@ -306,7 +307,7 @@ class Tolerances:
     distance: float = 0.003
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class CompareTarget:
     """The previous version of the model that the compare tests measure against.
 
@@ -326,7 +327,7 @@ class CompareTarget:
     ignore_failing_tests_for: str = ""
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class ModelTest:
     """One entry of `tests` (or of `hyrodynChecks`, then `dynamics`).
 
@@ -349,7 +350,7 @@ class ModelTest:
     as_error: bool = False
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class TestPlan:
     """The lowered `test` section: the tests in order, tolerances, the compare model and
     the expected values of `test_data_file`."""
@@ -363,7 +364,7 @@ class TestPlan:
     expected_mass: float | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Program:
     """A lowered model definition.
 
@@ -388,7 +389,7 @@ class Program:
 
 # -- deployment (deploy/) -------------------------------------------------------------------
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class DeploySubmodule:
     """A `deployment.submodules` entry: a git submodule kept in the model's repository.
 
@@ -404,7 +405,7 @@ class DeploySubmodule:
     branch: str | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class DeployMirror:
     """`deployment.mirror`: a second repository that gets a copy of the model's repository.
 
@@ -422,7 +423,7 @@ class DeployMirror:
     mr_target: str | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Deployment:
     """The `deployment` section: where the built and tested model goes (deploy/).
 

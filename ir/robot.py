@@ -16,11 +16,12 @@ Fields common to several elements:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, Literal
 
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Geometry, Vec3
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 JointType = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar"]
@@ -29,7 +30,7 @@ JOINT_TYPES: tuple[str, ...] = JointType.__args__  # type: ignore[attr-defined]
 ZERO: Vec3 = (0.0, 0.0, 0.0)
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Pose:
     """X_PC as URDF writes it: origin of C in P (xyz, metres) and fixed-axis rpy (radians).
 
@@ -44,7 +45,7 @@ class Pose:
 IDENTITY = Pose(written=(False, False))
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Inertia:
     """The rotational inertia about the COM, in the inertial frame (kg·m²)."""
 
@@ -56,7 +57,7 @@ class Inertia:
     izz: float
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Inertial:
     """Mass properties: origin is the COM frame in the link frame; mass in kg."""
 
@@ -66,7 +67,7 @@ class Inertial:
     extras: tuple[Fragment, ...] = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Material:
     """A named material: rgba colour (0..1 each) and/or a texture filename.
 
@@ -87,7 +88,7 @@ class Material:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Visual:
     """A visual shape of a link.
 
@@ -107,7 +108,7 @@ class Visual:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Collision:
     """A collision shape of a link."""
 
@@ -122,7 +123,7 @@ class Collision:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Link:
     """A rigid body. visuals and collisions keep their source order."""
 
@@ -138,7 +139,7 @@ class Link:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Limit:
     """Joint limits: position (lower, upper; rad or m), effort (N·m or N), velocity."""
 
@@ -149,7 +150,7 @@ class Limit:
     extra_attrs: Attrs = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Dynamics:
     """Viscous damping and Coulomb friction of a joint."""
 
@@ -158,7 +159,7 @@ class Dynamics:
     extra_attrs: Attrs = ()
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Mimic:
     """This joint follows `joint`: q = multiplier · q_joint + offset."""
 
@@ -167,7 +168,7 @@ class Mimic:
     offset: float | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Calibration:
     """Reference positions of the joint's calibration switches."""
 
@@ -176,7 +177,7 @@ class Calibration:
     reference_position: float | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class SafetyController:
     """Soft limits and gains of the joint's safety controller."""
 
@@ -186,7 +187,7 @@ class SafetyController:
     soft_upper_limit: float | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Joint:
     """A joint from `parent` to `child`; origin is X_PJ, the joint frame in the parent.
 
@@ -212,7 +213,7 @@ class Joint:
     span: Span | None = None
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Robot:
     """A robot model: a tree of links connected by joints.
 

@@ -6,10 +6,10 @@ found at any stage points at the user's text.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from mpc.ir.record import record
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Span:
     """A region of a source file.
 

@@ -31,6 +31,7 @@ from lark.tree import Meta
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.program import Program
+from mpc.ir.record import record
 from mpc.ir.span import Span
 from mpc.ir.text_types import (
     BAD,
@@ -169,7 +170,7 @@ def parser() -> Lark:
     return Lark.open_from_package("mpc.grammar", "ir.lark", parser="lalr", propagate_positions=True)
 
 
-@dataclasses.dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Record:
     """One parsed line: `word key fields @ at`; key, at: None when absent."""
 

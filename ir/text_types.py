@@ -21,6 +21,7 @@ from typing import Any, Literal, Union, get_args, get_origin
 
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.ops import OPS, import_all
+from mpc.ir.record import record
 from mpc.ir.span import Span
 
 import_all()  # the IR text names every op: import the op modules `mpc check` does not need
@@ -34,7 +35,7 @@ _NO: Any = object()  # a literal that does not fit the hint (nothing recorded ye
 
 # Value nodes: what the IR transformer returns and the converter consumes. span: in the IR text.
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Scalar:
     """A literal: none, true/false, an int, a float or a string."""
 
@@ -42,7 +43,7 @@ class Scalar:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ListNode:
     """`[a, b]`: a tuple, list or set, as the field's hint says."""
 
@@ -50,7 +51,7 @@ class ListNode:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class MapNode:
     """`{key: value, …}`, keys and values in written order."""
 
@@ -58,7 +59,7 @@ class MapNode:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class FieldNode:
     """`name=value`, in a record or in a call; name_span: where the name is."""
 
@@ -67,7 +68,7 @@ class FieldNode:
     name_span: Span
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Call:
     """`path("…")`, `span("f", 1, 2, 3, 4)` or `TypeName(field=value, …)`."""
 
@@ -200,7 +201,7 @@ def describe_node(node: Node) -> str:
     return "a mapping" if isinstance(node, MapNode) else f"{node.name}(…)"
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Where:
     """Where a value sits, for messages: owner `op 'move'`, path `pose.xyz[1]`."""
 

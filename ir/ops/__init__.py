@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.names import Kind, Names
+from mpc.ir.record import record
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -24,7 +25,7 @@ OPS: dict[str, type[Op]] = {}
 ROOT = "root"
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Ref:
     """A name an op needs: its kind, the name, and the op field that holds it (for spans)."""
 
@@ -57,7 +58,7 @@ class Effects:
 
 # Ops are not slotted: `slots=True` makes the dataclass decorator build a second class,
 # after `__init_subclass__` has already registered the first one in OPS.
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class Op:
     """Base of every IR operation. span: the YAML that asked for this op."""
 

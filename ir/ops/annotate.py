@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.record import record
 from mpc.ir.robot import Collision, Material, Pose, Robot
 
 
@@ -41,7 +42,7 @@ def _link_or_collision(names: Names, name: str, effects: Effects, field_name: st
                       f"{did_you_mean(name, pool)}", field_name)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EditMaterial(Op):
     """Edit material `name`, or create it; colours are rgba (0..1)."""
 
@@ -72,7 +73,7 @@ class EditMaterial(Op):
         return replace(robot, materials={**robot.materials, self.name: material})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EditCollisions(Op):
     """Edit the collisions of link `target` (or the one collision named `target`).
 
@@ -214,7 +215,7 @@ def _describe(c: Collision) -> dict[str, object]:
     return {"type": "sphere", "radius": g.radius, "pose": pose}
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AutoBitmask(Op):
     """Compute collision bitmasks so that no two links collide that must not (ir/bitmask.py).
 
@@ -269,7 +270,7 @@ class AutoBitmask(Op):
                        annotations={**robot.annotations, "self_collision": matrix})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EditVisuals(Op):
     """Edit the visuals of `targets` (all links but `exclude` when empty)."""
 
@@ -301,7 +302,7 @@ class EditVisuals(Op):
         return tuple(refs)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddSensor(Op):
     """A sensor: on `link` (or `joint`) for single-link types, over `targets` for the others.
 
@@ -349,7 +350,7 @@ class AddSensor(Op):
         return replace(robot, sensors={**robot.sensors, self.name: sensor})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddPose(Op):
     """A named joint configuration; `default` fills the movable joints not listed."""
 
@@ -390,7 +391,7 @@ class AddPose(Op):
         return replace(robot, poses={**robot.poses, self.name: values})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddSubmechanism(Op):
     """A submechanism or exoskeleton (HyRoDyn) over joints of the robot.
 
@@ -420,7 +421,7 @@ class AddSubmechanism(Op):
         return replace(robot, submechanisms=(*robot.submechanisms, item))
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class SubmechanismsFile(Op):
     """Use the submechanisms file at `path` as it is."""
 
@@ -430,7 +431,7 @@ class SubmechanismsFile(Op):
         return replace(robot, submechanisms_file=self.path)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddAnnotations(Op):
     """A free annotation category `category` (SMURF `<robot>_<category>.yml`)."""
 
@@ -442,7 +443,7 @@ class AddAnnotations(Op):
         return replace(robot, annotations={**robot.annotations, self.category: merged})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class CompleteSubmechanisms(Op):
     """Cover every joint no submechanism names (Phobos does this when any is given): each
     connected group of uncovered movable joints becomes a `serial` chain, each group of

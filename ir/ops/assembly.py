@@ -7,27 +7,28 @@ and attached to its parent part; after the last attach only `root` remains.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any, Literal
 
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.record import record
 from mpc.ir.rename import rename_robot, rename_with
 from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot
 
 Vec3 = tuple[float, float, float]
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class LoadModel(Op):
     """Start part `part` from input model `input` (the driver reads it)."""
 
     input: str
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EditNames(Op):
     """Rename names of the part by `rules`.
 
@@ -101,7 +102,7 @@ class EditNames(Op):
                             self._edit("collision"), self._edit("visual"))
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class RemoveBeyond(Op):
     """Keep the links up to and including `links`; remove everything below them."""
 
@@ -125,7 +126,7 @@ class RemoveBeyond(Op):
         return keep_links(robot, self._kept(Names.of(robot)), robot.root)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class TakeLeaf(Op):
     """Keep the subtree rooted at `link`; it becomes the root."""
 
@@ -183,7 +184,7 @@ def _extras_kept(robot: Robot, links: set[str], joints: set[str]) -> dict[str, A
     }
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class Mirror(Op):
     """Mirror the part at the plane through its root with normal `plane`.
 
@@ -213,7 +214,7 @@ class Mirror(Op):
         return EditNames(span=self.span, part=self.part, rules=rule).apply(mirrored, effects)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class Attach(Op):
     """Attach part `child` to `part` with a new joint from link `parent` to link `child_link`.
 

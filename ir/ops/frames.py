@@ -8,10 +8,11 @@ of link L in its parent P, T the transform the definition gives. An op whose
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.record import record
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint
 
@@ -19,7 +20,7 @@ Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddFrame(Op):
     """Add link `link` below `parent` through a new joint `joint` of `type` at (xyz, rpy).
 
@@ -67,7 +68,7 @@ class AddFrame(Op):
                        joints={**robot.joints, self.joint: joint})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class MakeRoot(Op):
     """Make `link` the root: the joints on the path to it are turned around."""
 
@@ -94,7 +95,7 @@ class MakeRoot(Op):
         return reroot_names(names, self.link)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class TransformLink(Op):
     """Move `link` with its visuals, collisions and inertial by X (xyz, rpy) in its own frame."""
 
@@ -124,7 +125,7 @@ class TransformLink(Op):
         return replace(robot, joints={**robot.joints, joint.name: replace(joint, origin=origin)})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class TransformFrame(TransformLink):
     """Move only the frame of `link`: its children, visuals, collisions and inertial stay put.
 
@@ -176,7 +177,7 @@ def move_frame(robot: Robot, link_name: str, T: Pose) -> Robot:
     return replace(robot, joints=joints, links={**robot.links, link_name: link})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class ReparentLink(Op):
     """Hang `link` below `parent`, keeping its pose in the root frame (at q = 0)."""
 
@@ -210,7 +211,7 @@ class ReparentLink(Op):
         return replace(robot, joints={**robot.joints, joint.name: moved})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EstimateMissingComs(Op):
     """Set the COM of each of `links` (all when empty) whose COM is at its origin, from its
     collision geometry."""
@@ -254,7 +255,7 @@ class EstimateMissingComs(Op):
         return replace(robot, links=links)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AnnotateLinks(Op):
     """Free annotations (for SMURF) on `links` (all when empty); material: set the visuals'."""
 

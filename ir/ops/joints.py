@@ -6,11 +6,12 @@ An op whose `SUPPORTED` is False is checked by `mpc check` but cannot be compile
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.record import record
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 
 MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
@@ -46,7 +47,7 @@ Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
 
 
-@dataclass(frozen=True, kw_only=True, slots=True)
+@record(kw_only=True, slots=True)
 class JointValues:
     """Values of a joint that an edit may set; None leaves a value as it is.
 
@@ -63,7 +64,7 @@ class JointValues:
     spring_reference: float | None = None
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class Dependency:
     """q = multiplier · q_joint + offset."""
 
@@ -72,7 +73,7 @@ class Dependency:
     offset: float = 0.0
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class ReplaceJointTypes(Op):
     """Every joint of type `old` becomes type `new`, for each (old, new) pair."""
 
@@ -84,7 +85,7 @@ class ReplaceJointTypes(Op):
                                       for n, j in robot.joints.items()})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class JointDefaults(Op):
     """Fill values the joints lack, and limits that are zero (`$default`).
 
@@ -114,7 +115,7 @@ class JointDefaults(Op):
         return replace(robot, joints=joints)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class EditJoint(Op):
     """Set values of `joint`: type, axis, limits and dynamics, mimic, dependencies, annotations."""
 
@@ -151,7 +152,7 @@ class EditJoint(Op):
         return replace(robot, joints={**robot.joints, self.joint: joint})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class SetMotor(Op):
     """Put a motor on `joint` (`active`, `motor`): name (default `<joint>_motor`) and settings."""
 
@@ -173,7 +174,7 @@ class SetMotor(Op):
         return names.with_other("motor", [self.name])
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class RemoveJoint(Op):
     """Remove `joint`: its child link merges into the parent link (mass, COM and inertia
     combined, visuals and collisions moved), the child's children hang from the parent."""
@@ -241,7 +242,7 @@ class RemoveJoint(Op):
                        visuals=visuals, gone=gone)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class AddCutJoint(Op):
     """A loop-closure joint `joint` between `parent` and `child`, outside the tree.
 
@@ -279,7 +280,7 @@ class AddCutJoint(Op):
         return replace(robot, cut_joints={**robot.cut_joints, self.joint: cut})
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class MoveJointAxisToIntersection(Op):
     """Move `joint`'s frame (its child link's frame) to where the axes of joints `a` and `b`
     meet at q = 0 — for skew axes, the middle of their closest points. Only the frame

@@ -4,10 +4,11 @@ They record mesh ops on the mesh values; the work is done once, at emission."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from mpc.ir.geometry import Mesh, ReduceMesh, ScaleMesh
 from mpc.ir.ops import Effects, Op
+from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
 
@@ -23,7 +24,7 @@ def _map_meshes(robot: Robot, edit) -> Robot:
     return replace(robot, links=links)
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class ReduceMeshes(Op):
     """Decimate every mesh (quadric decimation, fast-simplification) to `faces` faces each,
     or to `ratio` of its faces."""
@@ -38,7 +39,7 @@ class ReduceMeshes(Op):
         return _map_meshes(robot, lambda m: replace(m, ops=(*m.ops, op)))
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class ApplyScale(Op):
     """Bake each mesh's scale into its file; the element then has none."""
 

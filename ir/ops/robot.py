@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from mpc.ir.ops import Effects, Op
+from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
 
-@dataclass(frozen=True, kw_only=True)
+@record(kw_only=True)
 class SetRobotName(Op):
     """Name the robot `name` (the `robotname` of the definition)."""
 
