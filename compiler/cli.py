@@ -11,9 +11,12 @@ import gc
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from mpc.compiler import render
-from mpc.compiler.diagnostics import Sink
+# The rest of mpc is imported by the command that needs it: `mpc check` turns off the cyclic
+# garbage collector first (see _check), and no command pays for another's imports.
+if TYPE_CHECKING:
+    from mpc.compiler.diagnostics import Sink
 
 
 def _package(text: str) -> tuple[str, Path]:
@@ -87,7 +90,22 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _print_diagnostics(sink: Sink, fmt: str) -> None:
+def _sink(args: argparse.Namespace) -> Sink:
+    from mpc.compiler.diagnostics import Sink
+
+    return Sink(werror=args.werror)
+
+
+def _summary(sink: Sink) -> str:
+    """"2 errors, 1 warning"."""
+    from mpc.compiler import render
+
+    return render.summary(sink.diagnostics)
+
+
+def print_diagnostics(sink: Sink, fmt: str) -> None:
+    from mpc.compiler import render
+
     if fmt == "json":
         print(render.as_json(sink.diagnostics), file=sys.stderr)
     elif sink.diagnostics:
@@ -98,23 +116,23 @@ def _compile(args: argparse.Namespace) -> int:
     from mpc.backends.packages import PackageResolver
     from mpc.compiler.driver import Options, compile_model
 
-    sink = Sink(werror=args.werror)
+    sink = _sink(args)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
     if args.emit == "ir":
         from mpc.compiler.driver import load_program
         from mpc.ir.text import dump
 
         program = load_program(args.definition, sink, options)
-        _print_diagnostics(sink, args.format)
+        print_diagnostics(sink, args.format)
         if program is None:
             return 1
         sys.stdout.write(dump(program))
         return 0
     result = compile_model(args.definition, sink, options)
-    _print_diagnostics(sink, args.format)
+    print_diagnostics(sink, args.format)
     if result.out is None:
         if args.format == "human":
-            print(f"error: could not compile '{args.definition}' ({render.summary(sink.diagnostics)})",
+            print(f"error: could not compile '{args.definition}' ({_summary(sink)})",
                   file=sys.stderr)
         return 1
     files = sorted(str(p.relative_to(result.out)) for p in result.out.rglob("*") if p.is_file())
@@ -140,13 +158,13 @@ def _check_files(args: argparse.Namespace) -> int:
     from mpc.backends.packages import PackageResolver
     from mpc.compiler.driver import Options, check_file
 
-    sink = Sink(werror=args.werror)
+    sink = _sink(args)
     options = Options(resolver=PackageResolver(package_map=dict(args.package)))
     for path in args.files:
         check_file(path, sink, options)
-    _print_diagnostics(sink, args.format)
+    print_diagnostics(sink, args.format)
     if args.format == "human" and sink.diagnostics:
-        print(f"{render.summary(sink.diagnostics)} in {len(args.files)} file"
+        print(f"{_summary(sink)} in {len(args.files)} file"
               f"{'s' * (len(args.files) != 1)}", file=sys.stderr)
     return 1 if sink.has_errors() else 0
 
@@ -179,7 +197,7 @@ def _test(args: argparse.Namespace) -> int:
     from mpc.checks import run_model_tests
     from mpc.compiler.driver import InputLoader, Options, apply, compile_model, load_program
 
-    sink = Sink(werror=args.werror)
+    sink = _sink(args)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
     if args.built is not None:
         loader = InputLoader(sink, options, (args.definition.resolve(),))
@@ -193,14 +211,14 @@ def _test(args: argparse.Namespace) -> int:
         result = compile_model(args.definition, sink, options)
         program, robot, out = result.program, result.robot, result.out  # type: ignore[assignment]
     if program is None or robot is None or out is None:
-        _print_diagnostics(sink, args.format)
-        print(f"error: could not compile '{args.definition}' ({render.summary(sink.diagnostics)})",
+        print_diagnostics(sink, args.format)
+        print(f"error: could not compile '{args.definition}' ({_summary(sink)})",
               file=sys.stderr)
         return 1
     with tempfile.TemporaryDirectory(prefix="mpc-test-") as work:
         protocol = run_model_tests(program, out, sink, workdir=Path(work), robot=robot)
     target = args.out if args.built is not None and args.out is not None else out  # -o with --built
-    _print_diagnostics(sink, args.format)
+    print_diagnostics(sink, args.format)
     print(protocol.markdown())
     try:
         protocol.write(target)

@@ -8,12 +8,10 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mpc.compiler import render
-from mpc.compiler.diagnostics import Severity, Sink
 from mpc.deploy import FORGES
-from mpc.ir.span import Span
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the rest is imported by `run`: building the parser of `mpc` stays light
+    from mpc.compiler.diagnostics import Sink
     from mpc.deploy.result import DeployResult
     from mpc.deploy.settings import DeploySettings
 
@@ -46,6 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from mpc.compiler.cli import print_diagnostics
+    from mpc.compiler.diagnostics import Severity, Sink
     from mpc.compiler.driver import Options, load_program
     from mpc.deploy.model import deploy_model
 
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     if program is not None and settings is not None and not sink.has_errors():
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
                               tests_failed=args.tests_failed)
-    _print_diagnostics(sink, args.format)
+    print_diagnostics(sink, args.format)
     if result is None or not result.ok:
         print(f"error: could not deploy '{args.definition}'", file=sys.stderr)
         return 1
@@ -68,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _read_protocol(path: Path, sink: Sink) -> str | None:
     """The test protocol's text; E0802 when it cannot be read or is not UTF-8."""
+    from mpc.ir.span import Span
+
     try:
         return path.read_text(encoding="utf-8")
     except OSError as e:
@@ -117,9 +119,3 @@ def _report(result: DeployResult, indent: str) -> None:
     if result.mirror is not None:
         _report(result.mirror, indent + "mirror: ")
 
-
-def _print_diagnostics(sink: Sink, fmt: str) -> None:
-    if fmt == "json":
-        print(render.as_json(sink.diagnostics), file=sys.stderr)
-    elif sink.diagnostics:
-        print((render.gcc if fmt == "gcc" else render.human)(sink.diagnostics), file=sys.stderr)
