@@ -98,12 +98,13 @@ OneOrMore = Annotated[list[str], Before(str_or_list),
 # -- nodes -----------------------------------------------------------------------------------
 
 class FieldSpec:
-    """One declared field of a node, resolved: its name, key in the document, type, default."""
+    """One declared field of a node, resolved: its attribute name, type and default
+    (`Node.fields` files it under its key in the document)."""
 
-    __slots__ = ("default", "key", "name", "type")
+    __slots__ = ("default", "name", "type")
 
-    def __init__(self, name: str, key: str, type_: Type, default: Any) -> None:
-        self.name, self.key, self.type, self.default = name, key, type_, default
+    def __init__(self, name: str, type_: Type, default: Any) -> None:
+        self.name, self.type, self.default = name, type_, default
 
     @property
     def required(self) -> bool:
@@ -231,7 +232,7 @@ def _resolve(cls: type[Node]) -> dict[str, FieldSpec]:
         if info.min_length is not None or info.max_length is not None:
             type_ = type_.bounded(info.min_length, info.max_length)
         key = info.alias or name
-        out[key] = FieldSpec(name, key, type_, info.default)
+        out[key] = FieldSpec(name, type_, info.default)
     return out
 
 
@@ -499,10 +500,10 @@ class UnionType(Type):
     def check(self, value: Any, path: Path_, walk: Walk) -> Any:
         fitting = [m for m in self.members if m.fits(value)]
         if len(fitting) == 1 and isinstance(value, list | dict):  # its problems are the ones to show
-            return walk.check(fitting[0], value, path)
+            return fitting[0].check(value, path, walk)
         for m in fitting:
             if m.exact(value):
-                return walk.check(m, value, path)
+                return m.check(value, path, walk)
         for m in fitting:
             got, problems = walk.attempt(m, value, path)
             if not problems:
@@ -524,7 +525,7 @@ class Optional(Type):
         return value is None or self.inner.exact(value)
 
     def check(self, value: Any, path: Path_, walk: Walk) -> Any:
-        return None if value is None else walk.check(self.inner, value, path)
+        return None if value is None else self.inner.check(value, path, walk)
 
     def bounded(self, low: int | None, high: int | None) -> Type:
         return Optional(self.inner.bounded(low, high))
@@ -547,7 +548,7 @@ class Wrapped(Type):
     def check(self, value: Any, path: Path_, walk: Walk) -> Any:
         if self.before:
             value = self.before(value)
-        got = walk.check(self.inner, value, path)
+        got = self.inner.check(value, path, walk)
         if self.after and got is not BAD and got is not DROP:
             try:
                 self.after(got)
@@ -653,9 +654,6 @@ class Walk:
 
     def wrong(self, type_: Type, value: Any, path: Path_) -> Any:
         return self.fail(path, lambda key: f"'{key}' must be {type_.wanted}, got {describe(value)}")
-
-    def check(self, type_: Type, value: Any, path: Path_) -> Any:
-        return type_.check(value, path, self)
 
     def attempt(self, type_: Type, value: Any, path: Path_) -> tuple[Any, list[str]]:
         """The value as `type_` and the messages of its problems, which are not reported."""

@@ -3,7 +3,6 @@ in place (lxml), compiling and running the tests."""
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 from lxml import etree
@@ -11,6 +10,7 @@ from lxml import etree
 from mpc.checks import Protocol, run_model_tests
 from mpc.compiler.diagnostics import Sink
 from mpc.compiler.driver import Options, Result, compile_model
+from tests.conftest import definition as model_definition
 from tests.conftest import write
 
 EVERY_TEST = """\
@@ -34,20 +34,7 @@ def definition(basefile: Path | str, name: str, tests: str, compare: str = "", e
 
     tests: the lines of `tests:` (indented by 6); compare: lines of compare_model (by 6);
     extra: further model sections (indented by 2); exports: further export_config entries."""
-    text = textwrap.dedent(f"""\
-        model:
-          robotname: {name}
-          modelname: {name}-model
-          input_models:
-            base:
-              basefile: "{basefile}"
-          assemble:
-            model: base
-          export_config:
-            - type: urdf
-              mesh_format: input_type
-        """)
-    text += exports + extra + "  test:\n"
+    text = model_definition(basefile, robotname=name) + exports + extra + "  test:\n"
     if compare:
         text += "    compare_model:\n" + compare
     return text + "    tests:\n" + tests
