@@ -35,8 +35,22 @@ def _diagnostic_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--werror", action="store_true", help="treat warnings as errors")
 
 
+class _Version(argparse.Action):
+    """--version, which reads the installed metadata only when asked (not on every start)."""
+
+    def __init__(self, option_strings: list[str], dest: str, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)  # type: ignore[arg-type]
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: object) -> None:
+        from mpc.compiler.version import mpc_version
+
+        print(f"mpc {mpc_version()}")
+        parser.exit()
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
+    parser.add_argument("--version", action=_Version, help="print mpc's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     comp = sub.add_parser("compile", help="compile a model definition into model files")
     comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")

@@ -10,18 +10,11 @@ from __future__ import annotations
 import hashlib
 import re
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 
+from mpc.compiler.version import mpc_version
 from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.ir.program import Program
-
-
-def mpc_version() -> str:
-    try:
-        return metadata.version("model-pipeline-compiler")
-    except metadata.PackageNotFoundError:  # running from a source tree that is not installed
-        return "unknown"
 
 
 def _repository_state(path: Path) -> tuple[str, bool, str] | None:

@@ -1,17 +1,40 @@
 #!/usr/bin/env bash
-# Install everything mpc and its tests need on a fresh Debian machine:
-# Debian's check_urdf (liburdfdom-tools), sdformat 12 tools (`ign sdf`), Graphviz's `dot`
-# and poppler's `pdftoppm`, git-lfs (deployments that track meshes with LFS), then mpc
-# itself with its dev extra (pytest, hypothesis, Pinocchio, MuJoCo, example-robot-data,
-# ruff), editable.
+# Set up mpc on a fresh Debian machine, as root or not:
+#  1. Debian's tools that exports and tests call: check_urdf (liburdfdom-tools), sdformat 12's
+#     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, and python3-venv when the
+#     interpreter cannot make virtual environments (Debian's own python3);
+#  2. uv, in a virtual environment of its own under the user's cache (PEP 668: nothing is
+#     installed into the system's Python);
+#  3. the project's virtual environment `.venv`, exactly as `uv.lock` pins it, with the dev extra,
+#     and mpc in it (editable). Then `mpc` is `.venv/bin/mpc`, or `mpc` after
+#     `source .venv/bin/activate`.
+# PYTHON names the interpreter to build on (default: python3); MPC_SETUP_NO_APT=1 skips step 1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+PYTHON=${PYTHON:-python3}
+UV_VERSION=0.13.9
+
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
-if ! command -v check_urdf >/dev/null || ! command -v ign >/dev/null || ! command -v dot >/dev/null \
-    || ! command -v pdftoppm >/dev/null || ! command -v git-lfs >/dev/null; then
+packages=()
+command -v check_urdf >/dev/null || packages+=(liburdfdom-tools)
+command -v ign >/dev/null || packages+=(ignition-tools libsdformat12-12 sdformat-sdf libsdformat-dev)
+command -v dot >/dev/null || packages+=(graphviz)
+command -v pdftoppm >/dev/null || packages+=(poppler-utils)
+command -v git-lfs >/dev/null || packages+=(git-lfs)
+"$PYTHON" -c "import ensurepip, venv" 2>/dev/null || packages+=(python3-venv)
+if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
+  echo "setup: apt-get install ${packages[*]}" >&2
   $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq liburdfdom-tools ignition-tools \
-    libsdformat12-12 sdformat-sdf libsdformat-dev graphviz poppler-utils git-lfs >/dev/null
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${packages[@]}" >/dev/null
 fi
-python3 -m pip install -q --disable-pip-version-check -e '.[dev]'
+
+tools="${XDG_CACHE_HOME:-$HOME/.cache}/mpc/uv-$UV_VERSION"
+if [ ! -x "$tools/bin/uv" ]; then
+  rm -rf "$tools"
+  "$PYTHON" -m venv "$tools"
+  "$tools/bin/python" -m pip install -q --disable-pip-version-check "uv==$UV_VERSION"
+fi
+# Only the package registries are reachable: never let uv download a Python of its own.
+UV_PYTHON_DOWNLOADS=never "$tools/bin/uv" sync --frozen --extra dev --python "$PYTHON" --quiet
+echo "setup: mpc is $(pwd)/.venv/bin/mpc ($(.venv/bin/mpc --version))" >&2

@@ -52,12 +52,9 @@ def file_digest(path: Path) -> str:
 @cache
 def mpc_version() -> str:
     """mpc's version and a digest of its source files (compiler, ir, backends, grammar, …)."""
-    from importlib.metadata import PackageNotFoundError, version
+    from mpc.compiler.version import mpc_version as installed_version
 
-    try:
-        ver = version("model-pipeline-compiler")
-    except PackageNotFoundError:  # running from a checkout without installing
-        ver = "unknown"
+    ver = installed_version()
     h = hashlib.sha256(ver.encode())
     for name, file in source_files():
         h.update(name.encode())

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.version import mpc_version
 from mpc.deploy import deploy_model
-from mpc.deploy.provenance import mpc_version
 from tests.conftest import Diags
 from tests.deploy.conftest import Model, Server, git, heavier
 from tests.fixtures import ARM_URDF
