@@ -65,9 +65,43 @@ def test_gcc_and_json_formats(tmp_path: Path) -> None:
                           "model 'base' does not exist [E0601]\n")
     js = mpc("compile", spec, "--format", "json")
     assert js.returncode == 1
-    [d] = json.loads(js.stderr)
+    assert js.stderr == ""
+    [d] = json.loads(js.stdout)
     assert d["code"] == "E0601" and d["severity"] == "error"
     assert d["span"] == {"file": str(spec), "line": 6, "col": 17, "end_line": 6, "end_col": 31}
+
+
+def test_json_is_one_document_on_stdout_and_the_rest_goes_to_stderr(tmp_path: Path) -> None:
+    arm(tmp_path)
+    good = write(tmp_path / "good.yml", definition("arm.urdf", "stl", "arm"))
+    bad = write(tmp_path / "bad.yml", definition("missing.urdf"))
+    built = mpc("compile", good, "-o", tmp_path / "out", "--format", "json")
+    assert built.returncode == 0, built.stderr
+    assert json.loads(built.stdout) == []
+    assert built.stderr == (f"compiled '{good}' into '{tmp_path}/out': smurf/arm.smurf, urdf/arm.urdf "
+                            "and 1 mesh files\n")
+    checked = mpc("check", good, bad, bad, "--format", "json")
+    assert checked.returncode == 1
+    assert [(d["code"], d["span"]["file"]) for d in json.loads(checked.stdout)] == [
+        ("E0601", str(bad)), ("E0601", str(bad))]
+    ir = mpc("compile", bad, "--emit", "ir", "--format", "json")  # stdout is the IR's
+    assert (ir.returncode, ir.stdout) == (1, "")
+    assert [d["code"] for d in json.loads(ir.stderr)] == ["E0601"]
+
+
+def test_version_and_schema_go_to_stdout(tmp_path: Path) -> None:
+    from mpc.compiler.jsonschema import render
+    from mpc.compiler.version import mpc_version
+
+    version = mpc("--version")
+    assert (version.returncode, version.stdout) == (0, f"mpc {mpc_version()}\n")
+    assert mpc_version() != "unknown"
+    schema = mpc("schema", cwd=tmp_path)
+    assert (schema.returncode, schema.stdout) == (0, render())
+    assert list(tmp_path.iterdir()) == []  # nothing written where the user stands
+    written = mpc("schema", "-o", tmp_path / "s.json")
+    assert (written.returncode, written.stdout) == (0, f"wrote {tmp_path / 's.json'}\n")
+    assert (tmp_path / "s.json").read_text() == render()
 
 
 def test_broken_urdf_points_into_the_urdf(tmp_path: Path) -> None:
