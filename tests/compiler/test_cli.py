@@ -133,3 +133,26 @@ def test_check_imports_no_heavy_library() -> None:
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert run.stderr == ""
     assert run.stdout.splitlines()[-1] == "0 []"
+
+
+def test_package_paths_are_found_in_a_sourced_ros2_workspace(tmp_path: Path) -> None:
+    """AMENT_PREFIX_PATH: each prefix's `share/<package>`, as `ros2 pkg prefix` finds it."""
+    import os
+
+    from tests.fixtures import ARM_URDF, tetra_stl
+
+    tetra_stl(tmp_path / "ws/install/arm_description/share/arm_description/meshes/tetra.stl")
+    write(tmp_path / "models/arm.urdf",
+          ARM_URDF.replace("meshes/tetra.stl", "package://arm_description/meshes/tetra.stl"))
+    spec = write(tmp_path / "models/model.yml", definition("arm.urdf", "stl", "arm"))
+    missing = mpc("compile", spec, "-o", tmp_path / "out", "--format", "gcc")
+    assert missing.returncode == 1
+    assert "package 'arm_description' was not found (searched the package map, ROS_PACKAGE_PATH, " \
+           "AMENT_PREFIX_PATH, the Python environment and the folders above the model)" in missing.stderr
+    env = {**os.environ, "AMENT_PREFIX_PATH": f"{tmp_path}/ws/install/other{os.pathsep}"
+                                              f"{tmp_path}/ws/install/arm_description"}
+    found = subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o",
+                            str(tmp_path / "out")], capture_output=True, text=True, env=env)
+    assert found.returncode == 0, found.stderr
+    assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (
+        tmp_path / "ws/install/arm_description/share/arm_description/meshes/tetra.stl").read_bytes()
