@@ -32,6 +32,10 @@ def _environment_share_dirs() -> list[Path]:
     return seen
 
 
+def _path_list(variable: str) -> list[str]:
+    return [p for p in os.environ.get(variable, "").split(os.pathsep) if p]
+
+
 @dataclass
 class PackageResolver:
     """Finds the folder of a ROS package by name (see the module docstring)."""
@@ -42,8 +46,8 @@ class PackageResolver:
 
     def __post_init__(self) -> None:
         if self.search_path is None:
-            ros = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-            ament = [Path(p) / "share" for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+            ros = [Path(p) for p in _path_list("ROS_PACKAGE_PATH")]
+            ament = [Path(p) / "share" for p in _path_list("AMENT_PREFIX_PATH")]
             self.search_path = ros + ament + _environment_share_dirs()
 
     def find(self, package: str, near: Path | None = None) -> Path | None:
