@@ -78,6 +78,11 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
                 mesh = mesh.simplify_quadric_decimation(face_count=target)
         elif isinstance(op, ScaleMesh):
             mesh.apply_scale(np.asarray(op.scale))
+        elif isinstance(op, JoinShapes) and op.solid:
+            from mpc.ir.solids import solid, to_trimesh, union
+
+            mesh = to_trimesh(union([(solid(shape), tf.pose_to_matrix(xyz, rpy))
+                                     for shape, xyz, rpy in op.parts]).manifold)
         elif isinstance(op, JoinShapes):
             pieces = [] if mesh is None else [mesh]
             for shape, xyz, rpy in op.parts:
