@@ -86,14 +86,9 @@ def collision_box(robot: Robot, link: str) -> tuple[np.ndarray, np.ndarray] | No
 
 
 def findings(robot: Robot, distance: float, density: tuple[float, float] = DENSITY,
-             factor: float = FACTOR) -> list[tuple[str, str]]:
-    """(link, problem) for every finding, in link order (W0701's, then the plausibility ones)."""
-    return [(link, problem) for link, _, problem in coded_findings(robot, distance, density, factor)]
-
-
-def coded_findings(robot: Robot, distance: float, density: tuple[float, float] = DENSITY,
-                   factor: float = FACTOR) -> list[tuple[str, str, str]]:
-    """(link, diagnostic code, problem) for every finding."""
+             factor: float = FACTOR) -> list[tuple[str, str, str]]:
+    """(link, diagnostic code, problem) for every finding, in link order: W0701's, then the
+    plausibility ones."""
     out = [(link, "W0701", problem) for link, problem in _validity(robot, distance)]
     for name in sorted(robot.links):
         out += [(name, code, problem) for code, problem in plausibility(robot, name, density, factor)]
@@ -188,7 +183,7 @@ def _validity(robot: Robot, distance: float) -> list[tuple[str, str]]:
 @register("physical_validity")
 def physical_validity(ctx: Context, test: ModelTest) -> Result:
     robot = ctx.built.robot
-    found = coded_findings(robot, ctx.tol.distance, test.density, test.inertia_factor)
+    found = findings(robot, ctx.tol.distance, test.density, test.inertia_factor)
     details = tuple(f"{link}: {problem}" for link, _, problem in found)
     figure = float(len(found))
     if not found:

@@ -75,6 +75,9 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
         elif isinstance(op, ReduceMesh):
             target = op.faces if op.faces is not None else int(len(mesh.faces) * (op.ratio or 1.0))
             if 4 <= target < len(mesh.faces):
+                # An STL file is a triangle soup: decimated unmerged, its triangles come apart
+                # and a closed mesh comes out open (W0582).
+                mesh.merge_vertices()
                 mesh = mesh.simplify_quadric_decimation(face_count=target)
         elif isinstance(op, ScaleMesh):
             mesh.apply_scale(np.asarray(op.scale))
