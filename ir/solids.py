@@ -110,7 +110,7 @@ def solid_of_trimesh(mesh: trimesh.Trimesh, name: str) -> tuple[Manifold, list[N
     if _is_solid(solid):
         what = f"closed {open_edges} open edges" if open_edges else "fixed its triangle winding"
         return solid, [(REPAIRED, f"mesh '{name}' was not a closed solid; repaired ({what})")]
-    hull = manifold_of_trimesh(mesh.convex_hull)
+    hull = Manifold.hull_points(np.ascontiguousarray(mesh.vertices, dtype=np.float64))
     return hull, [(HULL, f"mesh '{name}' is not a closed solid ({_open_edges(work)} open edges after "
                    "merging vertices and closing small holes); its convex hull stands in for it")]
 
@@ -148,9 +148,7 @@ def solid(geometry: Geometry) -> Solid:
         return Solid(of_primitive(geometry), m)
     if isinstance(geometry, Sphere):
         return Solid(of_primitive(geometry), Manifold.sphere(geometry.radius, SEGMENTS))
-    mesh = as_trimesh(geometry)
-    if geometry.scale is not None and np.prod(geometry.scale) < 0:
-        mesh.invert()  # a negative scale reflects: turn the triangles outwards again
+    mesh = as_trimesh(geometry)  # a negative scale reflects; trimesh turns the triangles back out
     m, notes = solid_of_trimesh(mesh, mesh_name(geometry))
     return Solid(of_trimesh(to_trimesh(m)), m, closed=all(code != HULL for code, _ in notes), notes=notes)
 
