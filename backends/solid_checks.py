@@ -1,8 +1,12 @@
-"""A robot's meshes → W0582 for each closed mesh that a mesh op (mirror, apply_scale,
-reduce_meshes, convex_decomposition) left open; it changes nothing.
+"""A robot's meshes → W0582 for each closed mesh that a mesh op (reduce_meshes,
+convex_decomposition, apply_scale by a zero factor) left open; it changes nothing.
 
-Each mesh value is checked once per content (its file's bytes and its ops): the answer is
-kept in the cache (compiler/cache.py: `solids/`), so a rebuild does not compute it again.
+A reflection (mirror) or a scale by non-zero factors keeps a closed mesh closed: the same
+triangles, their winding reversed where the mesh is reflected (tests/backends/
+test_solid_meshes.py measures it on TALOS's meshes). They are not read again for it, which
+would double the cost of a cold mirrored build. Each mesh value that needs it is checked
+once per content (its file's bytes and its ops): the answer is kept in the cache
+(compiler/cache.py: `solids/`), so a rebuild does not compute it again.
 """
 
 from __future__ import annotations
@@ -12,13 +16,16 @@ import json
 import os
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.geometry import ConvexPart, JoinShapes, Mesh, ReduceMesh, ReflectMesh, ScaleMesh
+from mpc.ir.geometry import ConvexPart, JoinShapes, Mesh, MeshOp, ReduceMesh, ScaleMesh
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
 VERSION = "1"  # changes when the test for closed changes, so old answers go unused
-WATCHED = {ReflectMesh: "mirror", ScaleMesh: "apply_scale", ReduceMesh: "reduce_meshes",
-           ConvexPart: "convex_decomposition"}
+WATCHED = {ScaleMesh: "apply_scale", ReduceMesh: "reduce_meshes", ConvexPart: "convex_decomposition"}
+
+
+def _may_open(op: MeshOp) -> bool:
+    return type(op) in WATCHED and not (isinstance(op, ScaleMesh) and all(op.scale))
 
 
 def check_closed(robot: Robot, sink: Sink, span: Span) -> None:
@@ -30,7 +37,7 @@ def check_closed(robot: Robot, sink: Sink, span: Span) -> None:
     for use in mesh_uses(robot):
         mesh = use.mesh
         joined = bool(mesh.ops) and isinstance(mesh.ops[0], JoinShapes)  # made of parts: no file to read
-        if joined or not any(type(op) in WATCHED for op in mesh.ops):
+        if joined or not any(_may_open(op) for op in mesh.ops):
             continue
         if mesh.source.path is None or not mesh.source.path.is_file():
             continue
@@ -71,7 +78,7 @@ def _opened_by(mesh: Mesh) -> str | None:
         if not closed(as_trimesh(Mesh(source=mesh.source), scaled=False)):
             return None
         for n, op in enumerate(mesh.ops):
-            if type(op) in WATCHED and not closed(as_trimesh(Mesh(source=mesh.source, ops=mesh.ops[:n + 1]),
+            if _may_open(op) and not closed(as_trimesh(Mesh(source=mesh.source, ops=mesh.ops[:n + 1]),
                                                              scaled=False)):
                 return WATCHED[type(op)]
     except MeshError:

@@ -89,10 +89,10 @@ def test_join_union_of_talos_lower_leg_is_one_closed_mesh_that_pybullet_and_mujo
     assert any("joined" in name for name in meshes), meshes
 
 
-def test_mirrored_talos_meshes_stay_closed_without_a_warning(tmp_path: Path,
+def test_mirrored_talos_meshes_stay_closed_with_their_volume(tmp_path: Path,
                                                              monkeypatch: pytest.MonkeyPatch) -> None:
-    """The left arm mirrored: every mesh is reflected, each stays closed (no W0582) with its
-    volume (the written files measured)."""
+    """The left arm mirrored: every mesh is reflected, and each collision mesh written stays
+    closed with its volume (why solid_checks need not read mirrored meshes again)."""
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
     arm = ERD / "talos_data/robots/talos_left_arm.urdf"
     out = _compile(tmp_path, f"""
