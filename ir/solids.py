@@ -20,7 +20,7 @@ from manifold3d import Error, Manifold, Mesh64, OpType
 
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.inertia import Body, combine
-from mpc.ir.mesh_props import as_trimesh
+from mpc.ir.mesh_props import MeshError, as_trimesh
 
 SEGMENTS = 128  # circle segments of a cylinder or sphere that overlaps another shape
 RELATIVE = 1e-9  # union volume = sum of the parts' within this: the parts do not overlap
@@ -41,9 +41,11 @@ def principal(b: Body) -> np.ndarray:
 
 def of_trimesh(mesh: trimesh.Trimesh) -> Body:
     """Exact props of a closed, outward-oriented triangle mesh (divergence theorem)."""
-    if len(mesh.faces) == 0:
+    with np.errstate(invalid="ignore", divide="ignore"):  # no volume: its centre is 0 / 0
+        props = trimesh.triangles.mass_properties(mesh.triangles, density=1.0, skip_inertia=False) \
+            if len(mesh.faces) else {"volume": 0.0}
+    if not props["volume"] > 0:
         return Body(0.0, np.zeros(3), np.zeros((3, 3)))
-    props = trimesh.triangles.mass_properties(mesh.triangles, density=1.0, skip_inertia=False)
     return Body(float(props["volume"]), np.asarray(props["center_mass"], dtype=float),
                 np.asarray(props["inertia"], dtype=float))
 
@@ -95,7 +97,7 @@ def solid_of_trimesh(mesh: trimesh.Trimesh, name: str) -> tuple[Manifold, list[N
     solid = manifold_of_trimesh(work)
     if _is_solid(solid):
         return solid, []
-    if work.volume < 0 and work.is_winding_consistent and work.is_watertight:
+    if work.is_watertight and work.is_winding_consistent and _signed_volume(work) < 0:
         work.invert()  # closed but inside out (e.g. a reflection written without reversing)
         solid = manifold_of_trimesh(work)
         if _is_solid(solid):
@@ -103,9 +105,10 @@ def solid_of_trimesh(mesh: trimesh.Trimesh, name: str) -> tuple[Manifold, list[N
     open_edges = _open_edges(work)
     work.update_faces(work.nondegenerate_faces())
     work.update_faces(work.unique_faces())
-    trimesh.repair.fix_winding(work)
-    trimesh.repair.fill_holes(work)  # only holes of three or four edges
-    trimesh.repair.fix_inversion(work)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a flat mesh's centre is 0 / 0
+        trimesh.repair.fix_winding(work)
+        trimesh.repair.fill_holes(work)  # only holes of three or four edges
+        trimesh.repair.fix_inversion(work)
     solid = manifold_of_trimesh(work)
     if _is_solid(solid):
         what = f"closed {open_edges} open edges" if open_edges else "fixed its triangle winding"
@@ -113,6 +116,13 @@ def solid_of_trimesh(mesh: trimesh.Trimesh, name: str) -> tuple[Manifold, list[N
     hull = Manifold.hull_points(np.ascontiguousarray(mesh.vertices, dtype=np.float64))
     return hull, [(HULL, f"mesh '{name}' is not a closed solid ({_open_edges(work)} open edges after "
                    "merging vertices and closing small holes); its convex hull stands in for it")]
+
+
+def _signed_volume(mesh: trimesh.Trimesh) -> float:
+    """The volume the triangles enclose, negative when they face inwards (trimesh's
+    `volume` would also divide by it for a centre, and warn when it is 0)."""
+    a, b, c = (mesh.triangles[:, i] for i in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
 def _open_edges(mesh: trimesh.Trimesh) -> int:
@@ -149,6 +159,12 @@ def solid(geometry: Geometry) -> Solid:
     if isinstance(geometry, Sphere):
         return Solid(of_primitive(geometry), Manifold.sphere(geometry.radius, SEGMENTS))
     mesh = as_trimesh(geometry)  # a negative scale reflects; trimesh turns the triangles back out
+    if not np.isfinite(mesh.vertices).all():
+        raise MeshError(f"mesh '{mesh_name(geometry)}' has vertices that are not finite numbers")
+    if len(mesh.faces) == 0:
+        empty = Body(0.0, np.zeros(3), np.zeros((3, 3)))
+        return Solid(empty, Manifold(), closed=False,
+                     notes=[(HULL, f"mesh '{mesh_name(geometry)}' has no triangles: it adds no volume")])
     m, notes = solid_of_trimesh(mesh, mesh_name(geometry))
     return Solid(of_trimesh(to_trimesh(m)), m, closed=all(code != HULL for code, _ in notes), notes=notes)
 

@@ -206,3 +206,40 @@ def test_the_mirror_of_a_closed_talos_mesh_is_closed_with_equal_volume() -> None
         expected = original.props.com.copy()
         expected[axis] *= -1
         np.testing.assert_allclose(shape.props.com, expected, atol=1e-12)
+
+
+def test_a_mesh_with_nan_vertices_is_an_error_and_an_empty_one_a_warning(tmp_path: Path) -> None:
+    write(tmp_path / "nan.stl", """
+        solid t
+        facet normal 0 0 1
+        outer loop
+        vertex nan 0 0
+        vertex 1 0 0
+        vertex 0 1 0
+        endloop
+        endfacet
+        endsolid t
+        """)
+    write(tmp_path / "empty.stl", "solid empty\nendsolid empty\n")
+    urdf = write(tmp_path / "n.urdf", """
+        <robot name="bad">
+          <link name="base">
+            <inertial><mass value="2"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+            <collision><geometry><mesh filename="nan.stl"/></geometry></collision>
+          </link>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint>
+          <link name="tip">
+            <inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+            <collision><geometry><mesh filename="empty.stl"/></geometry></collision>
+          </link>
+        </robot>
+        """)
+    spec = tmp_path / "m.yml"
+    spec.write_text(definition(urdf, mesh_format="stl", robotname="bad")
+                    + "  frames:\n    $default: {estimate_missing_inertia: true}\n")
+    sink = Diags()
+    assert compile_file(spec, tmp_path / "out", sink).out is None
+    assert sink.take_error("E0602").message == ("estimate_missing_inertia of link 'base': mesh 'nan.stl' "
+                                                "has vertices that are not finite numbers")
+    assert sink.take("W0580", Severity.WARNING).message == ("estimate_missing_inertia of link 'tip': mesh "
+                                                            "'empty.stl' has no triangles: it adds no volume")
