@@ -1,5 +1,5 @@
 """Shapes as triangle meshes (trimesh), for the ops that need geometry: bounding
-primitives, centres of mass from collision volumes. Imported only by those ops."""
+primitives, and the meshes ir/solids.py makes solids of. Imported only by those ops."""
 
 from __future__ import annotations
 
@@ -96,19 +96,6 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
     if scaled and geometry.scale is not None:
         mesh.apply_scale(np.asarray(geometry.scale))
     return mesh
-
-
-def volume_and_centre(geometry: Geometry) -> tuple[float, np.ndarray]:
-    """(volume, centre of volume) in the shape's frame; for an open mesh, its convex hull's."""
-    if isinstance(geometry, Box):
-        return float(np.prod(geometry.size)), np.zeros(3)
-    if isinstance(geometry, Cylinder):
-        return float(np.pi * geometry.radius**2 * geometry.length), np.zeros(3)
-    if isinstance(geometry, Sphere):
-        return float(4.0 / 3.0 * np.pi * geometry.radius**3), np.zeros(3)
-    mesh = as_trimesh(geometry)
-    solid = mesh if mesh.is_volume else mesh.convex_hull
-    return float(abs(solid.volume)), np.asarray(solid.center_mass, dtype=float)
 
 
 def bounding(geometry: Geometry, shape: str, oriented: bool) -> tuple[Geometry, np.ndarray]:
