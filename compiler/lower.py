@@ -486,6 +486,14 @@ class _Lowering:
             elif entry.shell:
                 command = (entry.cmd,)
             else:
+                syntax = _SHELL_SYNTAX.search(entry.cmd)
+                if syntax is not None and "shell" not in entry.given:
+                    self.sink.error(entry.value_span("cmd"), "E0560", f"this command has shell syntax "
+                                    f"(`{syntax.group().strip()}`) but runs without a shell, so it would be "
+                                    "passed to the program as an argument (Phobos ran every command "
+                                    "through a shell)", hint="add `shell: true` to run it through /bin/sh, "
+                                    "or give `cmd` as a list of arguments")
+                    continue
                 try:
                     command = tuple(shlex.split(entry.cmd))
                 except ValueError as error:
@@ -573,6 +581,9 @@ class _Lowering:
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
+# What a shell would read differently from a plain split into arguments: redirections, pipes,
+# `;`, `&&`, `&`, `$` expansions, back quotes, subshells, globs, quotes, escapes, and `~`.
+_SHELL_SYNTAX = re.compile(r"&&|\|\||[|;&<>$`()*?'\"\\]|\[.*\]|(?:^|\s)~")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
