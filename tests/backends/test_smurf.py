@@ -157,8 +157,8 @@ def test_files_are_yaml_that_phobos_reads(tmp_path: Path, diags: Diags) -> None:
     assert base_link == {"name": "base_link", "collisions": ["base_link_collision"],
                          "visuals": ["base_link_visual"], "index_hint": base_link["index_hint"]}
     assert len(links) == len(robot.links)
-    assert {"name": "elbow_joint", "parent": "upper_arm_link", "child": "forearm_link", "joint_type": "revolute",
-            "cut_joint": False, "constraint_axes": [], "motor": "elbow_joint_motor",
+    assert {"name": "elbow_joint", "parent": "upper_arm_link", "child": "forearm_link",
+            "joint_type": "revolute", "cut_joint": False, "constraint_axes": [], "motor": "elbow_joint_motor",
             "noDataPackage": False} in joints
     materials = yaml.safe_load((folder / "ur5_materials.yml").read_text())["materials"]
     assert {"name": "shiny", "diffuseColor": {"r": 0.0, "g": 0.0, "b": 1.0, "a": 1.0}, "transparency": 0.0,
