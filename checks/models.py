@@ -17,7 +17,6 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 
 @dataclass

@@ -53,7 +53,8 @@ def test_first_mpc_test_against_the_last_phobos_release_passes(tmp_path: Path) -
     # Every file of the release is written again (README.md, manifest.xml, PDFs aside).
     release = sorted(str(p.relative_to(tmp_path / "input")) for p in (tmp_path / "input").rglob("*")
                      if p.is_file() and p.suffix not in (".pdf", ".md", ".xml"))
-    assert result(protocol, "file_consistency").reason == f"all {len(release)} files of the compare model are there"
+    reason = result(protocol, "file_consistency").reason
+    assert reason == f"all {len(release)} files of the compare model are there"
     assert result(protocol, "compare_torques").reason.startswith("1 joint torques with 1 loop closure")
 
 
