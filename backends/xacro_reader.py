@@ -66,7 +66,7 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
             sink.error(Span(where, e.lineno, e.offset + 1), "E0620", f"xacro cannot read '{where}': "
                        f"{xml.parsers.expat.ErrorString(e.code)}")
             return None
-        except Exception as e:  # noqa: BLE001 - whatever xacro raises is about the user's files
+        except Exception as e:
             where = _current_file(path)
             macros = [f"'{m.body.getAttribute('name')}' of {Path(m.history[-1][-1]).name}"
                       for m in (getattr(xacro, "macrostack", None) or []) if m.history and m.history[-1]]

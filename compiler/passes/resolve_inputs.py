@@ -22,5 +22,6 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
                            f"'{inp.name}' does not exist")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
-                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf) and xacro (.xacro)")
+                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf) and xacro "
+                           "(.xacro)")
     return program

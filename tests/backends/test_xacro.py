@@ -84,8 +84,8 @@ def test_two_segments_from_a_macro_and_an_argument_equal_the_xacro_command(tmp_p
                               capture_output=True, text=True, check=True).stdout
     write(tmp_path / "expanded.urdf", expanded)
     from_xacro = compiled_urdf(write(tmp_path / "a.yml", definition("arm.urdf.xacro")), tmp_path / "a")
-    spec = write(tmp_path / "b.yml", definition("expanded.urdf").replace("      xacro_args: {segment_length: 0.6}\n",
-                                                                        ""))
+    spec = write(tmp_path / "b.yml", definition("expanded.urdf").replace(
+        "      xacro_args: {segment_length: 0.6}\n", ""))
     from_command = compiled_urdf(spec, tmp_path / "b")
     # The same model, line for line; mpc leaves out xacro's banner naming the file's path.
     banner = [line for line in from_command.splitlines() if line.startswith("<!-- ")]
@@ -120,8 +120,9 @@ def test_xacro_errors_name_the_xacro_file_and_line(tmp_path: Path) -> None:
     spec = write(tmp_path / "m.yml", definition("arm.urdf.xacro"))
     done = mpc("check", spec)
     assert done.returncode == 1
-    assert f"{tmp_path / 'segment.xacro'}:11:5: error[E0620]: xacro cannot read '{tmp_path / 'segment.xacro'}': " \
-           "not well-formed (invalid token)" in done.stderr, done.stderr
+    segment = tmp_path / "segment.xacro"
+    assert f"{segment}:11:5: error[E0620]: xacro cannot read '{segment}': not well-formed (invalid token)" \
+        in done.stderr, done.stderr
     write(tmp_path / "segment.xacro", SEGMENT.replace("${length / 2}", "${lenght / 2}"))
     done = mpc("check", spec)
     assert f"{spec}:6:17: error[E0620]: xacro cannot expand '{tmp_path / 'arm.urdf.xacro'}' (in macro " \
@@ -132,8 +133,7 @@ def test_xacro_errors_name_the_xacro_file_and_line(tmp_path: Path) -> None:
     done = mpc("check", write(tmp_path / "n.yml", definition("arm.urdf.xacro", "{other: 1}")))
     assert "error[E0620]: xacro cannot expand" in done.stderr and "segment_length" in done.stderr, done.stderr
     assert "hint: give it in the input model's `xacro_args: {name: value}`" in done.stderr
-    done = mpc("check", write(tmp_path / "w.yml", definition("segment.xacro".replace("segment", "arm.urdf"),
-                                                             "{segment_length: [1]}")))
+    done = mpc("check", write(tmp_path / "w.yml", definition("arm.urdf.xacro", "{segment_length: [1]}")))
     assert "error[E0240]: xacro argument 'segment_length' is a string, a number or a boolean" in done.stderr
 
 
