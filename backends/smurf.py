@@ -149,15 +149,23 @@ def _names(robot: Robot, link_name: str, kind: str) -> list[str]:
     return shape_names(link_name, kind, [s.name for s in getattr(robot.links[link_name], f"{kind}s")])
 
 
-def _shapes(robot: Robot, kind: str) -> list[dict[str, Any]]:
-    """An entry for every visual or collision: its name (Phobos's name for an unnamed one,
-    which is how a reader finds it again), its link, its bitmask and annotations."""
+def _shapes(robot: Robot, kind: str) -> list[dict[str, Any]] | None:
+    """An entry for every named visual or collision, and for every unnamed one that carries
+    annotations or a bitmask: its name (Phobos's name for an unnamed one, which is how a
+    reader finds it again), its link, its bitmask and annotations. None: the robot has none.
+
+    Phobos 2.x reads an unnamed shape of a URDF as named "None" and fails on an entry it
+    cannot find, so an unnamed shape with nothing to say gets no entry (specs/smurf.md)."""
+    if not any(getattr(link, f"{kind}s") for link in robot.links.values()):
+        return None
     out = []
     for link_name in sorted(robot.links):
         shapes = getattr(robot.links[link_name], f"{kind}s")
         for shape, name in zip(shapes, _names(robot, link_name, kind), strict=True):
-            entry: dict[str, Any] = {**shape.annotations, "link": link_name, "name": name}
             bitmask = getattr(shape, "bitmask", None)
+            if shape.name is None and not shape.annotations and bitmask is None:
+                continue
+            entry: dict[str, Any] = {**shape.annotations, "link": link_name, "name": name}
             if bitmask is not None:
                 entry["bitmask"] = bitmask
             out.append(entry)
@@ -215,14 +223,17 @@ def annotation_files(robot: Robot, sink: Sink, span: Any = None,
     joints += [_cut_joint(c) for c in robot.cut_joints.values()]
     links = [_link(robot, n) for n in robot.links]
     materials = [_material(m) for m in robot.materials.values()]
-    lists = {
+    lists: dict[str, list[dict[str, Any]] | None] = {
         "motors": [_motor(robot, m) for m in robot.motors.values()],
         "sensors": [_sensor(s) for s in robot.sensors.values()],
         "materials": materials, "joints": joints, "links": links,
         "collisions": _shapes(robot, "collision"), "visuals": _shapes(robot, "visual"),
         "poses": [{"name": n, "joints": dict(values)} for n, values in robot.poses.items()],
     }
-    files: dict[str, dict[str, Any]] = {k: {k: _by_name(v)} for k, v in lists.items() if v}
+    # A category is written when the robot has elements of it (shapes: even when none of
+    # them gets an entry), as Phobos writes it.
+    files: dict[str, dict[str, Any]] = {k: {k: _by_name(v)} for k, v in lists.items()
+                                        if v is not None and (v or k in ("collisions", "visuals"))}
     submechanisms = _submechanisms(robot, sink, span)
     if submechanisms:
         files["submechanisms"] = submechanisms

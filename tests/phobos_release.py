@@ -7,8 +7,7 @@ no file of Phobos is copied.
 The model is the four-bar linkage of tests/checks/fourbar.py with a visual and a material
 per bar, a camera, a motor on the crank, a loop-closure joint and a submechanism. Phobos's
 habits it carries: collisions and visuals listed by name only (their links found through
-the URDF), one collision left unnamed in the URDF (Phobos calls it `<link>_collision`),
-colours as lists and as `{r, g, b, a}`, offsets as `{x, y, z}` and `{w, x, y, z}`,
+the URDF, where Phobos names every shape), colours as lists and as `{r, g, b, a}`, offsets as `{x, y, z}` and `{w, x, y, z}`,
 materials the URDF only names, derived keys on every entry (`cut_joint: false`,
 `constraint_axes: []`, the shape lists of links, `transparency`), and keys mpc does not
 model (`noDataPackage`, `reducedDataPackage`, a camera's `hud_width`, …).
@@ -60,7 +59,7 @@ URDF = """\
       <mass value="5.0"/>
       <inertia ixx="0.1" ixy="0.0" ixz="0.0" iyy="0.1" iyz="0.0" izz="0.1"/>
     </inertial>
-    <collision>
+    <collision name="base_collision">
       <origin rpy="0.0 0.0 0.0" xyz="1.0 0.0 -0.05"/>
       <geometry>
         <box size="2.2 0.1 0.1"/>
@@ -152,7 +151,7 @@ ANNOTATIONS: dict[str, Any] = {
                 "cut_joint": True, "constraint_axes": [{"name": "y", "axis": [0.0, 1.0, 0.0]}],
                 "origin": {"position": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 0.0],
                            "relative_to": "coupler_tip"}}],
-    # by name only, as Phobos wrote them in 2022; `base_collision` is unnamed in the URDF
+    # by name only, as Phobos wrote them in 2022
     "collisions": [{"name": "base_collision", **NO_DATA},
                    {"name": "crank_collision", "bitmask": 3, **NO_DATA},
                    {"name": "coupler_collision", "bitmask": 5, **NO_DATA},
@@ -180,9 +179,7 @@ SUBMECHANISMS = {"submechanisms": [{
     "name": "fourbar", "contextual_name": "four_bar_linkage", "type": "4BAR",
     "jointnames": ["coupler_joint", "coupler_tip_joint", "crank_joint", "rocker_joint", "rocker_tip_joint"],
     "jointnames_spanningtree": ["crank_joint", "coupler_joint", "rocker_joint"],
-    "jointnames_active": ["crank_joint"], "jointnames_independent": ["crank_joint"],
-    "loop_constraints": [{"cut_joint": "loop", "predecessor_body": "coupler_tip",
-                          "successor_body": "rocker_tip"}]}]}
+    "jointnames_active": ["crank_joint"], "jointnames_independent": ["crank_joint"]}]}
 
 JOINT_LIMITS = {"limits": {
     "names": ["crank_joint", "coupler_joint", "rocker_joint"],

@@ -51,7 +51,7 @@ def test_a_phobos_smurf_compiles_and_every_annotation_survives(tmp_path: Path) -
     assert index["additional_files"] == {}
     for category in ANNOTATIONS:
         assert entries(files, category).keys() == {e["name"] for e in ANNOTATIONS[category]}, category
-    # Collisions listed by name only: found through the URDF (one of them unnamed there).
+    # Collisions listed by name only: found through the URDF.
     collisions = entries(files, "collisions")
     assert collisions["base_collision"] == {"name": "base_collision", "link": "base", "noDataPackage": False,
                                             "reducedDataPackage": False}
