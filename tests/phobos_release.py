@@ -7,10 +7,12 @@ no file of Phobos is copied.
 The model is the four-bar linkage of tests/checks/fourbar.py with a visual and a material
 per bar, a camera, a motor on the crank, a loop-closure joint and a submechanism. Phobos's
 habits it carries: collisions and visuals listed by name only (their links found through
-the URDF, where Phobos names every shape), colours as lists and as `{r, g, b, a}`, offsets as `{x, y, z}` and `{w, x, y, z}`,
-materials the URDF only names, derived keys on every entry (`cut_joint: false`,
-`constraint_axes: []`, the shape lists of links, `transparency`), and keys mpc does not
-model (`noDataPackage`, `reducedDataPackage`, a camera's `hud_width`, …).
+the URDF, where Phobos names every shape), colours as lists and as `{r, g, b, a}`, offsets
+as `{x, y, z}` and `{w, x, y, z}`, materials the URDF only names, derived keys on every
+entry (`cut_joint: false`, `constraint_axes: []`, the shape lists of links,
+`transparency`), and keys mpc does not model (`noDataPackage`, `reducedDataPackage`, a
+camera's `hud_width`, …). Phobos 2.1 (run from its source) reads it, and reads mpc's SMURF
+of it to the same sensors, materials, motors, collisions, poses and submechanisms.
 """
 
 from __future__ import annotations
