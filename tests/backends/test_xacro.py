@@ -165,3 +165,16 @@ def test_editing_an_included_macro_rebuilds_the_model(tmp_path: Path) -> None:
     segment.write_text(segment.read_text().replace('effort="20"', 'effort="25"'))
     assert run_json(project / "pipeline.yml", cache=cache).states() == {"arm-model": "ok"}
     assert 'effort="25"' in (project / "build/arm-model/urdf/arm.urdf").read_text()
+
+
+def test_xacro_warnings_are_diagnostics(tmp_path: Path) -> None:
+    """An include whose glob matches nothing: xacro warns, the model still builds (W0623)."""
+    main = arm(tmp_path)
+    main.write_text(main.read_text().replace('<xacro:include filename="segment.xacro"/>',
+                                             '<xacro:include filename="segment.xacro"/>\n'
+                                             '  <xacro:include filename="extras/*.xacro"/>'))
+    spec = write(tmp_path / "m.yml", definition("arm.urdf.xacro"))
+    done = mpc("compile", spec, "-o", tmp_path / "out")
+    assert done.returncode == 0, done.stderr
+    assert f"{spec}:6:17: warning[W0623]: xacro, expanding '{main}': Include tag's filename spec " \
+           f"\"{tmp_path}/extras/*.xacro\" matched no files." in done.stderr, done.stderr
