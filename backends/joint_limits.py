@@ -6,12 +6,11 @@ Selections: ALL (every movable joint), ACTIVE and INDEPENDENT (the submechanisms
 `jointnames_active` / `jointnames_independent`), ABSTRACT (the movable joints of the
 abstract model, ir/submodel.py), ACTUATED (joints with a motor), or a list of joint names;
 `joints: <submodel>` is ALL of that submodel (the driver passes it in). Written as
-JSON-compatible YAML with sorted keys, so it diffs cleanly.
+block-style YAML with sorted keys (as Phobos's YAML writer did), so it diffs cleanly.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from mpc.backends.xml import write_path
@@ -65,7 +64,9 @@ def to_yaml(robot: Robot, names: list[str]) -> str:
         elements.append({"max": {"position": upper, "speed": lim.velocity if lim and lim.velocity else 0.0,
                                  "effort": lim.effort if lim and lim.effort else 0.0},
                          "min": {"position": lower}})
-    return json.dumps({"limits": {"names": names, "elements": elements}}, indent=2, sort_keys=True) + "\n"
+    from mpc.backends.smurf import dumps
+
+    return dumps({"limits": {"names": names, "elements": elements}})
 
 
 def emit(robot: Robot, export: JointLimitsExport, out: Path, sink: Sink) -> None:

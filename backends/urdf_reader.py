@@ -13,7 +13,7 @@ from pathlib import Path
 from lxml import etree
 
 from mpc.backends.packages import PackageResolver
-from mpc.backends.xml import XmlSource, load, parse_floats
+from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
@@ -34,6 +34,7 @@ from mpc.ir.robot import (
     SafetyController,
     Visual,
 )
+from mpc.ir.span import Span
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -51,8 +52,24 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
     src = load(path, sink, "URDF", display)
     if src is None:
         return None
+    return _robot(src, sink, resolver, path.parent.resolve())
+
+
+def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
+              resolver: PackageResolver | None = None) -> Robot | None:
+    """Read URDF text that no file holds (a xacro expansion), named `file` in diagnostics;
+    relative mesh paths start at `base_dir`."""
+    try:
+        src = XmlSource.parse(data, file)
+    except XmlError as e:
+        sink.error(Span(file, e.line, e.col), "E0401", f"malformed XML in '{file}': {e.message}")
+        return None
+    return _robot(src, sink, resolver, base_dir)
+
+
+def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_dir: Path) -> Robot | None:
     errors_before = sink.error_count
-    robot = _Reader(src, sink, resolver or PackageResolver(), path.parent.resolve()).robot()
+    robot = _Reader(src, sink, resolver or PackageResolver(), base_dir).robot()
     if robot is None or sink.error_count > errors_before:
         return None
     return robot

@@ -17,7 +17,6 @@ from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 
 @dataclass
@@ -44,33 +43,21 @@ class Model:
 
 
 def read_model(path: Path, sink: Sink) -> Robot | None:
-    """A URDF or SDF file (by its suffix) → a robot; diagnostics go to `sink`."""
+    """A URDF, SDF or SMURF file (by its suffix) → a robot; diagnostics go to `sink`.
+
+    A SMURF (Phobos names one as compare model) is read with its annotations: cut joints,
+    motors and submechanisms take part in the dynamics tests."""
     if path.suffix.lower() == ".sdf":
         from mpc.backends.sdf_reader import read as read_sdf
 
         return read_sdf(path, sink)
     if path.suffix.lower() == ".smurf":
-        urdf = _urdf_of_smurf(path)
-        if urdf is None:
-            sink.error(Span.of_file(str(path)), "E0704", "the SMURF file lists no URDF in `files`")
-            return None
-        path = urdf
+        from mpc.backends.smurf_reader import read as read_smurf
+
+        return read_smurf(path, sink)
     from mpc.backends.urdf_reader import read as read_urdf
 
     return read_urdf(path, sink)
-
-
-def _urdf_of_smurf(path: Path) -> Path | None:
-    """The URDF a SMURF file lists in `files` (Phobos names the SMURF as compare model)."""
-    import yaml
-
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, yaml.YAMLError):
-        return None
-    files = data.get("files", []) if isinstance(data, dict) else []
-    urdf = next((f for f in files if isinstance(f, str) and f.endswith(".urdf")), None)
-    return (path.parent / urdf).resolve() if urdf else None
 
 
 def read_submechanisms(path: Path) -> tuple[Submechanism, ...] | None:

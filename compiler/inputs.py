@@ -59,20 +59,24 @@ class InputLoader:
         if inp.kind == "basefile":
             if inp.path is None:  # its package was not found; reported when lowering
                 return None
-            return self._read(inp.path)
+            return self._read(inp.path, inp)
         if inp.kind == "derived_base":
             assert inp.path is not None
             if self._cycle(inp):
                 return None
             return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
         path = self._repo_file(inp, fetch=True)
-        return None if path is None else self._read(path)
+        return None if path is None else self._read(path, inp)
 
-    def _read(self, path: Path) -> Robot | None:
-        """A model file, by its extension: URDF, SDF or SMURF."""
+    def _read(self, path: Path, inp: Input) -> Robot | None:
+        """A model file, by its extension: URDF, SDF, SMURF, or a xacro (expanded with its args)."""
         from mpc.backends import BACKENDS
 
         suffix = path.suffix.lower()
+        if suffix == ".xacro":
+            from mpc.backends import xacro_reader
+
+            return xacro_reader.read(path, self.sink, self.options.resolver, inp.xacro_args, inp.span)
         reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
         return reader.read(path, self.sink, self.options.resolver)
 

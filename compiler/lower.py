@@ -124,6 +124,7 @@ class _Lowering:
     def inputs(self) -> dict[str, Input]:
         out = {}
         for name, entry in self.model.input_models.items():
+            xacro_args = self.xacro_args(entry)
             if entry.basefile is not None:
                 folder = self.folder_of(entry, "basefile")
                 path: Path | None = resolve_file(entry.basefile, folder, self.resolver)
@@ -135,7 +136,7 @@ class _Lowering:
                                     hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH")
                     path = None
                 out[name] = Input(name=name, kind="basefile", span=entry.value_span("basefile"),
-                                  path=path, is_human=entry.is_human)
+                                  path=path, is_human=entry.is_human, xacro_args=xacro_args)
             elif entry.derived_base is not None:
                 out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
                                   path=(self.folder_of(entry, "derived_base") / entry.derived_base).resolve(),
@@ -144,11 +145,31 @@ class _Lowering:
             elif entry.repo is not None:
                 r = entry.repo
                 out[name] = Input(name=name, kind="repo", path=None, span=entry.value_span("repo"),
-                                  is_human=entry.is_human,
+                                  is_human=entry.is_human, xacro_args=xacro_args,
                                   repo=RepoRef(git=r.git, commit=r.commit, branch=r.branch,
                                                model_in_repo=r.model_in_repo,
                                                submechanisms_in_repo=r.submechanisms_in_repo))
         return out
+
+    def xacro_args(self, entry: Any) -> tuple[tuple[str, str], ...]:
+        """The input's `xacro_args` as text (xacro's arguments are strings); a warning when its
+        model file is no xacro, which ignores them."""
+        if entry.xacro_args is None:
+            return ()
+        model = entry.basefile or (entry.repo.model_in_repo if entry.repo is not None else "")
+        if not model.endswith(".xacro"):
+            self.sink.warning(entry.key_span("xacro_args"), "W0622", f"xacro_args apply to a .xacro model "
+                              f"file; '{model}' is none, so they are ignored")
+            return ()
+        text = {True: "true", False: "false"}
+        out = []
+        for key, value in sorted(entry.xacro_args.items()):
+            if not isinstance(value, str | int | float | bool):
+                self.sink.error(entry.value_span("xacro_args"), "E0240", f"xacro argument '{key}' is a "
+                                "string, a number or a boolean (xacro's arguments are text)")
+                continue
+            out.append((key, text[value] if isinstance(value, bool) else str(value)))
+        return tuple(out)
 
     # -- assembly --------------------------------------------------------------------------
 
@@ -486,6 +507,14 @@ class _Lowering:
             elif entry.shell:
                 command = (entry.cmd,)
             else:
+                syntax = _SHELL_SYNTAX.search(entry.cmd)
+                if syntax is not None and "shell" not in entry.given:
+                    self.sink.error(entry.value_span("cmd"), "E0560", f"this command has shell syntax "
+                                    f"(`{syntax.group().strip()}`) but runs without a shell, so it would be "
+                                    "passed to the program as an argument (Phobos ran every command "
+                                    "through a shell)", hint="add `shell: true` to run it through /bin/sh, "
+                                    "or give `cmd` as a list of arguments")
+                    continue
                 try:
                     command = tuple(shlex.split(entry.cmd))
                 except ValueError as error:
@@ -573,6 +602,9 @@ class _Lowering:
 
 # Export types `mpc compile` writes; the others are reported as not supported yet.
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
+# What a shell would read differently from a plain split into arguments: redirections, pipes,
+# `;`, `&&`, `&`, `$` expansions, back quotes, subshells, globs, quotes, escapes, and `~`.
+_SHELL_SYNTAX = re.compile(r"&&|\|\||[|;&<>$`()*?'\"\\]|\[.*\]|(?:^|\s)~")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {

@@ -39,6 +39,7 @@ class Input:
     is_human: whether every link is marked as human (exoskeleton models).
     smurf_data: whether the input keeps its SMURF data (motors, sensors, poses, annotations…);
         False for a derived_base under `inherit_smurf_properties: false` (ir/smurf_data.py).
+    xacro_args: (name, value) of each argument a xacro model file is expanded with.
     span: the YAML value that names the source.
     """
 
@@ -49,6 +50,7 @@ class Input:
     repo: RepoRef | None = None
     is_human: bool = False
     smurf_data: bool = True
+    xacro_args: tuple[tuple[str, str], ...] = ()
 
 
 @record(slots=True, kw_only=True)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from mpc.compiler.passes import PassContext
 from mpc.ir.program import Program
 
-READABLE = (".urdf", ".sdf", ".smurf")
+READABLE = (".urdf", ".sdf", ".smurf", ".xacro")
 
 
 def resolve_inputs(program: Program, ctx: PassContext) -> Program:
@@ -22,5 +22,6 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
                            f"'{inp.name}' does not exist")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
-                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf) and SMURF (.smurf)")
+                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf) and xacro "
+                           "(.xacro)")
     return program

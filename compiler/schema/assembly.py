@@ -42,6 +42,7 @@ class InputModel(Node):
     derived_base: str | None = None
     repo: Repo | None = None
     is_human: bool = False
+    xacro_args: dict[str, Any] | None = None  # scalars each, checked when lowered (E0240)
 
     def problem(self) -> str | None:
         given = [k for k in ("basefile", "derived_base", "repo") if getattr(self, k) is not None]

@@ -82,3 +82,21 @@ def test_a_program_that_is_not_there(tmp_path: Path) -> None:
                                            "`mpc-no-such-program urdf/arm.urdf` could not start: "
                                            "No such file or directory [E0508]")
     assert not (tmp_path / "out").exists()
+
+
+def test_shell_syntax_without_shell_is_an_error_and_with_shell_writes_its_file(tmp_path: Path) -> None:
+    """Phobos ran `cmd` through a shell; without `shell`, `> log.txt` would be an argument and
+    nothing would be written, so mpc refuses it (mpc check too) and builds nothing."""
+    line = "    - cmd: \"python3 -c 'print(42)' > log.txt\"\n"
+    spec = write(tmp_path / "m.yml", HEAD + "  post_processing:\n" + line)
+    for command in ("check", "compile"):
+        done = mpc(command, spec, "-o", tmp_path / "out") if command == "compile" else mpc(command, spec)
+        assert done.returncode == 1
+        assert f"{spec}:7:12: error[E0560]: this command has shell syntax (`'`) but runs without a " \
+               "shell" in done.stderr, done.stderr
+        assert "add `shell: true` to run it through /bin/sh, or give `cmd` as a list" in done.stderr
+    assert not (tmp_path / "out").exists()
+    write(spec, HEAD + "  post_processing:\n" + line + "      shell: true\n")
+    done = mpc("compile", spec, "-o", tmp_path / "out")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "out/log.txt").read_text() == "42\n"

@@ -12,6 +12,8 @@ from lxml import etree
 
 from tests.conftest import ERD, Diags, compile_file, write
 
+# The SMURF files of every ur5 output: the categories it has elements of, as Phobos writes them.
+UR5_SMURF = ("ur5_collisions.yml", "ur5_joints.yml", "ur5_links.yml", "ur5_visuals.yml")
 
 def _spec(tmp_path: Path, source: Path, exports: str, extra: str = "", name: str = "m.yml") -> Path:
     return write(tmp_path / name, f"""
@@ -262,9 +264,10 @@ def test_inherit_smurf_properties_false_drops_the_derived_inputs_smurf_data(tmp_
         outs[name] = compile_file(tmp_path / f"{name}.yml", tmp_path / "out" / name, diags).out
         assert outs[name] is not None
         diags.take("W0500", severity=diags.diagnostics[0].severity)
-    assert sorted(p.name for p in (outs["plain"] / "smurf").iterdir()) == ["ur5.smurf"]
+    assert sorted(p.name for p in (outs["plain"] / "smurf").iterdir()) == ["ur5.smurf", *UR5_SMURF]
     assert (outs["plain"] / "urdf/ur5.urdf").read_bytes() == (outs["ur5"] / "urdf/ur5.urdf").read_bytes()
-    assert sorted(p.name for p in (outs["own"] / "smurf").iterdir()) == ["ur5.smurf", "ur5_poses.yml"]
+    assert sorted(p.name for p in (outs["own"] / "smurf").iterdir()) == [
+        "ur5.smurf", *UR5_SMURF[:3], "ur5_poses.yml", UR5_SMURF[3]]
     assert "rest" in (outs["own"] / "smurf/ur5_poses.yml").read_text()
     assert "home" not in (outs["own"] / "smurf/ur5_poses.yml").read_text()
 
@@ -299,7 +302,7 @@ def test_the_smurf_lists_the_submodels_and_reads_them_back(tmp_path: Path, diags
     out = compile_file(spec, tmp_path / "out", diags).out
     assert out is not None
     index = yaml.safe_load((out / "smurf/ur5.smurf").read_text())
-    assert index["files"] == ["../urdf/ur5.urdf", "ur5_submodels.yml"]
+    assert index["files"] == ["../urdf/ur5.urdf", *UR5_SMURF[:3], "ur5_submodels.yml", UR5_SMURF[3]]
     submodels = yaml.safe_load((out / "smurf/ur5_submodels.yml").read_text())["submodels"]
     assert submodels["arm"] == {
         "name": "arm", "robotname": "arm", "start": None, "stop": ["wrist_1_link"], "abstract_model": False,
@@ -400,8 +403,10 @@ def test_from_the_command_line(tmp_path: Path) -> None:
     assert run.stderr == (f"{spec}:10:7: warning: correct_inertials made the inertials of 2 links physical: "
                           "'sensor_mount_link', 'double_stereo_link' [W0530]\n")
     assert run.stdout.startswith(f"compiled '{spec}' into '{tmp_path}/out': CMakeLists.txt, "
-                                 "joint_limits.yml, package.xml, smurf/robot.smurf, urdf/robot.urdf, "
-                                 "urdf/robot_ros.urdf and ")
+                                 "joint_limits.yml, package.xml, smurf/robot.smurf, "
+                                 "smurf/robot_collisions.yml, smurf/robot_joints.yml, smurf/robot_links.yml, "
+                                 "smurf/robot_materials.yml, "
+                                 "smurf/robot_visuals.yml, urdf/robot.urdf, urdf/robot_ros.urdf and ")
 
 
 def test_a_submodel_inherits_ros_pathes(tmp_path: Path, diags: Diags) -> None:

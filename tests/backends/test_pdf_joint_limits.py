@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import json
 import shutil
 import subprocess
 from pathlib import Path
+
+import yaml
 
 from tests.conftest import ERD, Diags, compile_file, write
 from tests.fixtures import arm
@@ -42,8 +43,12 @@ model:
     expected = {"all": (["shoulder", "elbow"], [shoulder, elbow]), "active": (["elbow"], [elbow]),
                 "independent": (["shoulder"], [shoulder]), "listed": (["elbow"], [elbow])}
     for name, (names, elements) in expected.items():
-        data = json.loads((out / f"{name}.yml").read_text())
+        data = yaml.safe_load((out / f"{name}.yml").read_text())
         assert data == {"limits": {"names": names, "elements": elements}}, name
+    # Block style, keys sorted, as Phobos's YAML writer wrote it (not JSON in a .yml file).
+    assert (out / "listed.yml").read_text() == (
+        "limits:\n  elements:\n  - max:\n      effort: 5.0\n      position: 2.0\n      speed: 3.0\n"
+        "    min:\n      position: -2.0\n  names:\n  - elbow\n")
 
 
 def test_kinematic_tree_pdf(tmp_path: Path) -> None:

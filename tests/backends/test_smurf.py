@@ -133,7 +133,7 @@ def test_files_are_yaml_that_phobos_reads(tmp_path: Path, diags: Diags) -> None:
     folder = tmp_path / "smurf"
     index = yaml.safe_load((folder / "ur5.smurf").read_text())
     assert index == {
-        "modelname": "ur5", "description": "round trip", "version": "1.0.0",
+        "modelname": "ur5", "description": "round trip", "version": "1.0.0", "additional_files": {},
         "files": ["../urdf/ur5.urdf", "ur5_annotations.yml", "ur5_collisions.yml", "ur5_joints.yml",
                   "ur5_links.yml", "ur5_materials.yml", "ur5_motors.yml", "ur5_poses.yml", "ur5_sensors.yml",
                   "ur5_submechanisms.yml", "ur5_thermal.yml", "ur5_visuals.yml"]}
@@ -142,6 +142,7 @@ def test_files_are_yaml_that_phobos_reads(tmp_path: Path, diags: Diags) -> None:
         assert list(content) == [name[len("ur5_"):-len(".yml")]] or name == "ur5_submechanisms.yml"
     motors = yaml.safe_load((folder / "ur5_motors.yml").read_text())["motors"]
     assert motors[0] == {"name": "elbow_joint_motor", "joint": "elbow_joint", "p": 20.0, "i": 0.001, "d": 0,
+                         "type": "position",
                          "maxEffort": 150.0, "maxSpeed": 3.15, "maxValue": 3.14159265359,
                          "minValue": -3.14159265359}
     joints = yaml.safe_load((folder / "ur5_joints.yml").read_text())["joints"]
@@ -149,8 +150,22 @@ def test_files_are_yaml_that_phobos_reads(tmp_path: Path, diags: Diags) -> None:
     assert loop["origin"]["rpy"] == [0.0, 0.25, -1e-05]  # `-1.0e-05`: a float for YAML 1.1 too
     assert "rpy:\n    - 0.0\n    - 0.25\n    - -1.0e-05\n" in (folder / "ur5_joints.yml").read_text()
     collisions = yaml.safe_load((folder / "ur5_collisions.yml").read_text())["collisions"]
-    assert {"name": "base_link_collision", "link": "base_link", "index": 0, "bitmask": 0,
-            "ccfm": 0.002} in collisions
+    assert {"name": "base_link_collision", "link": "base_link", "bitmask": 0, "ccfm": 0.002} in collisions
+    # Every element has its entry, with Phobos's keys.
+    links = yaml.safe_load((folder / "ur5_links.yml").read_text())["links"]
+    base_link = next(x for x in links if x["name"] == "base_link")
+    assert base_link == {"name": "base_link", "collisions": ["base_link_collision"],
+                         "visuals": ["base_link_visual"], "index_hint": base_link["index_hint"]}
+    assert len(links) == len(robot.links)
+    assert {"name": "elbow_joint", "parent": "upper_arm_link", "child": "forearm_link",
+            "joint_type": "revolute", "cut_joint": False, "constraint_axes": [], "motor": "elbow_joint_motor",
+            "noDataPackage": False} in joints
+    materials = yaml.safe_load((folder / "ur5_materials.yml").read_text())["materials"]
+    assert {"name": "shiny", "diffuseColor": {"r": 0.0, "g": 0.0, "b": 1.0, "a": 1.0}, "transparency": 0.0,
+            "specularColor": {"r": 1.0, "g": 1.0, "b": 1.0}, "shininess": 20.0, "kind": "metal"} in materials
+    sensors = yaml.safe_load((folder / "ur5_sensors.yml").read_text())["sensors"]
+    assert {"name": "imu", "type": "IMU", "link": "world", "position_offset": {"x": 0.0, "y": 0.0, "z": 0.05},
+            "rate": 100} in sensors
 
 
 # -- from the command line ----------------------------------------------------------------------
@@ -237,7 +252,7 @@ def test_annotations_survive_derived_base_and_smurf_input(tmp_path: Path) -> Non
     parent = outs["ur5"]
     assert sorted(parent) == ["ur5.smurf", "ur5_collisions.yml", "ur5_joints.yml", "ur5_links.yml",
                               "ur5_motors.yml", "ur5_poses.yml", "ur5_self_collision.yml", "ur5_sensors.yml",
-                              "ur5_submechanisms.yml", "ur5_thermal.yml"]
+                              "ur5_submechanisms.yml", "ur5_thermal.yml", "ur5_visuals.yml"]
     index = yaml.safe_load(parent["ur5.smurf"])
     assert index["files"][0] == "../urdf/ur5.urdf"
     assert index["additional_files"] == {"sdf": "../sdf/ur5.sdf"}
@@ -290,7 +305,7 @@ def test_second_smurf_entry_warns_and_first_writes(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     assert f"{spec}:12:14: warning: SMURF is written once per output folder (always, without an entry); " \
            "this entry repeats it [W0510]" in run.stderr
-    assert yaml.safe_load((tmp_path / "out/smurf/arm.smurf").read_text())["files"] == ["../urdf/arm.urdf"]
+    assert yaml.safe_load((tmp_path / "out/smurf/arm.smurf").read_text())["files"][0] == "../urdf/arm.urdf"
 
 
 def broken_smurf(tmp_path: Path, motors: str, files: str = "[../arm.urdf, arm_motors.yml]") -> Path:

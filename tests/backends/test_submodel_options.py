@@ -3,11 +3,11 @@ and the joint_limits selections ABSTRACT and `<submodel name>`, on TALOS with Pi
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+import yaml
 
 from mpc.compiler.diagnostics import Severity
 from tests.backends.test_submodel import HEAD
@@ -90,11 +90,11 @@ def test_abstract_model_keeps_the_independent_joints(tmp_path: Path, diags: Diag
     assert np.allclose(c1, c2, atol=1e-12)
     assert np.allclose(I1, I2, atol=1e-10)
     movable = [n for n, t in joints_of(abstract).items() if t != "fixed"]
-    listed = json.loads((out / "abstract_limits.yml").read_text())["limits"]["names"]
+    listed = yaml.safe_load((out / "abstract_limits.yml").read_text())["limits"]["names"]
     assert sorted(listed) == sorted(movable)
     assert "gripper_left_joint" in listed and "gripper_left_fingertip_1_joint" not in listed
     # The abstract model (which inherits the entry) is its own abstract model.
-    again = json.loads((out / "submodels/abstract/abstract_limits.yml").read_text())["limits"]["names"]
+    again = yaml.safe_load((out / "submodels/abstract/abstract_limits.yml").read_text())["limits"]["names"]
     assert again == listed
 
 
@@ -130,7 +130,7 @@ def test_remove_joints_by_pattern_and_the_limits_of_a_submodel(tmp_path: Path, d
     kept = [n for n, t in joints_of(urdf).items() if t != "fixed"]
     expected = [f"arm_left_{i}_joint" for i in range(2, 7)] + ["gripper_left_joint"]
     assert sorted(kept) == sorted(expected)
-    listed = json.loads((out / "left_arm_limits.yml").read_text())["limits"]["names"]
+    listed = yaml.safe_load((out / "left_arm_limits.yml").read_text())["limits"]["names"]
     assert listed == expected
     assert not (out / "submodels/left_arm/joint_limits.yml").exists()
 
@@ -257,6 +257,6 @@ def test_from_the_command_line(tmp_path: Path) -> None:
         "and kccdcoveriv each body's fitted volume [W0520]\n")
     legs = tmp_path / "out/submodels/legs"
     assert "fixed" not in joints_of(legs / "urdf/legs.urdf").values()
-    names = json.loads((legs / "joint_limits.yml").read_text())["limits"]["names"]
+    names = yaml.safe_load((legs / "joint_limits.yml").read_text())["limits"]["names"]
     assert len(names) == 12
     assert len(list((legs / "meshes/iv").glob("*.stl"))) == 13  # base_link and twelve leg links

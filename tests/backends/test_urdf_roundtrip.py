@@ -34,7 +34,7 @@ def test_compiling_twice_gives_identical_bytes(tmp_path: Path) -> None:
     second = compile_file(spec, tmp_path / "b", Diags()).out
     assert first and second
     a, b = _files(first), _files(second)
-    assert len(a) == 50  # the URDF, its SMURF and 48 distinct STL files
+    assert len(a) == 55  # the URDF, its SMURF (.smurf and 5 category files) and 48 distinct STL files
     assert a == b
 
 

@@ -95,8 +95,8 @@ def test_edge_models_compared_with_themselves_never_crash(tmp_path: Path, name: 
      "malformed XML in '{tmp}/notes.txt': Start tag expected, '<' not found"),
     ("      path: broken.urdf\n", "cannot read the compare model 'broken.urdf': {tmp}/broken.urdf:1:33: "
      "joint 'j' has no <child link=…>"),
-    ("      path: robot.smurf\n", "cannot read the compare model 'robot.smurf': {tmp}/robot.smurf:1:1: "
-     "the SMURF file lists no URDF in `files`"),
+    ("      path: robot.smurf\n", "cannot read the compare model 'robot.smurf': {tmp}/robot.smurf:2:8: "
+     "the SMURF lists no URDF or SDF file"),
     ("      git: {tmp}/remote.git\n      branch: nope\n", "cannot get branch 'nope' of compare repository "
      "'{tmp}/remote.git': fatal: Remote branch nope not found in upstream origin"),
     ("      git: {tmp}/remote.git\n      model_in_repo: urdf/other.urdf\n",

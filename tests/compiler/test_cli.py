@@ -25,7 +25,9 @@ def test_bundled_example_compiles(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     assert run.stderr == ""
     assert run.stdout == (f"compiled '{ROOT}/examples/talos.yml' into '{tmp_path}/talos': "
-                          "smurf/talos.smurf, urdf/talos.urdf and 48 mesh files\n")
+                          "smurf/talos.smurf, smurf/talos_collisions.yml, smurf/talos_joints.yml, "
+                          "smurf/talos_links.yml, smurf/talos_materials.yml, smurf/talos_visuals.yml, "
+                          "urdf/talos.urdf and 48 mesh files\n")
     urdf = etree.parse(str(tmp_path / "talos/urdf/talos.urdf")).getroot()
     assert urdf.get("name") == "talos"
     assert {m.get("filename").rsplit("/", 1)[0] for m in urdf.iter("mesh")} == {"../meshes/stl"}

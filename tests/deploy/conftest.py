@@ -19,6 +19,10 @@ from mpc.deploy import DeploySettings
 from mpc.ir.program import Program
 from tests.fixtures import ARM_URDF, arm
 
+# The arm's SMURF annotation files beside `smurf/arm.smurf` (Phobos's set: every category
+# the arm has elements of).
+SMURF_FILES = ("smurf/arm_collisions.yml", "smurf/arm_joints.yml", "smurf/arm_links.yml",
+               "smurf/arm_visuals.yml")
 IDENTITY = {"GIT_AUTHOR_NAME": "Test Author", "GIT_AUTHOR_EMAIL": "author@example.org",
             "GIT_COMMITTER_NAME": "Test Committer", "GIT_COMMITTER_EMAIL": "committer@example.org"}
 

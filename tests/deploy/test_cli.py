@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from tests.compiler.test_cli import mpc
-from tests.deploy.conftest import Model, Server, definition_text, git
+from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git
 
 PIPELINE = """\
 pipeline:
@@ -38,8 +38,8 @@ def test_dry_run_then_deploy_with_a_pipeline(model: Model, server: Server, tmp_p
     lines = dry.stdout.splitlines()
     assert lines[0] == f"dry run: would push to branch 'master' of '{url}':"
     assert [line.split("|")[0].strip() for line in lines[1:-1]] == [
-        "README.md", "meshes/stl/tetra.stl", "old.txt", "smurf/arm.smurf", "urdf/arm.urdf"]
-    assert lines[-1].strip() == "5 files changed, 60 insertions(+), 1 deletion(-)"
+        "README.md", "meshes/stl/tetra.stl", "old.txt", "smurf/arm.smurf", *SMURF_FILES, "urdf/arm.urdf"]
+    assert lines[-1].strip() == "9 files changed, 92 insertions(+), 1 deletion(-)"
     assert server.log() == ["by hand"] and (tmp_path / ".mpc-deploy" / "arm-model" / ".git").is_dir()
 
     run = mpc("deploy", model.definition, "--built", model.built, "--pipeline", pipeline)
@@ -48,7 +48,7 @@ def test_dry_run_then_deploy_with_a_pipeline(model: Model, server: Server, tmp_p
     assert run.stdout == (f"deployed 'arm-model' to branch 'master' of '{url}': commit {head[:12]}\n"
                           "  merge request into 'develop'\n")
     assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "notes/todo.md", "smurf/arm.smurf",
-                                       "urdf/arm.urdf"]
+                                       *SMURF_FILES, "urdf/arm.urdf"]
     options = server.pushes()[-1]["options"]
     assert options[1:3] == ["merge_request.target=develop", "merge_request.title=Default title"]
     assert options[-1] == "merge_request.assign=carol"

@@ -12,7 +12,7 @@ from mpc.compiler.diagnostics import Sink
 from mpc.compiler.version import mpc_version
 from mpc.deploy import deploy_model
 from tests.conftest import Diags
-from tests.deploy.conftest import Model, Server, git, heavier
+from tests.deploy.conftest import SMURF_FILES, Model, Server, git, heavier
 from tests.fixtures import ARM_URDF
 
 PROTOCOL = "## Test protocol\n\n| test | result |\n|---|---|\n| total_mass | passed |\n\n3 passed, 0 failed\n"
@@ -27,7 +27,7 @@ def test_first_deploy_pushes_the_build_with_its_provenance(model: Model, server:
     assert sink.diagnostics == [] and result.ok and result.pushed
     assert (result.branch, server.branches()) == ("master", {"master": result.commit})
     assert sorted(server.files()) == [".gitignore", "README.md", "meshes/stl/tetra.stl",
-                                    "smurf/arm.smurf", "urdf/arm.urdf"]
+                                    "smurf/arm.smurf", *SMURF_FILES, "urdf/arm.urdf"]
     assert server.show("master", "urdf/arm.urdf") == (model.built / "urdf/arm.urdf").read_text().rstrip("\n")
     assert "# arm-model" in server.show("master", "README.md")
     definitions = git(model.folder, "rev-parse", "HEAD")
@@ -80,7 +80,7 @@ def test_keep_files_survive_and_everything_else_is_replaced(model: Model, server
     server.commit_files({"submechanisms/knee.lua": "-- by hand\n", "old/stale.urdf": "<robot/>\n",
                          ".gitattributes": "*.bin binary\n"}, "hand-written files")
     deploy_model(model.compile(), model.built, model.settings(remote=server.url, forge="none"), Sink())
-    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf",
+    assert sorted(server.files()) == ["README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf", *SMURF_FILES,
                                       "submechanisms/knee.lua", "urdf/arm.urdf"]
     assert server.show("master", "submechanisms/knee.lua") == "-- by hand"
     assert server.log() == ["[mpc] Update arm-model", "hand-written files"]
@@ -162,9 +162,9 @@ def test_dry_run_reports_the_diff_stat_and_pushes_nothing(model: Model, server: 
     assert result.ok and not result.pushed and result.commit is None
     assert server.branches() == {} and server.pushes() == []
     lines = result.diffstat.splitlines()
-    assert [line.split("|")[0].strip() for line in lines[:-1]] == ["README.md", "meshes/stl/tetra.stl",
-                                                                    "smurf/arm.smurf", "urdf/arm.urdf"]
-    assert lines[-1].strip().startswith("4 files changed")
+    assert [line.split("|")[0].strip() for line in lines[:-1]] == [
+        "README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf", *SMURF_FILES, "urdf/arm.urdf"]
+    assert lines[-1].strip().startswith("8 files changed")
 
 
 def test_do_not_deploy(model: Model, server: Server) -> None:

@@ -44,7 +44,7 @@ def test_compile_test_deploy_in_one_run(model: Model, server: Server, tmp_path: 
     code, stages = _run(pipeline)
     head = git(server.path, "rev-parse", "master")
     assert code == 0
-    assert stages == {"compile": ("ok", "2 files, 1 mesh"), "test": ("ok", "3 passed, 0 failed, 1 skipped"),
+    assert stages == {"compile": ("ok", "6 files, 1 mesh"), "test": ("ok", "3 passed, 0 failed, 1 skipped"),
                       "deploy": ("ok", f"pushed {head[:10]} to master")}
     options = server.pushes()[-1]["options"]
     assert "merge_request.target=develop" in options

@@ -7,7 +7,7 @@ from pathlib import Path
 from mpc.compiler.diagnostics import Sink
 from mpc.deploy import deploy_model
 from tests.conftest import Diags
-from tests.deploy.conftest import Model, Server, definition_text, git, heavier, make_server
+from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git, heavier, make_server
 
 
 def _plain(model: Model, server: Server) -> object:
@@ -92,7 +92,7 @@ def test_mirror_gets_a_copy_with_submodule_files(model: Model, server: Server, t
     result = deploy_model(model.compile(), model.built, model.settings(remote=server.url), Sink())
     assert result.ok and result.mirror is not None and result.mirror.pushed
     assert sorted(mirror.files("develop")) == ["README.md", "lua/knee.lua", "meshes/stl/tetra.stl",
-                                               "smurf/arm.smurf", "urdf/arm.urdf"]
+                                               "smurf/arm.smurf", *SMURF_FILES, "urdf/arm.urdf"]
     assert mirror.log("develop") == ["[mpc] Update arm-model", "start"]
     options = mirror.pushes()[-1]["options"]
     assert options[:3] == ["merge_request.create", "merge_request.target=master",

@@ -17,7 +17,7 @@ from mpc.compiler.diagnostics import Sink
 from mpc.deploy import DeploySettings, deploy_model
 from tests.compiler.test_cli import mpc
 from tests.conftest import Diags
-from tests.deploy.conftest import Model, Server, definition_text, git, heavier, make_server
+from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git, heavier, make_server
 
 
 def _plain(model: Model, server: Server) -> DeploySettings:
@@ -71,7 +71,7 @@ def test_git_metadata_in_the_build_is_left_out(model: Model, server: Server, dia
             "repository")
     tree = git(server.path, "ls-tree", "-r", "master").splitlines()
     assert sorted(line.split("\t")[1] for line in tree) == [
-        "README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf", "urdf/arm.urdf"]
+        "README.md", "meshes/stl/tetra.stl", "smurf/arm.smurf", *SMURF_FILES, "urdf/arm.urdf"]
     assert {line.split()[0] for line in tree} == {"100644"}  # no gitlink
 
 

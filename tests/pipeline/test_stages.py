@@ -80,7 +80,7 @@ def test_a_stage_gets_the_program_and_files_and_is_skipped_after_a_failed_compil
     build = pipeline.parent / "build"
     assert seen == {"model": "good", "program": "good", "built": str(build / ".mpc/staging/good/out"),
                     "out": str(build / "good"), "files": ["urdf/good.urdf"], "compile": "ok",
-                    "compile_summary": "2 files, 0 meshes",
+                    "compile_summary": "6 files, 0 meshes",
                     "mr_mention": None, "root": str(pipeline.parent)}
     assert status.exit_status() == 1
 
@@ -95,7 +95,7 @@ def test_unchanged_stages_are_cached_and_a_changed_setting_reruns_the_later_stag
     assert {s: r.state for s, r in third.models["good"].stages.items()} == {"compile": "cached", "test": "ok"}
     seen = _seen(pipeline, "good")
     assert (seen["built"], seen["compile"], seen["compile_summary"], seen["mr_mention"]) == (
-        str(pipeline.parent / "build/good"), "cached", "2 files, 0 meshes", "@robots")
+        str(pipeline.parent / "build/good"), "cached", "6 files, 0 meshes", "@robots")
 
 
 def test_a_model_added_to_the_pipeline_does_not_rerun_the_others_stages(pipeline: Path) -> None:
