@@ -85,16 +85,19 @@ class Store:
         return self._read_state(model)[1]
 
     def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
+        from mpc.compiler import source
+        from mpc.compiler.diagnostics import Sink
+
         path = self.state_file(model)
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
+        if not path.exists() and not path.is_symlink():
             return {}, None
-        except OSError as e:
-            return {}, describe(e)
-        except ValueError as e:
-            return {}, f"not JSON: {e}"
-        return (data, None) if well_formed(data) else ({}, "not a state mpc writes")
+        # JSON is YAML: the bounded loader refuses deep nesting, huge numbers and the like
+        sink = Sink()
+        doc = source.load(path, sink)
+        if doc is None:
+            first = sink.diagnostics[0]
+            return {}, f"{first.message} (line {first.span.line})"
+        return (doc.data, None) if well_formed(doc.data) else ({}, "not a state mpc writes")
 
     def save_state(self, model: str, state: dict[str, Any]) -> None:
         write_json(self.state_file(model), state)
