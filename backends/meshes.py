@@ -233,10 +233,7 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
         data: bytes | str = bobj.dumps(mesh)
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
-    partial.write_bytes(data if isinstance(data, bytes) else data.encode())
-    os.replace(partial, dest)
+    store_entry(dest, data if isinstance(data, bytes) else data.encode())
     return None
 
 

@@ -135,5 +135,7 @@ def parse_floats(text: str | None) -> list[float] | None:
 
 
 def write_path(path: Path, data: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(data, encoding="utf-8")
+    """Write a text output file (compiler/files.py: all or nothing)."""
+    from mpc.compiler.files import write_atomic
+
+    write_atomic(path, data)

@@ -35,6 +35,10 @@ class InputLoader:
     _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
     _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        for definition in self.stack:  # inputs may link to files beside their definitions
+            self.options.resolver.add_root(definition.parent)
+
     def _key(self, inp: Input) -> tuple[str, str]:
         return (inp.kind, str(inp.path) if inp.path else repr(inp.repo))
 
@@ -59,19 +63,22 @@ class InputLoader:
         if inp.kind == "basefile":
             if inp.path is None:  # its package was not found; reported when lowering
                 return None
-            return self._read(inp.path)
+            return self._read(inp.path, inp)
         if inp.kind == "derived_base":
             assert inp.path is not None
             if self._cycle(inp):
                 return None
             return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
         path = self._repo_file(inp, fetch=True)
-        return None if path is None else self._read(path)
+        return None if path is None else self._read(path, inp)
 
-    def _read(self, path: Path) -> Robot | None:
+    def _read(self, path: Path, inp: Input) -> Robot | None:
         """A model file, by its extension: URDF, SDF or SMURF."""
         from mpc.backends import BACKENDS
 
+        if why := self.options.resolver.refusal(path):
+            self.sink.error(inp.span, "E0650", f"input model '{path}' is not read: {why}")
+            return None
         suffix = path.suffix.lower()
         reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
         return reader.read(path, self.sink, self.options.resolver)
@@ -83,6 +90,7 @@ class InputLoader:
         tree = checkout(inp.repo, self.sink, inp.span, fetch=fetch)
         if tree is None:
             return None
+        self.options.resolver.add_root(tree)
         path = tree / inp.repo.model_in_repo
         if not path.is_file():
             self.sink.error(inp.span, "E0601", f"'{inp.repo.model_in_repo}' is not in repository "

@@ -14,14 +14,13 @@ state on with its output.
 
 from __future__ import annotations
 
-import errno
 import fcntl
 import json
-import os
 import shutil
-import tempfile
 from pathlib import Path
 from typing import IO, Any
+
+from mpc.compiler.files import describe, write_atomic
 
 
 class BuildFolderBusy(Exception):
@@ -111,42 +110,9 @@ class Store:
         return path
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def describe(error: OSError) -> str:
-    """An OSError as a user reads it: "Not a directory: '/x/build/.mpc'"."""
-    where = f": '{error.filename}'" if error.filename else ""
-    return f"{error.strerror or error}{where}"
-
-
 def write_json(path: Path, data: Any) -> None:
     """Write `data` as JSON to `path` atomically."""
-    write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
-
-
-def write_text(path: Path, text: str) -> None:
-    """Write `text` to `path` atomically: a reader, or a write that fails half-way, never
-    sees a partial file, and the previous one stays until the new one is complete."""
-    # Named as the user named them, not as mkdir and the temporary file would.
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
-    blocking = next((p for p in path.parents if p.exists()), None)
-    if blocking is not None and not blocking.is_dir():
-        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(blocking))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes it private; state travels as CI artifacts
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def well_formed(state: Any) -> bool:
