@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "1"  # changes when the way meshes are computed changes, so old cache entries go unused
+ENGINE = "2"  # changes when the way meshes are computed changes, so old cache entries go unused
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
@@ -162,9 +162,19 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     when several are missing; a later build with the same inputs only copies them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
+    from mpc.compiler.cache import load_entry, remove_entry
+    from mpc.compiler.files import describe
+
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
+    entries: dict[Path, bytes] = {}
     plan_: list[tuple[Path, Path, str]] = []
+    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
+
+    def span_of(src: Path, ops: tuple[MeshOp, ...]) -> Span:
+        use = users.get((src, ops))
+        return use.mesh.span if use and use.mesh.span else export_span
+
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
         dest = out / rel
         if dest.exists():
@@ -173,23 +183,45 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 and not dest.name.endswith(".mars.obj"):
             plan_.append((src, dest, rel))
             continue
-        cached = _cached_path(src, ops, dest.suffix)
-        if not cached.is_file():
+        try:
+            cached = _cached_path(src, ops, dest.suffix)
+            data, bad = load_entry(cached)
+            if bad is not None:
+                sink.warning(span_of(src, ops), "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
+                             f"is unusable ({bad}); it is removed and computed again")
+                remove_entry(cached)
+        except OSError as e:
+            sink.error(span_of(src, ops), "E0652", f"mesh '{rel}': {describe(e, 'use the mesh cache')}")
+            ok = False
+            continue
+        if data is None:
             todo[cached] = (src, ops, cached)
+        else:
+            entries[cached] = data
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
-    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None and problems else {}
     for source, dest, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
             use = users.get((src, ops))
             where = f" of a {use.element} of link '{use.link}'" if use else ""
-            sink.error(use.mesh.span if use and use.mesh.span else export_span, "E0603",
-                       f"cannot compute mesh '{rel}'{where} from '{src}': {problems[source]}")
+            code, problem = problems[source]
+            sink.error(span_of(src, ops), code, f"cannot compute mesh '{rel}'{where} from '{src}': {problem}")
             ok = False
             continue
+        if source in todo:
+            data, bad = load_entry(source)
+            if data is None:  # written a moment ago: only a cache changed under us gets here
+                sink.error(span_of(*todo[source][:2]), "E0652", f"mesh '{rel}': the cache entry "
+                           f"'{source}' cannot be read back ({bad or 'it is gone'})")
+                ok = False
+                continue
+            entries[source] = data
         dest.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(source, dest)
+        if source in entries:
+            dest.write_bytes(entries[source])
+        else:
+            shutil.copyfile(source, dest)  # a regular file, checked when the model was read
     return ok
 
 
@@ -202,8 +234,9 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 
-def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, str]:
-    """Materialise each job into its cache path; {cache path: problem} for those that failed."""
+def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
+    """Materialise each job into its cache path; {cache path: (code, problem)} for those
+    that failed."""
     if len(jobs) < 4:
         results = [_materialise(*job) for job in jobs]
     else:
@@ -216,24 +249,30 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, st
     return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
 
 
-def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
-    """Apply `ops` to the mesh in `src` and write it to `dest` atomically; why not, or None."""
+def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
+    """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
+    or None."""
+    from mpc.compiler.cache import store_entry
+    from mpc.compiler.files import describe
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
     try:
         mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
     except MeshError as e:
-        return str(e)
+        return "E0603", str(e)
     if len(mesh.faces) == 0:  # e.g. pycollada failed on a texture and trimesh gave an empty scene
-        return "it has no triangles after reading"
+        return "E0603", "it has no triangles after reading"
     if dest.suffix == ".bobj":
         from mpc.backends import bobj
 
         data: bytes | str = bobj.dumps(mesh)
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
-    store_entry(dest, data if isinstance(data, bytes) else data.encode())
+    try:
+        store_entry(dest, data if isinstance(data, bytes) else data.encode())
+    except OSError as e:
+        return "E0652", describe(e, "write the mesh cache entry")
     return None
 
 
