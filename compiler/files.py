@@ -92,7 +92,7 @@ def input_problem(path: Path, roots: Iterable[Path]) -> str | None:
         return describe(e, "read")
     if not stat.S_ISREG(mode):
         return "it is not a regular file (a device, FIFO, socket or folder)"
-    if real != path.absolute():
+    if real != Path(os.path.normpath(path.absolute())):  # a link on the way
         roots = tuple(roots)
         if not any(r == real or r in real.parents for r in roots):
             return f"it is a link to '{real}', outside the model's package roots"
