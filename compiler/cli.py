@@ -258,6 +258,11 @@ def main(argv: list[str] | None = None) -> int:
                 "deploy": _deploy, "run": _pipeline, "ci": _pipeline}[args.command](args)
     except KeyboardInterrupt:
         return 130
+    except OSError as e:  # the disk, not mpc: what no phase reported with its own code
+        from mpc.compiler.files import describe
+
+        print(f"error[E0669]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)
+        return 1
     except Exception as e:  # a bug in mpc, not a user mistake
         if os.environ.get("MPC_DEBUG"):
             raise
