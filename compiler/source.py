@@ -187,7 +187,8 @@ class _Builder:
             return None
         self.nodes += 1
         if self.nodes > self.limits.nodes:  # aliases expand to copies: billion laughs stop here
-            where = self.doc.span(path[:1]) if path else _span(self.doc.file, node)
+            keyed = next((path[:n] for n in range(len(path), 0, -1) if path[:n] in self.doc.keys), None)
+            where = self.doc.keys[keyed] if keyed else _span(self.doc.file, node)
             self.sink.error(where, "E0109", f"the aliases expand to more than {self.limits.nodes} "
                             "values")
             self.unusable = True
