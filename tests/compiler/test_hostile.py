@@ -285,5 +285,6 @@ def test_git_runs_never_prompt_and_scrub_credentials(tmp_path: Path, capsys: pyt
         'repo: {git: "http://user:s3cret-pw@127.0.0.1:9/arm.git", model_in_repo: arm.urdf}'))
     code, err = _mpc(capsys, "compile", spec, "-o", tmp_path / "out")
     assert code == 1
-    assert f"{spec}:6:13: error[E0604]: cannot get 'HEAD' of repository 'http://***@127.0.0.1:9/arm.git'" in err
+    assert (f"{spec}:6:13: error[E0604]: cannot get 'HEAD' of repository "
+            "'http://***@127.0.0.1:9/arm.git'") in err
     assert "s3cret" not in err.splitlines()[0]  # the message; the source line below is the user's
