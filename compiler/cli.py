@@ -259,6 +259,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 130
     except OSError as e:  # the disk, not mpc: what no phase reported with its own code
+        if os.environ.get("MPC_DEBUG"):
+            raise
         from mpc.compiler.files import describe
 
         print(f"error[E0669]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)
