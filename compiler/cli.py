@@ -190,8 +190,9 @@ def _schema(args: argparse.Namespace) -> int:
     if str(args.out) == "-":
         sys.stdout.write(text)
     else:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(text, encoding="utf-8")
+        from mpc.compiler.files import write_atomic
+
+        write_atomic(args.out, text)
         print(f"wrote {args.out}")
     return 0
 
