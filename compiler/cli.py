@@ -264,7 +264,8 @@ def main(argv: list[str] | None = None) -> int:
             raise
         from mpc.compiler.files import describe
 
-        print(f"error[E0669]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)
+        code = "E0669"
+        print(f"error[{code}]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)
         return 1
     except Exception as e:  # a bug in mpc, not a user mistake
         if os.environ.get("MPC_DEBUG"):
