@@ -68,10 +68,6 @@ def mesh_uses(robot: Robot) -> Iterator[MeshUse]:
                     yield MeshUse(name, kind, item.geometry)
 
 
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()[:10]
-
-
 # Extensions of the formats the language names; `mars_obj` is OBJ content (Phobos's intended
 # axis change was never written), `bobj` is MARS's binary OBJ (backends/bobj.py).
 EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply", "bobj": "bobj"}
@@ -171,9 +167,10 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     plan_: list[tuple[Path, Path, str]] = []
     users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
 
-    def span_of(src: Path, ops: tuple[MeshOp, ...]) -> Span:
+    def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
         use = users.get((src, ops))
-        return use.mesh.span if use and use.mesh.span else export_span
+        return ((use.mesh.span or export_span) if use else export_span,
+                f" of a {use.element} of link '{use.link}'" if use else "")
 
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
         dest = out / rel
@@ -187,11 +184,12 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             cached = _cached_path(src, ops, dest.suffix)
             data, bad = load_entry(cached)
             if bad is not None:
-                sink.warning(span_of(src, ops), "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
+                sink.warning(where(src, ops)[0], "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
                              f"is unusable ({bad}); it is removed and computed again")
                 remove_entry(cached)
+                _ignored_path(cached).unlink(missing_ok=True)
         except OSError as e:
-            sink.error(span_of(src, ops), "E0652", f"mesh '{rel}': {describe(e, 'use the mesh cache')}")
+            sink.error(where(src, ops)[0], "E0652", f"mesh '{rel}': {describe(e, 'use the mesh cache')}")
             ok = False
             continue
         if data is None:
@@ -203,20 +201,26 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     for source, dest, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
-            use = users.get((src, ops))
-            where = f" of a {use.element} of link '{use.link}'" if use else ""
+            span, of = where(src, ops)
             code, problem = problems[source]
-            sink.error(span_of(src, ops), code, f"cannot compute mesh '{rel}'{where} from '{src}': {problem}")
+            sink.error(span, code, f"cannot compute mesh '{rel}'{of} from '{src}': {problem}")
             ok = False
             continue
         if source in todo:
             data, bad = load_entry(source)
             if data is None:  # written a moment ago: only a cache changed under us gets here
-                sink.error(span_of(*todo[source][:2]), "E0652", f"mesh '{rel}': the cache entry "
+                sink.error(where(*todo[source][:2])[0], "E0652", f"mesh '{rel}': the cache entry "
                            f"'{source}' cannot be read back ({bad or 'it is gone'})")
                 ok = False
                 continue
             entries[source] = data
+        ignored = _ignored_path(source)
+        if ignored.is_file():  # the cache entry records what its computation ignored
+            src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
+            span, of = where(src, ops)
+            sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
+                         f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
+                         hint="the geometry is complete; only materials or textures are missing")
         dest.parent.mkdir(parents=True, exist_ok=True)
         if source in entries:
             dest.write_bytes(entries[source])
@@ -253,15 +257,17 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, s
     """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
     or None."""
     from mpc.compiler.cache import store_entry
-    from mpc.compiler.files import describe
+    from mpc.compiler.files import describe, write_atomic
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
+    ignored: list[str] = []
     try:
-        mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
+        mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False,
+                          ignored=ignored)
     except MeshError as e:
         return "E0603", str(e)
-    if len(mesh.faces) == 0:  # e.g. pycollada failed on a texture and trimesh gave an empty scene
+    if len(mesh.faces) == 0:
         return "E0603", "it has no triangles after reading"
     if dest.suffix == ".bobj":
         from mpc.backends import bobj
@@ -270,10 +276,17 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, s
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     try:
+        if ignored:  # written before the entry, so that an entry never lacks its record
+            write_atomic(_ignored_path(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
         store_entry(dest, data if isinstance(data, bytes) else data.encode())
     except OSError as e:
         return "E0652", describe(e, "write the mesh cache entry")
     return None
+
+
+def _ignored_path(entry: Path) -> Path:
+    """Where a cache entry records the broken references its computation ignored (W0605)."""
+    return entry.with_name(entry.name + ".ignored")
 
 
 def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,

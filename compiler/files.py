@@ -66,13 +66,10 @@ def confined(root: Path, *names: str) -> Path:
     return path
 
 
-def package_roots(extra: Iterable[Path] = ()) -> tuple[Path, ...]:
-    """Folders whose files inputs may link to: `extra` (the definition's folder, --package
-    roots, a checkout) and the folders of ROS_PACKAGE_PATH and AMENT_PREFIX_PATH."""
-    roots = list(extra)
-    for variable in ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH"):
-        roots += [Path(p) for p in os.environ.get(variable, "").split(os.pathsep) if p]
-    return tuple(dict.fromkeys(r.resolve() for r in roots))
+def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
+    """The folders whose files inputs may link to, resolved (the definitions' folders,
+    --package roots, the package search path, a checkout: backends/packages.py names them)."""
+    return tuple(dict.fromkeys(Path(f).resolve() for f in folders))
 
 
 def input_problem(path: Path, roots: Iterable[Path]) -> str | None:
