@@ -40,11 +40,11 @@ class Span:
         return cls(file, 1, 1)
 
 
-def hardened_parser() -> Any:
+def hardened_parser(huge: bool = False) -> Any:
     """The one lxml parser of mpc (here, on the ground floor, for readers and IR alike): no
-    DTD, no entity expansion, no network, no huge trees. A new parser per call: lxml
-    parsers must not be shared between threads."""
+    DTD, no entity expansion, no network; huge trees only when asked (meshes: DAE files
+    hold long arrays). A new parser per call: lxml parsers must not be shared between threads."""
     from lxml import etree
 
-    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=huge,
                            remove_blank_text=False)
