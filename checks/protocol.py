@@ -170,6 +170,7 @@ class Protocol:
         """Write test_protocol.md, test_protocol.json and test_protocol.junit.xml into `folder`."""
         from mpc.compiler.files import write_atomic
 
+        folder.mkdir(parents=True, exist_ok=True)  # its error names the folder as the user gave it
         write_atomic(folder / "test_protocol.md", self.markdown())
         write_atomic(folder / "test_protocol.json", json.dumps(self.to_json(), indent=2) + "\n")
         write_atomic(folder / "test_protocol.junit.xml", self.junit())

@@ -19,8 +19,9 @@ def cache_dir(kind: str) -> Path:
 
 # -- verified entries --------------------------------------------------------------------------
 # An entry is its file plus `<file>.sha256`, the hash of its bytes, written after it: an entry
-# without its hash is unfinished (a killed write), and one whose bytes do not match it was
-# damaged (a full disk, an edit, a flipped bit) and is never returned.
+# without its hash is unfinished (a killed write) and counts as none (it is written again),
+# and one whose bytes do not match it was damaged (a full disk, an edit, a flipped bit) and
+# is never returned.
 
 def _hash_file(entry: Path) -> Path:
     return entry.with_name(entry.name + ".sha256")
@@ -44,8 +45,8 @@ def load_entry(entry: Path) -> tuple[bytes | None, str | None]:
             return None, "it is not a regular file"
         data = entry.read_bytes()
         expected = _hash_file(entry).read_text(encoding="ascii").strip()
-    except FileNotFoundError:
-        return None, "its hash is missing (an unfinished write)"
+    except FileNotFoundError:  # an unfinished write (or an older mpc's): no entry yet
+        return None, None
     except (OSError, UnicodeDecodeError) as e:
         return None, f"it cannot be read ({e})"
     if hashlib.sha256(data).hexdigest() != expected:
