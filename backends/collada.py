@@ -15,6 +15,8 @@ from pathlib import Path
 
 import trimesh
 
+from mpc.ir.span import hardened_parser
+
 
 def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:
     """The triangles of a DAE file, scaled to metres by its `<unit>`, and the broken references
@@ -38,7 +40,7 @@ def _without_material_bindings(data: bytes) -> bytes:
     of nodes whose materials cannot be resolved (materials only colour a mesh)."""
     from lxml import etree
 
-    root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=True))
+    root = etree.fromstring(data, hardened_parser(huge=True))
     for binding in list(root.iter("{*}bind_material")):
         binding.getparent().remove(binding)
     return etree.tostring(root)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.files import confined
 from mpc.ir.program import JointLimitsExport
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first
@@ -72,4 +73,4 @@ def to_yaml(robot: Robot, names: list[str]) -> str:
 def emit(robot: Robot, export: JointLimitsExport, out: Path, sink: Sink) -> None:
     """Write `<file_name>` in the export's root folder."""
     names = select(robot, export, sink)
-    write_path(out / export.file_name, to_yaml(robot, names))
+    write_path(confined(out, export.file_name), to_yaml(robot, names))

@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "3"  # changes when the way meshes are computed changes, so old cache entries go unused
+ENGINE = "4"  # changes when the way meshes are computed changes, so old cache entries go unused
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
@@ -158,9 +158,20 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     when several are missing; a later build with the same inputs only copies them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
+    from mpc.compiler.cache import load_entry, remove_entry
+    from mpc.compiler.files import describe
+
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
+    entries: dict[Path, bytes] = {}
     plan_: list[tuple[Path, Path, str]] = []
+    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
+
+    def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
+        use = users.get((src, ops))
+        return ((use.mesh.span or export_span) if use else export_span,
+                f" of a {use.element} of link '{use.link}'" if use else "")
+
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
         dest = out / rel
         if dest.exists():
@@ -169,25 +180,40 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 and not dest.name.endswith(".mars.obj"):
             plan_.append((src, dest, rel))
             continue
-        cached = _cached_path(src, ops, dest.suffix)
-        if not cached.is_file():
+        try:
+            cached = _cached_path(src, ops, dest.suffix)
+            data, bad = load_entry(cached)
+            if bad is not None:
+                sink.warning(where(src, ops)[0], "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
+                             f"is unusable ({bad}); it is removed and computed again")
+                remove_entry(cached)
+                _ignored_path(cached).unlink(missing_ok=True)
+        except OSError as e:
+            sink.error(where(src, ops)[0], "E0652", f"mesh '{rel}': {describe(e, 'use the mesh cache')}")
+            ok = False
+            continue
+        if data is None:
             todo[cached] = (src, ops, cached)
+        else:
+            entries[cached] = data
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
-    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
-
-    def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
-        use = users.get((src, ops))
-        return ((use.mesh.span or export_span) if use else export_span,
-                f" of a {use.element} of link '{use.link}'" if use else "")
-
     for source, dest, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
             span, of = where(src, ops)
-            sink.error(span, "E0603", f"cannot compute mesh '{rel}'{of} from '{src}': {problems[source]}")
+            code, problem = problems[source]
+            sink.error(span, code, f"cannot compute mesh '{rel}'{of} from '{src}': {problem}")
             ok = False
             continue
+        if source in todo:
+            data, bad = load_entry(source)
+            if data is None:  # written a moment ago: only a cache changed under us gets here
+                sink.error(where(*todo[source][:2])[0], "E0652", f"mesh '{rel}': the cache entry "
+                           f"'{source}' cannot be read back ({bad or 'it is gone'})")
+                ok = False
+                continue
+            entries[source] = data
         ignored = _ignored_path(source)
         if ignored.is_file():  # the cache entry records what its computation ignored
             src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
@@ -196,7 +222,10 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
         dest.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(source, dest)
+        if source in entries:
+            dest.write_bytes(entries[source])
+        else:
+            shutil.copyfile(source, dest)  # a regular file, checked when the model was read
     return ok
 
 
@@ -209,8 +238,9 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 
-def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, str]:
-    """Materialise each job into its cache path; {cache path: problem} for those that failed."""
+def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
+    """Materialise each job into its cache path; {cache path: (code, problem)} for those
+    that failed."""
     if len(jobs) < 4:
         results = [_materialise(*job) for job in jobs]
     else:
@@ -223,8 +253,11 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, st
     return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
 
 
-def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
-    """Apply `ops` to the mesh in `src` and write it to `dest` atomically; why not, or None."""
+def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
+    """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
+    or None."""
+    from mpc.compiler.cache import store_entry
+    from mpc.compiler.files import describe, write_atomic
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
@@ -233,31 +266,27 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
         mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False,
                           ignored=ignored)
     except MeshError as e:
-        return str(e)
+        return "E0603", str(e)
     if len(mesh.faces) == 0:
-        return "it has no triangles after reading"
+        return "E0603", "it has no triangles after reading"
     if dest.suffix == ".bobj":
         from mpc.backends import bobj
 
         data: bytes | str = bobj.dumps(mesh)
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    if ignored:  # written before the entry, so that an entry never lacks its record
-        _write_atomically(_ignored_path(dest), "".join(f"{line}\n" for line in sorted(set(ignored))).encode())
-    _write_atomically(dest, data if isinstance(data, bytes) else data.encode())
+    try:
+        if ignored:  # written before the entry, so that an entry never lacks its record
+            write_atomic(_ignored_path(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
+        store_entry(dest, data if isinstance(data, bytes) else data.encode())
+    except OSError as e:
+        return "E0652", describe(e, "write the mesh cache entry")
     return None
 
 
 def _ignored_path(entry: Path) -> Path:
     """Where a cache entry records the broken references its computation ignored (W0605)."""
     return entry.with_name(entry.name + ".ignored")
-
-
-def _write_atomically(dest: Path, data: bytes) -> None:
-    partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
-    partial.write_bytes(data)
-    os.replace(partial, dest)
 
 
 def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,

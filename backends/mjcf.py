@@ -44,6 +44,7 @@ from mpc.backends import meshes
 from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.files import confined
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
@@ -491,4 +492,4 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
     robot, files = prepared
     formats = Formats(export.float_formats, MJCF_KEYS) if export.float_formats else None
     text = to_string(robot, meshes.namer(files, "../"), formats=formats, enforce_zero=export.enforce_zero)
-    write_path(out / "mjcf" / f"{export.filename or robot.name}.xml", text)
+    write_path(confined(out, "mjcf", f"{export.filename or robot.name}.xml"), text)

@@ -42,6 +42,9 @@ class PackageResolver:
 
     package_map: dict[str, Path] = field(default_factory=dict)
     search_path: list[Path] | None = None
+    # Folders, besides the packages, whose files inputs may link to: the definitions' own
+    # folders and the checkouts of `repo` inputs (compiler/inputs.py adds them).
+    roots: list[Path] = field(default_factory=list)
     _cache: dict[str, Path | None] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -71,6 +74,23 @@ class PackageResolver:
             if (root / package).is_dir():
                 return root / package
         return None
+
+    def add_root(self, folder: Path) -> None:
+        if folder not in self.roots:
+            self.roots.append(folder)
+
+    def refusal(self, path: Path, base_dir: Path | None = None) -> str | None:
+        """Why the input file `path` (a mesh, a model) must not be read, or None: a link out
+        of the package roots (and `base_dir`, the folder of the file naming it), a special
+        file (compiler/files.py: input_problem). A missing file is no refusal: whoever reads
+        it reports that."""
+        from mpc.compiler.files import input_problem, package_roots
+
+        if not path.exists():
+            return None
+        assert self.search_path is not None
+        extra = [*self.package_map.values(), *self.search_path, *self.roots]
+        return input_problem(path, package_roots([*extra, *([base_dir] if base_dir else [])]))
 
     def resolve(self, uri: str, base_dir: Path) -> MeshSource:
         """A mesh filename as written in a model file in `base_dir` → its MeshSource."""

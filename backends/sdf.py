@@ -21,6 +21,7 @@ from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.files import confined
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import links_in_root, matrix_pose
@@ -382,5 +383,5 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     for suffix, prefix in variants(export):
         text = to_string(robot, meshes.namer(files, prefix), export.version,
                          cut_joints=export.include_cut_joints, formats=formats)
-        write_path(out / "sdf" / f"{export.filename or robot.name}{suffix}.sdf", text)
+        write_path(confined(out, "sdf", f"{export.filename or robot.name}{suffix}.sdf"), text)
     write_path(out / "sdf" / "model.config", model_config(robot, export.version))

@@ -490,6 +490,9 @@ class _Reader:
             # model://NAME/… is found as package://NAME/… is (Gazebo searches its model path).
             found = self.resolver.resolve("package://" + uri[8:] if uri.startswith("model://") else uri,
                                           self.base_dir)
+            if found.path is not None and (why := self.resolver.refusal(found.path, self.base_dir)):
+                self.error(uri_el, "E0650", f"mesh '{uri}' in {where} is not read: {why}")
+                return None
             return Mesh(source=replace(found, uri=uri), scale=self.floats(s.find("scale"), 3, where),  # type: ignore[arg-type]
                         span=self.src.span(uri_el))
         v = {t: self.floats(s.find(t), 3 if t == "size" else 1, where) for t in _SHAPES[s.tag]}

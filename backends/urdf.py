@@ -14,6 +14,7 @@ from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.files import confined
 from mpc.ir.program import UrdfExport
 from mpc.ir.robot import Robot
 
@@ -46,5 +47,5 @@ def emit(robot: Robot, export: UrdfExport, out: Path, sink: Sink) -> None:
     robot, files = prepared
     formats = Formats(export.float_formats, URDF_KEYS) if export.float_formats else None
     for suffix, prefix in variants(export):
-        write_path(out / "urdf" / f"{export.filename or robot.name}{suffix}.urdf",
+        write_path(confined(out, "urdf", f"{export.filename or robot.name}{suffix}.urdf"),
                    to_string(robot, meshes.namer(files, prefix), formats))

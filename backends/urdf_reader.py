@@ -332,7 +332,11 @@ class _Reader:
                 self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
                 return None
             scale = self.floats(shape, "scale", 3, where)
-            return Mesh(source=self.resolver.resolve(uri, self.base_dir),
+            source = self.resolver.resolve(uri, self.base_dir)
+            if source.path is not None and (why := self.resolver.refusal(source.path, self.base_dir)):
+                self.error(shape, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
+                return None
+            return Mesh(source=source,
                         scale=scale, span=self.src.span(shape, "filename"),  # type: ignore[arg-type]
                         extra_attrs=self.extra_attrs(shape, ("filename", "scale")))
         self.error(shape, "E0405", f"unsupported geometry <{shape.tag}> in {where}; URDF has "

@@ -16,12 +16,8 @@ from pathlib import Path
 from lxml import etree
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.span import Span
+from mpc.ir.span import Span, hardened_parser
 
-_PARSER = etree.XMLParser(
-    resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
-    remove_blank_text=False,
-)
 # Start tags outside comments, CDATA, processing instructions and doctype, in document order.
 _TOKENS = re.compile(
     r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE[^>]*>|<([A-Za-z_][\w:.\-]*)", re.DOTALL
@@ -50,12 +46,17 @@ class XmlSource:
     def parse(cls, data: bytes, file: str) -> XmlSource:
         """Parse `data`; raises XmlError when it is not well-formed."""
         try:
-            root = etree.fromstring(data, _PARSER)
+            root = etree.fromstring(data, hardened_parser())
         except etree.XMLSyntaxError as e:
             line, col = e.position if e.position else (1, 1)
             # libxml2 appends ", line N, column M"; the span carries the position.
             message = re.sub(r", line \d+, column \d+$", "", str(e.msg).strip())
             raise XmlError(message, max(line, 1), max(col, 1)) from None
+        # Entities stay unexpanded (no DTD is read): one kept in a fragment would make the
+        # output not well-formed, so a file that uses any is refused here.
+        for entity in root.iter(etree.Entity):
+            raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
+                           "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
         src = cls(file, text, root)
         src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
@@ -135,5 +136,7 @@ def parse_floats(text: str | None) -> list[float] | None:
 
 
 def write_path(path: Path, data: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(data, encoding="utf-8")
+    """Write a text output file (compiler/files.py: all or nothing)."""
+    from mpc.compiler.files import write_atomic
+
+    write_atomic(path, data)

@@ -148,35 +148,27 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
 def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]:
     """Clone the repository into `workdir` and check out the branch or commit; the work
     tree, the commit checked out, and the reason when it failed."""
-    import git
+    from mpc.compiler.gitrun import GitFailed, git, scrub, without_credentials
 
-    key = hashlib.sha256(f"{target.git}\0{target.branch}\0{target.commit}".encode()).hexdigest()[:12]
+    key = hashlib.sha256(f"{without_credentials(target.git)}\0{target.branch}\0{target.commit}"
+                         .encode()).hexdigest()[:12]
     folder = workdir / f"compare_model-{key}"
     if folder.exists():
         shutil.rmtree(folder)
     workdir.mkdir(parents=True, exist_ok=True)
     try:
-        kwargs = {"branch": target.branch} if target.branch else {}
-        # never ask for credentials: a CI job has no terminal to answer
-        repo = git.Repo.clone_from(target.git, folder, env={"GIT_TERMINAL_PROMPT": "0"}, **kwargs)
+        branch = ["--branch", target.branch] if target.branch else []
+        git("clone", "--quiet", *branch, "--", target.git, str(folder))
         if target.commit:
-            repo.git.checkout(target.commit)
-        commit = repo.head.commit.hexsha
-    except (git.GitCommandError, ValueError) as e:
+            git("checkout", "--quiet", target.commit, cwd=folder)
+        commit = git("rev-parse", "HEAD", cwd=folder)
+    except (GitFailed, OSError) as e:
         shutil.rmtree(folder, ignore_errors=True)
         what = (f"commit '{target.commit}'" if target.commit else
                 f"branch '{target.branch}'" if target.branch else "the default branch")
-        return None, "", f"cannot get {what} of compare repository '{target.git}': {_git_error(e)}"
+        why = e.message if isinstance(e, GitFailed) else str(e.strerror or e)
+        return None, "", f"cannot get {what} of compare repository '{scrub(target.git)}': {why}"
     return folder, commit, ""
-
-
-def _git_error(e: Exception) -> str:
-    """git's own complaint (its last `fatal:` or `error:` line), without GitPython's framing."""
-    text = str(getattr(e, "stderr", "") or e)
-    lines = [ln.strip().removeprefix("stderr: ").strip("'").strip() for ln in text.splitlines()]
-    lines = [ln for ln in lines if ln]
-    said = [ln for ln in lines if ln.startswith(("fatal:", "error:"))]
-    return (said or lines or [type(e).__name__])[-1]
 
 
 def _first_error(sink: Sink) -> str:

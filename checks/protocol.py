@@ -168,11 +168,12 @@ class Protocol:
 
     def write(self, folder: Path) -> None:
         """Write test_protocol.md, test_protocol.json and test_protocol.junit.xml into `folder`."""
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / "test_protocol.md").write_text(self.markdown(), encoding="utf-8")
-        (folder / "test_protocol.json").write_text(json.dumps(self.to_json(), indent=2) + "\n",
-                                                   encoding="utf-8")
-        (folder / "test_protocol.junit.xml").write_text(self.junit(), encoding="utf-8")
+        from mpc.compiler.files import write_atomic
+
+        folder.mkdir(parents=True, exist_ok=True)  # its error names the folder as the user gave it
+        write_atomic(folder / "test_protocol.md", self.markdown())
+        write_atomic(folder / "test_protocol.json", json.dumps(self.to_json(), indent=2) + "\n")
+        write_atomic(folder / "test_protocol.junit.xml", self.junit())
 
 
 def first_of(problems: list[str]) -> str:

@@ -186,8 +186,9 @@ def _schema(args: argparse.Namespace) -> int:
     if args.out is None or str(args.out) == "-":
         sys.stdout.write(text)
     else:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(text, encoding="utf-8")
+        from mpc.compiler.files import write_atomic
+
+        write_atomic(args.out, text)
         print(f"wrote {args.out}")
     return 0
 
@@ -267,6 +268,14 @@ def main(argv: list[str] | None = None) -> int:
         return command(args)
     except KeyboardInterrupt:
         return 130
+    except OSError as e:  # the disk, not mpc: what no phase reported with its own code
+        if os.environ.get("MPC_DEBUG"):
+            raise
+        from mpc.compiler.files import describe
+
+        code = "E0669"
+        print(f"error[{code}]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)
+        return 1
     except Exception as e:  # a bug in mpc, not a user mistake
         if os.environ.get("MPC_DEBUG"):
             raise

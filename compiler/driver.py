@@ -8,6 +8,7 @@ previous outputs untouched.
 
 from __future__ import annotations
 
+import glob
 import os
 import shutil
 import tempfile
@@ -18,6 +19,7 @@ from pathlib import Path
 from mpc.backends.packages import PackageResolver
 from mpc.compiler import inherit, schema, source
 from mpc.compiler.diagnostics import Severity, Sink
+from mpc.compiler.files import OutsideOutput, confined, describe
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
@@ -91,11 +93,31 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
         sink.error(Span.of_file(str(path)), "E0601", f"cannot read '{path}': {e.strerror}")
         return None
     program = parse(text, str(path), sink)                              # parse the IR
-    if program is None:
+    if program is None or not check_output_names(program, sink):
         return None
     loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
+
+
+def check_output_names(program: Program, sink: Sink) -> bool:
+    """The names of an IR program that become file names, checked as the schema checks
+    them in YAML (E0250): IR text comes without a schema."""
+    from mpc.compiler.files import name_problem
+
+    named = [("robotname", program.robotname, program.span, False),
+             ("modelname", program.modelname, program.span, False)]
+    for export in program.exports:
+        for field_, folders in (("filename", False), ("file_name", True), ("name", False)):
+            value = getattr(export, field_, "")
+            if isinstance(value, str) and value:
+                named.append((field_, value, export.span, folders))
+    ok = True
+    for field_, value, span, folders in named:
+        if why := name_problem(value, folders=folders):
+            sink.error(span, "E0250", f"'{field_}': cannot name a file in the output: {why}")
+            ok = False
+    return ok
 
 
 def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
@@ -150,6 +172,13 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
     A model definition goes through the front end with names checked; a pipeline file
     is validated and each of its model definitions checked.
     """
+    try:
+        _check(path, sink, options)
+    except OSError as e:
+        sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
+
+
+def _check(path: Path, sink: Sink, options: Options) -> None:
     if path.suffix == ".ir":
         load_program(path, sink, options, Severity.WARNING)
         return
@@ -166,48 +195,104 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
 
 
 def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | None = None) -> bool:
-    """Write every export into a fresh folder next to `out`, then swap it into place."""
-    from mpc.backends import BACKENDS
+    """Write every export into a fresh folder next to `out`, then swap it into place.
 
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".mpc-tmp", dir=out.parent))
+    An OSError (a read-only or full disk, a file where a folder must be, a name too long)
+    is E0660 naming the path and what was being done; a name that would lead out of the
+    output folder is E0653. Either way the previous output stays as it was.
+    """
+    step = "make the output's folder"
+    staging: Path | None = None
     try:
-        submodels: dict[str, Robot | None] = {}
-        for export in program.exports:
-            if isinstance(export, SubmodelExport):
-                from mpc.ir.submodel import cut
-
-                submodels[export.name] = part = cut(robot, export, sink)
-                if part is not None and export.add_floating_base:
-                    submodels[export.name] = _floating(part, export, sink)
-                continue
-            if isinstance(export, CommandExport):
-                from mpc.backends.commands import run
-
-                if sink.has_errors() or not run(export, staging, target or out, sink):
-                    break  # the files a command would see are incomplete, or it failed
-                continue
-            model, folder = robot, staging
-            if isinstance(export, RobotExport):
-                if export.submodel:
-                    model, folder = submodels[export.submodel], staging / "submodels" / export.submodel
-                if isinstance(export, JointLimitsExport) and export.joints_of:
-                    model = submodels[export.joints_of]  # its joints, written where the entry is
-                if model is not None and export.add_floating_base:
-                    model = _floating(model, export, sink)
-                if model is not None and getattr(export, "correct_inertials", False):
-                    model = _physical(model, export, sink)
-                if model is None:
-                    continue
-            folder.mkdir(parents=True, exist_ok=True)
-            BACKENDS[export.type]().emit(model, export, folder, sink)
-        if sink.has_errors():
+        out.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale_staging(out)
+        step = "make a staging folder"
+        staging = Path(tempfile.mkdtemp(prefix=_staging_prefix(out), suffix=".mpc-tmp", dir=out.parent))
+        step = "write the output"
+        if not _emit_exports(program, robot, staging, out, sink, target):
             return False
+        step = "move the build into place"
         _replace(staging, out)
         return True
+    except OSError as e:
+        sink.error(program.span, "E0660",
+                   f"{describe(e, step)}; the previous output is unchanged")
+        return False
+    except OutsideOutput as e:
+        sink.error(program.span, "E0653", f"{e}; nothing is written there")
+        return False
     finally:
-        if staging.exists():
+        if staging is not None and staging.exists():
             shutil.rmtree(staging, ignore_errors=True)
+
+
+def _staging_prefix(out: Path) -> str:
+    """`.<out>.<pid>.`: a later build removes the folders of builds that no longer run."""
+    return f".{out.name[:100]}.{os.getpid()}."
+
+
+def remove_stale_staging(out: Path) -> None:
+    """Remove the staging (`.mpc-tmp`) and old-output (`.mpc-old-<pid>`) folders that killed
+    builds of `out` left beside it; those of builds still running stay."""
+    stem = f".{out.name[:100]}."
+    for folder in out.parent.glob(f"{glob.escape(stem)}*"):
+        rest = folder.name[len(stem):]
+        if folder.name.endswith(".mpc-tmp"):
+            pid = rest.split(".", 1)[0]
+        elif rest.startswith("mpc-old-"):
+            pid = folder.name.rsplit("-", 1)[-1]
+        else:
+            continue
+        if not pid.isdigit() or not _running(int(pid)):
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's process
+    return True
+
+
+def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink: Sink,
+                  target: Path | None) -> bool:
+    """Write every export into `staging`; whether all succeeded."""
+    from mpc.backends import BACKENDS
+
+    submodels: dict[str, Robot | None] = {}
+    for export in program.exports:
+        if isinstance(export, SubmodelExport):
+            from mpc.ir.submodel import cut
+
+            submodels[export.name] = part = cut(robot, export, sink)
+            if part is not None and export.add_floating_base:
+                submodels[export.name] = _floating(part, export, sink)
+            continue
+        if isinstance(export, CommandExport):
+            from mpc.backends.commands import run
+
+            if sink.has_errors() or not run(export, staging, target or out, sink):
+                break  # the files a command would see are incomplete, or it failed
+            continue
+        model, folder = robot, staging
+        if isinstance(export, RobotExport):
+            if export.submodel:
+                model = submodels[export.submodel]
+                folder = confined(staging, "submodels", export.submodel)
+            if isinstance(export, JointLimitsExport) and export.joints_of:
+                model = submodels[export.joints_of]  # its joints, written where the entry is
+            if model is not None and export.add_floating_base:
+                model = _floating(model, export, sink)
+            if model is not None and getattr(export, "correct_inertials", False):
+                model = _physical(model, export, sink)
+            if model is None:
+                continue
+        folder.mkdir(parents=True, exist_ok=True)
+        BACKENDS[export.type]().emit(model, export, folder, sink)
+    return not sink.has_errors()
 
 
 def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
@@ -239,7 +324,7 @@ def _replace(new: Path, out: Path) -> None:
     if not out.exists():
         os.replace(new, out)
         return
-    old = out.with_name(f".{out.name}.mpc-old-{os.getpid()}")
+    old = out.with_name(f".{out.name[:100]}.mpc-old-{os.getpid()}")
     os.replace(out, old)
     try:
         os.replace(new, out)
@@ -252,11 +337,15 @@ def _replace(new: Path, out: Path) -> None:
 def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     result = Result()
-    loader = InputLoader(sink, options, (path.resolve(),))
-    result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
-    if result.program is None:
-        return result
-    result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
+    try:
+        loader = InputLoader(sink, options, (path.resolve(),))
+        result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
+        if result.program is None:
+            return result
+        result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
+    except OSError as e:  # what the readers do not report themselves (a name too long, say)
+        sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
+        return Result()
     if result.robot is None:
         return result
     from mpc.backends.solid_checks import check_closed

@@ -35,6 +35,10 @@ class InputLoader:
     _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
     _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        for definition in self.stack:  # inputs may link to files beside their definitions
+            self.options.resolver.add_root(definition.parent)
+
     def _key(self, inp: Input) -> tuple[str, str]:
         return (inp.kind, str(inp.path) if inp.path else repr(inp.repo))
 
@@ -72,6 +76,9 @@ class InputLoader:
         """A model file, by its extension: URDF, SDF, SMURF, or a xacro (expanded with its args)."""
         from mpc.backends import BACKENDS
 
+        if why := self.options.resolver.refusal(path):
+            self.sink.error(inp.span, "E0650", f"input model '{path}' is not read: {why}")
+            return None
         suffix = path.suffix.lower()
         if suffix == ".xacro":
             from mpc.backends import xacro_reader
@@ -87,6 +94,7 @@ class InputLoader:
         tree = checkout(inp.repo, self.sink, inp.span, fetch=fetch)
         if tree is None:
             return None
+        self.options.resolver.add_root(tree)
         path = tree / inp.repo.model_in_repo
         if not path.is_file():
             self.sink.error(inp.span, "E0601", f"'{inp.repo.model_in_repo}' is not in repository "

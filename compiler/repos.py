@@ -2,7 +2,7 @@
 exactly the commit (or branch) a definition names.
 
 Cache: `$MPC_CACHE_DIR/repos`, else `$XDG_CACHE_HOME/mpc/repos`, else `~/.cache/mpc/repos`;
-one folder per URL and commit, so two definitions at different commits never disturb
+one folder per URL (without credentials) and commit, so two definitions at different commits never disturb
 each other and a pinned commit is cloned once. A branch is fetched on every use and
 resolved to its current commit.
 """
@@ -17,12 +17,15 @@ from pathlib import Path
 
 from mpc.compiler.cache import cache_dir
 from mpc.compiler.diagnostics import Sink
+from mpc.compiler.files import describe
+from mpc.compiler.gitrun import GitFailed, git, scrub, without_credentials
 from mpc.ir.program import RepoRef
 from mpc.ir.span import Span
 
 
 def _slot(url: str) -> Path:
-    return cache_dir("repos") / hashlib.sha256(url.encode()).hexdigest()[:16]
+    # keyed without credentials: a CI token changes from job to job, the repository does not
+    return cache_dir("repos") / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
 
 
 def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path | None:
@@ -30,32 +33,40 @@ def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path 
 
     fetch: False for `mpc check`, which only uses what is cached already (None otherwise).
     """
-    import git  # GitPython: only needed when a definition names a repository
-
     ref = repo.commit or repo.branch or "HEAD"
     slot = _slot(repo.git)
-    if repo.commit and (slot / repo.commit).is_dir():
-        return slot / repo.commit
-    if not fetch:
-        return None
+    try:
+        if repo.commit and (slot / repo.commit).is_dir():
+            return slot / repo.commit
+        if not fetch:
+            return None
+        return _checkout(repo, ref, slot)
+    except GitFailed as e:
+        sink.error(span, "E0604", f"cannot get '{ref}' of repository '{scrub(repo.git)}': {e.message}")
+    except OSError as e:
+        sink.error(span, "E0604", f"cannot get '{ref}' of repository '{scrub(repo.git)}': "
+                   f"{describe(e, 'keep the checkout')}")
+    return None
+
+
+def _checkout(repo: RepoRef, ref: str, slot: Path) -> Path:
+    """Fetch into the slot's mirror and check `ref` out into its own folder; raises
+    GitFailed or OSError."""
     slot.mkdir(parents=True, exist_ok=True)
     mirror = slot / "mirror.git"
-    try:
-        if mirror.is_dir():
-            git.Repo(mirror).remote().fetch("+refs/heads/*:refs/heads/*", prune=False)
-        else:
-            git.Repo.clone_from(repo.git, mirror, bare=True)
-        store = git.Repo(mirror)
-        sha = store.commit(ref).hexsha
-    except (git.GitCommandError, git.BadName, ValueError) as e:
-        sink.error(span, "E0604", f"cannot get '{ref}' of repository '{repo.git}': "
-                   f"{_first_line(e)}")
-        return None
+    if mirror.is_dir():
+        git("fetch", "--quiet", repo.git, "+refs/heads/*:refs/heads/*", cwd=mirror)
+    else:
+        git("clone", "--quiet", "--bare", "--", repo.git, str(mirror))
+        # no token in the cache's config: fetches name the URL of the day
+        git("remote", "set-url", "origin", without_credentials(repo.git), cwd=mirror)
+    sha = git("rev-parse", "--verify", "--end-of-options", f"{ref}^{{commit}}", cwd=mirror)
     tree = slot / sha
     if not tree.is_dir():
         staging = Path(tempfile.mkdtemp(prefix=".checkout-", dir=slot))
         try:
-            git.Repo.clone_from(str(mirror), staging, no_checkout=True).git.checkout(sha)
+            git("clone", "--quiet", "--no-checkout", "--", str(mirror), str(staging))
+            git("checkout", "--quiet", sha, cwd=staging)
             shutil.rmtree(staging / ".git", ignore_errors=True)
             os.replace(staging, tree)
         finally:
@@ -63,9 +74,3 @@ def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path 
     if repo.commit and repo.commit != sha and not (slot / repo.commit).exists():
         (slot / repo.commit).symlink_to(sha)  # an abbreviated commit finds the tree next time
     return tree
-
-
-def _first_line(e: Exception) -> str:
-    text = getattr(e, "stderr", "") or str(e)
-    lines = [ln.strip() for ln in str(text).splitlines() if ln.strip()]
-    return lines[-1].removeprefix("stderr: ").strip("'") if lines else type(e).__name__

@@ -3,12 +3,18 @@
 Values follow the YAML 1.2 core schema (only true/false are booleans, `1e-3` is a
 number, `on`, `yes` and `1:30` stay strings). Duplicate keys, malformed YAML and
 unsupported tags are diagnostics. Merge keys (`<<`) work.
+
+The loader is bounded (`Limits`): file size, nesting depth, alias uses and the size of
+what they expand to, scalar length and integer digits; hitting a limit, a recursive alias
+or a non-printable character is a located diagnostic (E0107–E0113), never an exception.
+Definitions, pipeline files, SMURF files and pipeline state files all come through here.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import stat
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -38,16 +44,62 @@ for tag, pattern, first in [
     _Resolver.add_implicit_resolver(tag, re.compile(pattern), list(first))
 
 
+@dataclass(frozen=True)
+class Limits:
+    """How much YAML one file may hold; far above any model definition or SMURF file.
+
+    bytes: the file; depth: nested lists and mappings; aliases: `*name` uses;
+    nodes: values after expanding aliases (what an alias bomb multiplies);
+    scalar: characters of one value; digits: of one integer (Python refuses > 4300).
+    """
+
+    bytes: int = 64 * 2**20
+    depth: int = 200
+    aliases: int = 10_000
+    nodes: int = 500_000
+    scalar: int = 2**20
+    digits: int = 100
+
+
+LIMITS = Limits()
+
+
+class _Limit(Exception):
+    """A limit was hit while composing; becomes a diagnostic at `mark`."""
+
+    def __init__(self, code: str, message: str, mark: yaml.Mark | None) -> None:
+        super().__init__(message)
+        self.code, self.message, self.mark = code, message, mark
+
+
 class _Composer(yaml.reader.Reader, yaml.scanner.Scanner, yaml.parser.Parser,
                 yaml.composer.Composer, _Resolver):
-    """PyYAML's composer (nodes with start and end marks) with the resolver above."""
+    """PyYAML's composer (nodes with start and end marks) with the resolver above, and
+    bounded: PyYAML composes recursively (a deep file is a RecursionError) and counts
+    nothing (an alias bomb is composed as a small graph, then expanded without end)."""
 
-    def __init__(self, stream: str) -> None:
+    def __init__(self, stream: str, limits: Limits) -> None:
         yaml.reader.Reader.__init__(self, stream)
         yaml.scanner.Scanner.__init__(self)
         yaml.parser.Parser.__init__(self)
         yaml.composer.Composer.__init__(self)
         _Resolver.__init__(self)
+        self.limits, self.depth, self.aliases = limits, 0, 0
+
+    def compose_node(self, parent: Node | None, index: Any) -> Node:
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            self.aliases += 1
+            if self.aliases > self.limits.aliases:
+                raise _Limit("E0109", f"more than {self.limits.aliases} aliases", event.start_mark)
+        self.depth += 1
+        try:
+            if self.depth > self.limits.depth:
+                raise _Limit("E0110", f"lists and mappings nested more than {self.limits.depth} deep",
+                             event.start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
 
 
 @dataclass
@@ -94,12 +146,19 @@ def _span(file: str, node: Node) -> Span:
 
 
 class _Builder:
-    def __init__(self, doc: Document, sink: Sink) -> None:
-        self.doc, self.sink = doc, sink
-        self.unusable = False  # a value no later step can take (a NUL character)
+    def __init__(self, doc: Document, sink: Sink, limits: Limits = LIMITS) -> None:
+        self.doc, self.sink, self.limits = doc, sink, limits
+        self.unusable = False  # a value no later step can take (a NUL character, a limit hit)
+        self.nodes = 0
+        self.open: set[int] = set()  # the nodes being built: an alias to one of them is a cycle
 
     def scalar(self, node: ScalarNode, path: Path_) -> Any:
         v, tag = node.value, node.tag
+        if len(v) > self.limits.scalar:
+            self.sink.error(_span(self.doc.file, node), "E0111", f"a value of {len(v)} characters; "
+                            f"at most {self.limits.scalar} are read")
+            self.unusable = True
+            return None
         if tag == "tag:yaml.org,2002:str":
             if "\0" in v:
                 self.sink.error(_span(self.doc.file, node), "E0106", "a NUL character in a string: "
@@ -111,6 +170,11 @@ class _Builder:
         if tag == "tag:yaml.org,2002:bool":
             return v.lower() == "true"
         if tag == "tag:yaml.org,2002:int":
+            if len(v.lstrip("+-")) > self.limits.digits:
+                self.sink.error(_span(self.doc.file, node), "E0112", f"an integer of {len(v)} "
+                                f"digits; at most {self.limits.digits} are read")
+                self.unusable = True
+                return None
             return int(v, 0) if v[:2] in ("0o", "0x") else int(v, 10)
         if tag == "tag:yaml.org,2002:float":
             low = v.lower().lstrip("+")
@@ -119,9 +183,31 @@ class _Builder:
         return v
 
     def build(self, node: Node, path: Path_) -> Any:
+        if self.unusable:
+            return None
+        self.nodes += 1
+        if self.nodes > self.limits.nodes:  # aliases expand to copies: billion laughs stop here
+            keyed = next((path[:n] for n in range(len(path), 0, -1) if path[:n] in self.doc.keys), None)
+            where = self.doc.keys[keyed] if keyed else _span(self.doc.file, node)
+            self.sink.error(where, "E0109", f"the aliases expand to more than {self.limits.nodes} "
+                            "values")
+            self.unusable = True
+            return None
         self.doc.values[path] = _span(self.doc.file, node)
         if isinstance(node, ScalarNode):
             return self.scalar(node, path)
+        if id(node) in self.open:
+            self.sink.error(_span(self.doc.file, node), "E0108", "a recursive alias: the value "
+                            "contains itself")
+            self.unusable = True
+            return None
+        self.open.add(id(node))
+        try:
+            return self.collection(node, path)
+        finally:
+            self.open.discard(id(node))
+
+    def collection(self, node: Node, path: Path_) -> Any:
         if isinstance(node, SequenceNode):
             return [self.build(item, (*path, i)) for i, item in enumerate(node.value)]
         assert isinstance(node, MappingNode)
@@ -159,7 +245,14 @@ def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None
     """
     file = display or str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = _read(path, LIMITS)
+    except _NotAFile:
+        sink.error(origin or Span.of_file(file), "E0601", f"'{file}' is not a regular file")
+        return None
+    except _TooLarge as e:
+        sink.error(origin or Span.of_file(file), "E0113", f"'{file}' has {e.size} bytes; "
+                   f"at most {LIMITS.bytes} are read")
+        return None
     except FileNotFoundError:
         sink.error(origin or Span.of_file(file), "E0601", f"file '{file}' does not exist")
         return None
@@ -169,11 +262,47 @@ def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None
     return loads(text, file, sink)
 
 
-def loads(text: str, file: str, sink: Sink) -> Document | None:
+class _NotAFile(Exception):
+    """A device, FIFO or socket where a YAML file was expected."""
+
+
+class _TooLarge(Exception):
+    def __init__(self, size: int) -> None:
+        super().__init__(size)
+        self.size = size
+
+
+def _read(path: Path, limits: Limits) -> str:
+    """The text of `path`, read no further than the limit (a FIFO or /dev/zero never ends)."""
+    if not stat.S_ISREG(path.stat().st_mode):  # opening a FIFO would wait for a writer
+        raise _NotAFile()
+    with path.open("rb") as f:
+        data = f.read(limits.bytes + 1)
+        size = os.fstat(f.fileno()).st_size
+    if len(data) > limits.bytes:
+        raise _TooLarge(max(size, len(data)))
+    return data.decode("utf-8")
+
+
+def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS) -> Document | None:
     """Parse YAML text that came from `file`."""
-    loader = _Composer(text)
+    if len(text) > limits.bytes:
+        sink.error(Span.of_file(file), "E0113", f"'{file}' has {len(text)} characters; "
+                   f"at most {limits.bytes} are read")
+        return None
+    loader: _Composer | None = None
     try:
+        loader = _Composer(text, limits)  # the reader checks the characters already
         node = loader.get_single_node()
+    except yaml.reader.ReaderError as e:
+        line, col = _position(text, e.position)
+        sink.error(Span(file, line, col), "E0107", f"a non-printable character (#x{e.character:04x}) "
+                   "in YAML; write it escaped in a double-quoted string")
+        return None
+    except _Limit as e:
+        line, col = (e.mark.line + 1, e.mark.column + 1) if e.mark else (1, 1)
+        sink.error(Span(file, line, col), e.code, e.message)
+        return None
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
@@ -184,14 +313,21 @@ def loads(text: str, file: str, sink: Sink) -> Document | None:
         sink.error(Span.of_file(file), "E0102", f"malformed YAML: {e}")
         return None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
     if node is None:
         sink.error(Span.of_file(file), "E0104", f"'{file}' is empty")
         return None
     doc = Document(file, None)
-    builder = _Builder(doc, sink)
+    builder = _Builder(doc, sink, limits)
     doc.data = builder.build(node, ())
     return None if builder.unusable else doc
+
+
+def _position(text: str, offset: int) -> tuple[int, int]:
+    """1-based line and column of character `offset` of `text`."""
+    line = text.count("\n", 0, offset) + 1
+    return line, offset - (text.rfind("\n", 0, offset) + 1) + 1
 
 
 def source_line(file: str, line: int) -> str | None:

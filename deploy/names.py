@@ -5,19 +5,17 @@ repository addresses (never taken for an option) and the modelname (one folder o
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
 
-from mpc.deploy.gitcmd import DeployError, git_environment
+from mpc.compiler import gitrun
+from mpc.deploy.gitcmd import DeployError
 
 
 def check_branch(name: str, what: str) -> None:
     """Raise E0840 unless git accepts `name` as a branch name; `what` says where it came from."""
     if name and not name.startswith("-") and name != "HEAD" and name.isprintable():
-        run = subprocess.run(["git", "check-ref-format", "--branch", name], capture_output=True,
-                             text=True, env={**os.environ, **git_environment()})
-        if run.returncode == 0 and run.stdout.strip() == name:
+        status, out, _ = gitrun.result(["check-ref-format", "--branch", name])
+        if status == 0 and out.strip() == name:
             return
     raise DeployError("E0840", f"{what} '{name}' is not a valid git branch name")
 

@@ -19,19 +19,18 @@ from mpc.ir.program import Program
 
 def _repository_state(path: Path) -> tuple[str, bool, str] | None:
     """(commit, dirty, path in the repository) of the git working copy holding `path`, or None."""
-    import git
+    from mpc.compiler.gitrun import GitFailed, git
 
     try:
-        repo = git.Repo(path if path.is_dir() else path.parent, search_parent_directories=True)
-        if repo.working_tree_dir is None:  # a bare repository holds no definitions
-            return None
-        commit = repo.head.commit.hexsha
-        top = Path(repo.working_tree_dir).resolve()
+        folder = path if path.is_dir() else path.parent
+        top = Path(git("rev-parse", "--show-toplevel", cwd=folder)).resolve()  # fails in a bare one
+        commit = git("rev-parse", "--verify", "HEAD^{commit}", cwd=folder)
         rel = path.resolve().relative_to(top).as_posix() if path.resolve().is_relative_to(top) else str(path)
-        dirty = repo.is_dirty(untracked_files=True, path=None if rel == "." else rel)
-    except (git.GitError, ValueError, OSError):  # no repository, no commit yet, or git failing
+        status = git("status", "--porcelain", "--untracked-files=all", "--", ".", cwd=top) if rel == "." \
+            else git("status", "--porcelain", "--untracked-files=all", "--", rel, cwd=top)
+    except (GitFailed, ValueError, OSError):  # no repository, no commit yet, or git failing
         return None
-    return commit, dirty, rel
+    return commit, bool(status.strip()), rel
 
 
 def _sha256(path: Path) -> str | None:

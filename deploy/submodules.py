@@ -8,7 +8,6 @@ submodule is ever checked out inside the model repository.
 
 from __future__ import annotations
 
-import io
 import tarfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,14 +94,19 @@ def link(git: Git, pinned: list[Pinned]) -> None:
 def write_files(p: Pinned, folder: Path) -> None:
     """The submodule's files at its commit, written into `folder` (for mirrors that take
     the files instead of the submodule)."""
-    import git
+    import tempfile
 
-    buffer = io.BytesIO()
-    git.Repo(p.cache).archive(buffer, p.sha, format="tar")
-    buffer.seek(0)
+    from mpc.compiler.gitrun import GitFailed, git
+
     folder.mkdir(parents=True, exist_ok=True)
-    with tarfile.open(fileobj=buffer) as tar:
-        _extract_data(tar, folder)
+    with tempfile.TemporaryDirectory(prefix="mpc-archive-") as work:
+        archive = Path(work) / "files.tar"
+        try:
+            git("archive", "--format=tar", "-o", str(archive), p.sha, cwd=p.cache)
+        except GitFailed as e:
+            raise DeployError("E0803", f"git archive failed in '{p.cache}': {e.message}") from None
+        with tarfile.open(archive) as tar:
+            _extract_data(tar, folder)
 
 
 def _extract_data(tar: tarfile.TarFile, folder: Path) -> None:

@@ -8,12 +8,14 @@ mesh is decomposed once, however often it is used or built.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
 
 import numpy as np
 import trimesh
 
-from mpc.compiler.cache import cache_dir
+from mpc.compiler.cache import cache_dir, load_entry, remove_entry, store_entry
 from mpc.ir.geometry import Mesh
 from mpc.ir.mesh_props import as_trimesh
 
@@ -28,12 +30,22 @@ def _key(mesh: Mesh) -> str:
 
 
 def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
-    """The convex parts of `mesh` (scaled, with its ops), computed once."""
-    path = cache_dir("decompositions") / f"{_key(mesh)}.npz"
-    if path.is_file():
-        data = np.load(path)
-        return [trimesh.Trimesh(data[f"v{i}"], data[f"f{i}"], process=False)
-                for i in range(int(data["n"]))]
+    """The convex parts of `mesh` (scaled, with its ops), computed once.
+
+    A damaged cache entry (compiler/cache.py checks its hash) is removed and computed
+    again; a cache that cannot be written only costs the time of computing again.
+    """
+    entry = cache_dir("decompositions") / f"{_key(mesh)}.npz"
+    try:
+        data, bad = load_entry(entry)
+        if bad is not None:
+            remove_entry(entry)
+    except OSError:
+        data = None
+    if data is not None:
+        arrays = np.load(io.BytesIO(data))
+        return [trimesh.Trimesh(arrays[f"v{i}"], arrays[f"f{i}"], process=False)
+                for i in range(int(arrays["n"]))]
     import coacd
 
     coacd.set_log_level("error")
@@ -42,11 +54,11 @@ def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
     result = coacd.run_coacd(coacd.Mesh(shape.vertices, shape.faces), threshold=THRESHOLD, seed=0,
                              max_convex_hull=MAX_PARTS)
     out = [trimesh.Trimesh(np.asarray(v), np.asarray(f), process=False) for v, f in result]
-    path.parent.mkdir(parents=True, exist_ok=True)
     arrays = {"n": np.array(len(out))}
     for i, m in enumerate(out):
         arrays[f"v{i}"], arrays[f"f{i}"] = m.vertices, m.faces
-    partial = path.with_suffix(".part.npz")
-    np.savez(partial, **arrays)
-    partial.replace(path)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    with contextlib.suppress(OSError):
+        store_entry(entry, buffer.getvalue())
     return out

@@ -15,6 +15,7 @@ from lxml import etree
 
 from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.robot import Joint, Link, Robot
+from mpc.ir.span import hardened_parser
 
 Rename = Callable[[str], str]
 
@@ -34,7 +35,7 @@ def rename_fragment(frag: Fragment, link: Rename, joint: Rename, xmlns: str = ""
     if all(new == ref.name for ref, new in renamed):
         return frag
     # Parse inside a wrapper that declares the robot's namespaces, which the fragment may use.
-    wrapper = etree.fromstring(f"<w{xmlns}>{frag.xml}</w>")
+    wrapper = etree.fromstring(f"<w{xmlns}>{frag.xml}</w>", hardened_parser())
     root = wrapper[0]
     refs = []
     for ref, new in renamed:

@@ -6,6 +6,8 @@ found at any stage points at the user's text.
 
 from __future__ import annotations
 
+from typing import Any
+
 from mpc.ir.record import record
 
 
@@ -36,3 +38,13 @@ class Span:
     def of_file(cls, file: str) -> Span:
         """The span of a whole file, for errors that concern the file itself."""
         return cls(file, 1, 1)
+
+
+def hardened_parser(huge: bool = False) -> Any:
+    """The one lxml parser of mpc (here, on the ground floor, for readers and IR alike): no
+    DTD, no entity expansion, no network; huge trees only when asked (meshes: DAE files
+    hold long arrays). A new parser per call: lxml parsers must not be shared between threads."""
+    from lxml import etree
+
+    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=huge,
+                           remove_blank_text=False)

@@ -17,7 +17,13 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
         if inp.path is None:
             continue
         what = "basefile" if inp.kind == "basefile" else "derived_base definition"
-        if not inp.path.is_file():
+        try:
+            exists = inp.path.is_file()
+        except OSError as e:  # a name too long, a loop of links
+            ctx.sink.error(inp.span, "E0601", f"{what} '{inp.path}' of input model '{inp.name}' "
+                           f"cannot be read: {e.strerror}")
+            continue
+        if not exists:
             ctx.sink.error(inp.span, "E0601", f"{what} '{inp.path}' of input model "
                            f"'{inp.name}' does not exist")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:

@@ -174,10 +174,10 @@ def ci(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(text)
     else:
-        from mpc.compiler.pipeline.store import describe, write_text
+        from mpc.compiler.files import describe, write_atomic
 
         try:
-            write_text(args.output, text)
+            write_atomic(args.output, text)
         except OSError as e:
             print(f"mpc ci: error: cannot write '{args.output}' ({describe(e)})", file=sys.stderr)
             return 1

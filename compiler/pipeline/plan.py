@@ -147,10 +147,14 @@ def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span
         # Its build could not be found again from a clone elsewhere, nor kept by CI.
         sink.error(span, "E0641", f"model definition '{written}' is outside the workspace root '{root}'",
                    hint="set the pipeline's `root` to a folder that holds every model definition")
-    elif definition.is_dir():
-        sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
-    elif not definition.is_file():
-        sink.error(span, "E0601", f"model definition '{written}' does not exist")
+    else:
+        try:
+            if definition.is_dir():
+                sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
+            elif not definition.is_file():
+                sink.error(span, "E0601", f"model definition '{written}' does not exist")
+        except OSError as e:  # a name too long, a loop of links
+            sink.error(span, "E0601", f"model definition '{written}' cannot be read: {e.strerror}")
     if sink.diagnostics:
         model.diagnostics = sink.diagnostics
         return model, []

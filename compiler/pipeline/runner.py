@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
+from mpc.compiler.files import describe
 from mpc.compiler.pipeline import dag
 from mpc.compiler.pipeline.fingerprint import mpc_version, with_deps
 from mpc.compiler.pipeline.freshness import Freshness
@@ -40,7 +41,7 @@ from mpc.compiler.pipeline.status import (
     diagnostics_from_json,
     diagnostics_json,
 )
-from mpc.compiler.pipeline.store import Store, describe
+from mpc.compiler.pipeline.store import Store
 from mpc.ir.span import Span
 
 if TYPE_CHECKING:

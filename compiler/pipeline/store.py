@@ -14,14 +14,13 @@ state on with its output.
 
 from __future__ import annotations
 
-import errno
 import fcntl
 import json
-import os
 import shutil
-import tempfile
 from pathlib import Path
 from typing import IO, Any
+
+from mpc.compiler.files import describe, write_atomic
 
 
 class BuildFolderBusy(Exception):
@@ -85,16 +84,19 @@ class Store:
         return self._read_state(model)[1]
 
     def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
+        from mpc.compiler import source
+        from mpc.compiler.diagnostics import Sink
+
         path = self.state_file(model)
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
+        if not path.exists() and not path.is_symlink():
             return {}, None
-        except OSError as e:
-            return {}, describe(e)
-        except ValueError as e:
-            return {}, f"not JSON: {e}"
-        return (data, None) if well_formed(data) else ({}, "not a state mpc writes")
+        # JSON is YAML: the bounded loader refuses deep nesting, huge numbers and the like
+        sink = Sink()
+        doc = source.load(path, sink)
+        if doc is None:
+            first = sink.diagnostics[0]
+            return {}, f"{first.message} (line {first.span.line})"
+        return (doc.data, None) if well_formed(doc.data) else ({}, "not a state mpc writes")
 
     def save_state(self, model: str, state: dict[str, Any]) -> None:
         write_json(self.state_file(model), state)
@@ -108,42 +110,9 @@ class Store:
         return path
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
-def describe(error: OSError) -> str:
-    """An OSError as a user reads it: "Not a directory: '/x/build/.mpc'"."""
-    where = f": '{error.filename}'" if error.filename else ""
-    return f"{error.strerror or error}{where}"
-
-
 def write_json(path: Path, data: Any) -> None:
     """Write `data` as JSON to `path` atomically."""
-    write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
-
-
-def write_text(path: Path, text: str) -> None:
-    """Write `text` to `path` atomically: a reader, or a write that fails half-way, never
-    sees a partial file, and the previous one stays until the new one is complete."""
-    # Named as the user named them, not as mkdir and the temporary file would.
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
-    blocking = next((p for p in path.parents if p.exists()), None)
-    if blocking is not None and not blocking.is_dir():
-        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(blocking))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes it private; state travels as CI artifacts
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def well_formed(state: Any) -> bool:

@@ -60,10 +60,11 @@ class Before:
 
 
 class After:
-    """Check the value further once its type is right; `fn` raises ValueError(message)."""
+    """Check the value further once its type is right; `fn` raises ValueError(message),
+    reported as `code` (or the error's own `code` attribute)."""
 
-    def __init__(self, fn: Callable[[Any], Any]) -> None:
-        self.fn = fn
+    def __init__(self, fn: Callable[[Any], Any], code: str = "E0203") -> None:
+        self.fn, self.code = fn, code
 
 
 class JsonSchema:
@@ -89,6 +90,31 @@ def str_or_list(value: Any) -> Any:
     """Many keys take one name or a list of names; the AST always holds a list."""
     return [value] if isinstance(value, str) else value
 
+
+class NameTooLong(ValueError):
+    code = "E0251"
+
+
+# Names that become file or folder names in the output: a name, never a path out of it.
+# mpc adds suffixes and extensions (`_relpath.urdf`, `_motors.yml`), hence less than 255.
+NAME_BYTES = 200
+
+
+def _path_name(value: str, folders: bool) -> None:
+    from mpc.compiler.files import name_problem
+
+    longest = max(len(part.encode("utf-8", "surrogatepass")) for part in value.split("/"))
+    if longest > NAME_BYTES:
+        raise NameTooLong(f"a name of {longest} bytes cannot name a file in the output; at most "
+                          f"{NAME_BYTES} (file systems take 255, and mpc adds suffixes and extensions)")
+    if why := name_problem(value, folders=folders):
+        raise ValueError(f"cannot name a file in the output: {why}")
+
+
+FileName = Annotated[str, After(lambda v: _path_name(v, False), "E0250")]
+# A suffix may be empty; a relative path (`file_name: limits/arm.yml`) has folders.
+FileSuffix = Annotated[str, After(lambda v: v == "" or _path_name(v, False), "E0250")]
+RelativeName = Annotated[str, After(lambda v: _path_name(v, True), "E0250")]
 
 OneOrMore = Annotated[list[str], Before(str_or_list),
                       JsonSchema({"anyOf": [{"type": "string"},
@@ -535,7 +561,7 @@ class Wrapped(Type):
     """A type with `Before`/`After` functions or its own JSON Schema."""
 
     def __init__(self, inner: Type, before: Callable[[Any], Any] | None,
-                 after: Callable[[Any], Any] | None, json: dict[str, Any] | None) -> None:
+                 after: After | None, json: dict[str, Any] | None) -> None:
         self.inner, self.before, self.after, self.json = inner, before, after, json
         self.wanted = inner.wanted
 
@@ -551,10 +577,11 @@ class Wrapped(Type):
         got = self.inner.check(value, path, walk)
         if self.after and got is not BAD and got is not DROP:
             try:
-                self.after(got)
+                self.after.fn(got)
             except ValueError as e:
                 problem = str(e)
-                return walk.fail(path, lambda key: f"'{key}': {problem}")
+                return walk.fail(path, lambda key: f"'{key}': {problem}",
+                                 getattr(e, "code", self.after.code))
         return got
 
     def bounded(self, low: int | None, high: int | None) -> Type:
@@ -577,7 +604,7 @@ def compile_type(tp: Any) -> Type:
             if isinstance(m, Field):
                 out = out.bounded(m.min_length, m.max_length)
         before = next((m.fn for m in meta if isinstance(m, Before)), None)
-        after = next((m.fn for m in meta if isinstance(m, After)), None)
+        after = next((m for m in meta if isinstance(m, After)), None)
         json = next((m.schema for m in meta if isinstance(m, JsonSchema)), None)
         return Wrapped(out, before, after, json) if before or after or json else out
     if origin in (typing.Union, types.UnionType):
@@ -644,12 +671,12 @@ class Walk:
                 out = (*out, step)
         return out
 
-    def fail(self, path: Path_, message: str | Callable[[str], str]) -> Any:
+    def fail(self, path: Path_, message: str | Callable[[str], str], code: str = "E0203") -> Any:
         """Report a problem of the value at `path`; message: text, or made from the key."""
         path = self.written(path)
         if callable(message):
             message = message(_key(path))
-        self.error(self.doc.value_span(path), "E0203", message)
+        self.error(self.doc.value_span(path), code, message)
         return BAD
 
     def wrong(self, type_: Type, value: Any, path: Path_) -> Any:

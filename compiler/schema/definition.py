@@ -14,7 +14,7 @@ from mpc.compiler.schema.annotations import (
     Submechanism,
 )
 from mpc.compiler.schema.assembly import Assemble, InputModel
-from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, validate_as
+from mpc.compiler.schema.base import Expr, Field, FileName, Node, OneOrMore, validate_as
 from mpc.compiler.schema.editing import (
     CollisionsSection,
     FramesSection,
@@ -32,9 +32,9 @@ class ModelSection(Node):
 
     SECTION: ClassVar[str] = "model"
     ALIASES: ClassVar[dict[str, str]] = {"links": "frames", "smurf_sensors": "sensors"}
-    robotname: str = Field(min_length=1)
-    modelname: str = Field(min_length=1)
-    filename: str | None = None
+    robotname: Annotated[FileName, Field(min_length=1)]
+    modelname: Annotated[FileName, Field(min_length=1)]
+    filename: FileName | None = None
     description: str | None = None
     version: str | None = None
     license: str | None = None

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from mpc.compiler.schema.base import Before, Expr, Node, OneOrMore
+from mpc.compiler.schema.base import Before, Expr, FileName, FileSuffix, Node, OneOrMore, RelativeName
 
 
 class _Export(Node):
@@ -22,8 +22,8 @@ class _Kinematic(_Export):
     additional_meshes: list[MeshFormat] | MeshFormat | None = None
     link_in_smurf: bool = False
     include_cut_joints: bool = False
-    filename_suffix: str = ""
-    filename: str | None = None
+    filename_suffix: FileSuffix = ""
+    filename: FileName | None = None
     ros_pathes: bool = False
     copy_with_other_pathes: bool = False
     enforce_zero: bool = False
@@ -66,7 +66,7 @@ class JointLimitsExport(_Export):
     SECTION: ClassVar[str] = "a joint_limits export"
     type: Literal["joint_limits"]
     joints: OneOrMore = ["ALL"]
-    file_name: str = "joint_limits.yml"
+    file_name: RelativeName = "joint_limits.yml"
 
 
 class BrakingModel(Node):
@@ -85,7 +85,7 @@ class KccdExport(_Export):
     merge_additionally: list[str] = []
     keep_stls: bool = False
     keep_urdf: bool = False
-    dirname: str = "kccd"
+    dirname: str = "kccd"  # a folder inside the output: E0521 when lowering
     reduce_meshes: Expr | None = None
     edit_collisions: dict[str, dict[str, int | str]] = {}
     braking_model: BrakingModel | None = None
@@ -100,7 +100,7 @@ class KccdExport(_Export):
 class SubmodelExport(_Export):
     SECTION: ClassVar[str] = "a submodel export"
     type: Literal["submodel"]
-    name: str
+    name: FileName
     start: str | None = None
     stop: OneOrMore | None = None
     include_unstopped_branches: bool = False
@@ -113,7 +113,7 @@ class SubmodelExport(_Export):
     move_joint_axis_to_intersection: dict[str, list[str]] = {}
     name_replacements: dict[str, str] = {}
     add_floating_base: bool = False
-    filename: str | None = None
+    filename: FileName | None = None
     only_urdf: bool = False
     export_config: list[ExportEntry] | None = None
 

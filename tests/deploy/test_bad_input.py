@@ -140,9 +140,8 @@ def test_a_submodule_repository_missing_or_without_commits(model: Model, used_se
 
 def test_a_modelname_that_is_not_a_folder_name(model: Model, used_server: Server) -> None:
     model.definition.write_text(definition_text().replace("modelname: arm-model", "modelname: ../escape"))
-    model.compile()
-    run = _deploy(model, "--remote", used_server.url)
-    _fails(run, "E0842", "modelname '../escape' cannot name mpc's clone")
+    run = _deploy(model, "--remote", used_server.url)  # the schema refuses it (issue 17)
+    _fails(run, "E0250", "'modelname': cannot name a file in the output: it holds a '/' or '\\'")
     assert not (model.folder.parent / "escape").exists() and used_server.pushes() == []
 
 

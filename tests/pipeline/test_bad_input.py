@@ -220,6 +220,9 @@ CORRUPT = {
     "a failure with bad deps": lambda good: json.dumps({**good, "failure": {"pre": good["pre"], "deps": 5}}),
     "a failure with a bad summary": lambda good: json.dumps(
         {**good, "failure": {"pre": good["pre"], "deps": [], "summary": 3, "diagnostics": []}}),
+    "nested 5000 deep": lambda good: json.dumps({**good, "deps": []})[:-1] + ', "x": '
+                                     + "[" * 5000 + "]" * 5000 + "}",
+    "a number of 4000 digits": lambda good: json.dumps({**good, "x": 10 ** 4000 - 1}),
     "a failure with bad diagnostics": lambda good: json.dumps(
         {**good, "failure": {"pre": good["pre"], "deps": [], "summary": "x", "diagnostics": [{"a": 1}]}}),
 }

@@ -1,0 +1,137 @@
+"""Paths and bytes on disk → confined output paths, checked inputs, atomic writes.
+
+The one place that decides where mpc may write (`confined`: under the output root, never
+through a link out of it), what it may read (`input_problem`: regular files, links only
+within the package roots, nothing of /proc, /sys or /dev), how it writes a file
+(`write_atomic`: all or nothing) and how an OSError reads to a user (`describe`). It
+imports nothing of mpc (the ground floor); it reports nothing itself.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import stat
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+
+NAME_BYTES = 255  # the longest file name of Linux's file systems (NAME_MAX), in bytes
+SPECIAL_ROOTS = (Path("/proc"), Path("/sys"), Path("/dev"))
+
+
+class OutsideOutput(ValueError):
+    """A name that would put a file outside the output folder."""
+
+
+def name_problem(name: str, *, folders: bool = False) -> str | None:
+    """Why `name` cannot be a file name inside the output folder, or None.
+
+    folders: `a/b` is allowed (a relative path of several names), `..` never is.
+    """
+    if not name:
+        return "it is empty"
+    if "\0" in name:
+        return "it holds a NUL character"
+    if name.startswith("/") or (len(name) > 1 and name[1] == ":"):
+        return "it is an absolute path"
+    parts = name.split("/")
+    if not folders and (len(parts) > 1 or "\\" in name):
+        return "it holds a '/' or '\\' (a file name, not a path)"
+    if "\\" in name:
+        return "it holds a '\\'"
+    for part in parts:
+        if part in (".", ".."):
+            return f"it holds '{part}', which names a folder outside the file's own"
+        if not part and folders:
+            return "it holds an empty folder name ('//' or a '/' at the end)"
+        if len(part.encode("utf-8", "surrogatepass")) > NAME_BYTES:
+            return f"a name of {len(part.encode('utf-8', 'surrogatepass'))} bytes; file systems take " \
+                   f"at most {NAME_BYTES}"
+    return None
+
+
+def confined(root: Path, *names: str) -> Path:
+    """`root / names…`, which must stay inside `root` once links are followed; raises
+    OutsideOutput when a name is absolute, climbs out with `..`, or a link on the way
+    (a folder a command made, say) leads out."""
+    path = root.joinpath(*names)
+    for name in names:
+        if Path(name).is_absolute() or ".." in Path(name).parts:
+            raise OutsideOutput(f"'{name}' leads out of the output folder")
+    real_root = root.resolve()
+    real = path.resolve()
+    if real != real_root and real_root not in real.parents:
+        raise OutsideOutput(f"'{path}' resolves to '{real}', outside the output folder")
+    return path
+
+
+def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
+    """The folders whose files inputs may link to, resolved (the definitions' folders,
+    --package roots, the package search path, a checkout: backends/packages.py names them)."""
+    return tuple(dict.fromkeys(Path(f).resolve() for f in folders))
+
+
+def input_problem(path: Path, roots: Iterable[Path]) -> str | None:
+    """Why the input file `path` must not be read, or None.
+
+    A link (or a linked folder on the way) must resolve inside one of `roots`: a mesh that
+    links to /proc/self/environ or ~/.ssh would otherwise be copied into the build and
+    deployed. Whatever the path, devices, FIFOs, sockets and the kernel's /proc, /sys and
+    /dev are refused.
+    """
+    real = path.resolve()
+    if any(real == s or s in real.parents for s in SPECIAL_ROOTS):
+        return f"it is '{real}', a special file of the system"
+    try:
+        mode = os.stat(real).st_mode
+    except OSError as e:
+        return describe(e, "read")
+    if not stat.S_ISREG(mode):
+        return "it is not a regular file (a device, FIFO, socket or folder)"
+    if real != Path(os.path.normpath(path.absolute())):  # a link on the way
+        roots = tuple(roots)
+        if not any(r == real or r in real.parents for r in roots):
+            return f"it is a link to '{real}', outside the model's package roots"
+    return None
+
+
+def describe(error: OSError, operation: str | None = None) -> str:
+    """An OSError as a user reads it: "cannot write '/x/build': Read-only file system"."""
+    where = f" '{error.filename}'" if error.filename else ""
+    reason = error.strerror or str(error)
+    if operation:
+        return f"cannot {operation}{where}: {reason}"
+    return f"{reason}{':' if where else ''}{where}"
+
+
+def write_atomic(path: Path, data: str | bytes, *, private: bool = False) -> None:
+    """Write `data` to `path` all at once: a reader, or a write that fails half-way (a full
+    disk, a kill), never sees a partial file; the previous file stays until the new one is
+    complete, and a failed write leaves nothing behind. Raises OSError.
+
+    private: keep mkstemp's 0600 (otherwise the umask's usual mode: state travels as CI
+    artifacts)."""
+    # Named as the user named them, not as mkdir and the temporary file would.
+    if path.is_dir() and not path.is_symlink():
+        raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), str(path))
+    blocking = next((p for p in path.parents if p.exists()), None)
+    if blocking is not None and not blocking.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(blocking))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:200]}.", suffix=".part", dir=path.parent)
+    try:
+        if not private:
+            os.fchmod(fd, 0o666 & ~_umask())
+        with os.fdopen(fd, "wb") as f:
+            f.write(data.encode("utf-8") if isinstance(data, str) else data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
