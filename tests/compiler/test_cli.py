@@ -80,8 +80,9 @@ def test_json_is_one_document_on_stdout_and_the_rest_goes_to_stderr(tmp_path: Pa
     built = mpc("compile", good, "-o", tmp_path / "out", "--format", "json")
     assert built.returncode == 0, built.stderr
     assert json.loads(built.stdout) == []
-    assert built.stderr == (f"compiled '{good}' into '{tmp_path}/out': smurf/arm.smurf, urdf/arm.urdf "
-                            "and 1 mesh files\n")
+    assert built.stderr == (f"compiled '{good}' into '{tmp_path}/out': smurf/arm.smurf, "
+                            "smurf/arm_collisions.yml, smurf/arm_joints.yml, smurf/arm_links.yml, "
+                            "smurf/arm_visuals.yml, urdf/arm.urdf and 1 mesh files\n")
     checked = mpc("check", good, bad, bad, "--format", "json")
     assert checked.returncode == 1
     assert [(d["code"], d["span"]["file"]) for d in json.loads(checked.stdout)] == [
