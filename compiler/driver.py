@@ -53,11 +53,13 @@ class Result:
 
 
 def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
-              loader: InputLoader | None = None, doc: source.Document | None = None) -> Program | None:
+              loader: InputLoader | None = None, doc: source.Document | None = None,
+              passes: bool = True) -> Program | None:
     """Load, resolve defaults, validate, lower and run passes; the program or None.
 
     later: how to report what compiling does not support yet (check: a warning).
     doc: the file, when the caller loaded it already.
+    passes: False: the program as lowered (`--emit ir-lowered`), the passes not run.
     """
     doc = doc or source.load(path, sink)                                  # load sources
     if doc is None:
@@ -71,18 +73,19 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     if ast is None:
         return None
     program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
-    if program is None:
-        return None
+    if program is None or not passes:
+        return None if sink.has_errors() else program
     loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
 
 def load_program(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
-                 loader: InputLoader | None = None) -> Program | None:
-    """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints)."""
+                 loader: InputLoader | None = None, passes: bool = True) -> Program | None:
+    """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints);
+    passes: False: as lowered or parsed, the passes (compiler/passes/) not run."""
     if path.suffix != ".ir":
-        return front_end(path, sink, options, later, loader)
+        return front_end(path, sink, options, later, loader, passes=passes)
     from mpc.ir.text import parse
 
     try:
@@ -91,8 +94,8 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
         sink.error(Span.of_file(str(path)), "E0601", f"cannot read '{path}': {e.strerror}")
         return None
     program = parse(text, str(path), sink)                              # parse the IR
-    if program is None:
-        return None
+    if program is None or not passes:
+        return program
     loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program

@@ -32,9 +32,14 @@ class PassContext:
 Pass = Callable[[Program, PassContext], Program]
 
 from mpc.compiler.passes.check_names import check_names  # noqa: E402
+from mpc.compiler.passes.drop_dead_ops import drop_dead_ops  # noqa: E402
+from mpc.compiler.passes.fold_renames import fold_renames  # noqa: E402
+from mpc.compiler.passes.order_ops import order_ops  # noqa: E402
 from mpc.compiler.passes.resolve_inputs import resolve_inputs  # noqa: E402
 
-PASSES: tuple[Pass, ...] = (resolve_inputs, check_names)
+# The order matters: names are checked on the program the others leave (ordered, folded, with
+# no dead op), so that a report points at what will run.
+PASSES: tuple[Pass, ...] = (resolve_inputs, order_ops, fold_renames, drop_dead_ops, check_names)
 
 
 def run_passes(program: Program, ctx: PassContext) -> Program:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 from dataclasses import field
+from enum import IntEnum
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from mpc.compiler.diagnostics import Sink
@@ -23,6 +24,38 @@ from mpc.ir.span import Span
 
 OPS: dict[str, type[Op]] = {}
 ROOT = "root"
+
+
+class Phase(IntEnum):
+    """Where an op runs in the language's order (specs/assembly.md "Order of operations").
+
+    The first six are the steps of one part of the assembly, which the parts take depth first
+    (a part's own steps, then each child part and its attaching); the rest edit the assembled
+    robot, one section after another. Ops of one phase keep the order they are written in.
+    """
+
+    LOAD = 0
+    NAMES = 1
+    REMOVE_BEYOND = 2
+    TAKE_LEAF = 3
+    MIRROR = 4
+    ATTACH = 5
+    ROBOT_NAME = 10
+    MATERIALS = 11
+    FRAMES = 12
+    JOINTS = 13
+    COLLISIONS = 14
+    VISUALS = 15
+    SUBMECHANISMS = 16
+    SENSORS = 17
+    POSES = 18
+    ANNOTATIONS = 19
+    MESHES = 20
+
+    @property
+    def assembly(self) -> bool:
+        """Whether ops of this phase build a part of the assembly (else they edit the robot)."""
+        return self <= Phase.ATTACH
 
 
 @record(slots=True)
@@ -66,6 +99,7 @@ class Op:
     SUPPORTED: ClassVar[bool] = True
     WHAT: ClassVar[str] = ""  # how messages name the op; default: its kind in words
     EFFECT_NEEDS_READS: ClassVar[bool] = True  # False: `effect` is sound even if a read is missing
+    PHASE: ClassVar[Phase]  # every op class declares it (tests/compiler/test_passes.py checks)
     span: Span
     part: str = ROOT
     spans: Mapping[str, Span] = field(default_factory=dict)
@@ -77,6 +111,14 @@ class Op:
     @classmethod
     def what(cls) -> str:
         return cls.WHAT or cls.kind.replace("_", " ")
+
+    def phase(self) -> Phase:
+        """Where the op runs in the language's order (an op whose fields decide says so)."""
+        return self.PHASE
+
+    def parts(self) -> tuple[str, ...]:
+        """The parts of the assembly the op reads or changes."""
+        return (self.part,)
 
     def span_of(self, field: str) -> Span:
         """The span of one of the op's fields, else of the op."""
@@ -199,6 +241,7 @@ __all__ = [
     "MoveJointAxisToIntersection",
     "Names",
     "Op",
+    "Phase",
     "ReduceMeshes",
     "Ref",
     "RemoveBeyond",

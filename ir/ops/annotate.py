@@ -12,7 +12,7 @@ from dataclasses import field, replace
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.robot import Collision, Material, Pose, Robot
 
@@ -45,6 +45,8 @@ def _link_or_collision(names: Names, name: str, effects: Effects, field_name: st
 @record(kw_only=True)
 class EditMaterial(Op):
     """Edit material `name`, or create it; colours are rgba (0..1)."""
+
+    PHASE = Phase.MATERIALS
 
     WHAT = "material"
     EFFECT_NEEDS_READS = False
@@ -86,6 +88,8 @@ class EditCollisions(Op):
         convex hull. `remove`: as remove: true. `mesh`: unchanged.
     join: merge the link's collisions into one convex hull (not supported yet).
     """
+
+    PHASE = Phase.COLLISIONS
 
     target: str = ""
     exclude: tuple[str, ...] = ()
@@ -224,6 +228,8 @@ class AutoBitmask(Op):
     listing the link pairs that may collide.
     """
 
+    PHASE = Phase.COLLISIONS
+
     never: tuple[tuple[str, str], ...] = ()
     always: tuple[tuple[str, str], ...] = ()
 
@@ -274,6 +280,8 @@ class AutoBitmask(Op):
 class EditVisuals(Op):
     """Edit the visuals of `targets` (all links but `exclude` when empty)."""
 
+    PHASE = Phase.VISUALS
+
     WHAT = "visuals"
 
     targets: tuple[str, ...] = ()
@@ -308,6 +316,8 @@ class AddSensor(Op):
 
     targets: joints (Joint*, MotorCurrent) or links (Node*); ("All",) for every movable joint.
     """
+
+    PHASE = Phase.SENSORS
 
     WHAT = "sensor"
     EFFECT_NEEDS_READS = False
@@ -353,6 +363,8 @@ class AddSensor(Op):
 @record(kw_only=True)
 class AddPose(Op):
     """A named joint configuration; `default` fills the movable joints not listed."""
+
+    PHASE = Phase.POSES
 
     WHAT = "pose"
 
@@ -400,6 +412,8 @@ class AddSubmechanism(Op):
     definition: the definition as written, for the submechanisms file.
     """
 
+    PHASE = Phase.SUBMECHANISMS
+
     WHAT = "submechanism"
     EFFECT_NEEDS_READS = False
 
@@ -425,6 +439,8 @@ class AddSubmechanism(Op):
 class SubmechanismsFile(Op):
     """Use the submechanisms file at `path` as it is."""
 
+    PHASE = Phase.SUBMECHANISMS
+
     path: str
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -434,6 +450,8 @@ class SubmechanismsFile(Op):
 @record(kw_only=True)
 class AddAnnotations(Op):
     """A free annotation category `category` (SMURF `<robot>_<category>.yml`)."""
+
+    PHASE = Phase.ANNOTATIONS
 
     category: str
     content: Annotations = field(default_factory=dict)
@@ -448,6 +466,8 @@ class CompleteSubmechanisms(Op):
     """Cover every joint no submechanism names (Phobos does this when any is given): each
     connected group of uncovered movable joints becomes a `serial` chain, each group of
     uncovered fixed joints a `fixed` chain, in depth-first order, marked `auto_gen`."""
+
+    PHASE = Phase.SUBMECHANISMS
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         from mpc.ir.tree import depth_first

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from dataclasses import field, replace
 
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint
@@ -26,6 +26,8 @@ class AddFrame(Op):
 
     mass: when given, the link gets a point mass (inertia diag(1e-6)).
     """
+
+    PHASE = Phase.FRAMES
 
     WHAT = "new frame"
     EFFECT_NEEDS_READS = False
@@ -72,6 +74,8 @@ class AddFrame(Op):
 class MakeRoot(Op):
     """Make `link` the root: the joints on the path to it are turned around."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "make_root"
 
     link: str
@@ -98,6 +102,8 @@ class MakeRoot(Op):
 @record(kw_only=True)
 class TransformLink(Op):
     """Move `link` with its visuals, collisions and inertial by X (xyz, rpy) in its own frame."""
+
+    PHASE = Phase.FRAMES
 
     WHAT = "transform"
 
@@ -181,6 +187,8 @@ def move_frame(robot: Robot, link_name: str, T: Pose) -> Robot:
 class ReparentLink(Op):
     """Hang `link` below `parent`, keeping its pose in the root frame (at q = 0)."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "reparent_to"
 
     link: str
@@ -215,6 +223,8 @@ class ReparentLink(Op):
 class EstimateMissingComs(Op):
     """Set the COM of each of `links` (all when empty) whose COM is at its origin, from its
     collision geometry."""
+
+    PHASE = Phase.FRAMES
 
     WHAT = "estimate_missing_coms"
 
@@ -258,6 +268,8 @@ class EstimateMissingComs(Op):
 @record(kw_only=True)
 class AnnotateLinks(Op):
     """Free annotations (for SMURF) on `links` (all when empty); material: set the visuals'."""
+
+    PHASE = Phase.FRAMES
 
     WHAT = "frames"
 

@@ -10,7 +10,7 @@ from dataclasses import field, replace
 
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 
@@ -77,6 +77,8 @@ class Dependency:
 class ReplaceJointTypes(Op):
     """Every joint of type `old` becomes type `new`, for each (old, new) pair."""
 
+    PHASE = Phase.JOINTS
+
     mapping: tuple[tuple[str, str], ...]
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -93,6 +95,8 @@ class JointDefaults(Op):
     backup: only for movable joints without any limit (`$backup`).
     annotations: set where the joint has no annotation of that key.
     """
+
+    PHASE = Phase.JOINTS
 
     WHAT = "joints $default"
 
@@ -118,6 +122,8 @@ class JointDefaults(Op):
 @record(kw_only=True)
 class EditJoint(Op):
     """Set values of `joint`: type, axis, limits and dynamics, mimic, dependencies, annotations."""
+
+    PHASE = Phase.JOINTS
 
     WHAT = "joints"
 
@@ -156,6 +162,8 @@ class EditJoint(Op):
 class SetMotor(Op):
     """Put a motor on `joint` (`active`, `motor`): name (default `<joint>_motor`) and settings."""
 
+    PHASE = Phase.JOINTS
+
     WHAT = "motor"
     EFFECT_NEEDS_READS = False
 
@@ -178,6 +186,8 @@ class SetMotor(Op):
 class RemoveJoint(Op):
     """Remove `joint`: its child link merges into the parent link (mass, COM and inertia
     combined, visuals and collisions moved), the child's children hang from the parent."""
+
+    PHASE = Phase.JOINTS
 
     WHAT = "joint removal"
 
@@ -249,6 +259,8 @@ class AddCutJoint(Op):
     constraint_axes: (name, axis) pairs of the constrained directions.
     """
 
+    PHASE = Phase.JOINTS
+
     WHAT = "cut joint"
     EFFECT_NEEDS_READS = False
 
@@ -286,6 +298,8 @@ class MoveJointAxisToIntersection(Op):
     meet at q = 0 — for skew axes, the middle of their closest points. Only the frame
     moves: the link's content stays where it is. This changes the kinematics on purpose
     (aligning, say, an exoskeleton's shoulder axes with the human's)."""
+
+    PHASE = Phase.JOINTS
 
     joint: str
     a: str
