@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.names import Kind, Names
 from mpc.ir.record import record
+from mpc.ir.refs import refs as declared_refs
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
 
@@ -121,12 +122,18 @@ class Op:
         return (self.part,)
 
     def span_of(self, field: str) -> Span:
-        """The span of one of the op's fields, else of the op."""
-        return self.spans.get(field, self.span)
+        """The span of one of the op's fields (`links/2`, else `links`), else of the op."""
+        while field:
+            if field in self.spans:
+                return self.spans[field]
+            field = field.rpartition("/")[0]
+        return self.span
 
     def reads(self) -> tuple[Ref, ...]:
-        """Names that must exist when the op runs."""
-        return ()
+        """Names that must exist when the op runs: its fields typed as references (ir/refs.py),
+        in the order of the fields. An op whose reads depend on other fields writes its own."""
+        return tuple(Ref(declared.kinds[0], name, path)  # type: ignore[arg-type]
+                     for declared, name, path in declared_refs(self) if not declared.defines)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         """The names after the op, computed from the names before it."""

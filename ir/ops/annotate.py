@@ -14,6 +14,7 @@ from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName
 from mpc.ir.robot import Collision, Material, Pose, Robot
 
 
@@ -51,7 +52,7 @@ class EditMaterial(Op):
     WHAT = "material"
     EFFECT_NEEDS_READS = False
 
-    name: str
+    name: MaterialName
     diffuse: tuple[float, ...] | None = None
     ambient: tuple[float, ...] | None = None
     specular: tuple[float, ...] | None = None
@@ -92,7 +93,7 @@ class EditCollisions(Op):
     PHASE = Phase.COLLISIONS
 
     target: str = ""
-    exclude: tuple[str, ...] = ()
+    exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
     shape: str | None = None
     oriented: bool = True
@@ -101,9 +102,6 @@ class EditCollisions(Op):
     join: bool = False
     bitmask: int | None = None
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "exclude") for n in self.exclude)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.target:
@@ -284,10 +282,10 @@ class EditVisuals(Op):
 
     WHAT = "visuals"
 
-    targets: tuple[str, ...] = ()
-    exclude: tuple[str, ...] = ()
+    targets: tuple[LinkRef, ...] = ()
+    exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
-    material: str | None = None
+    material: MaterialRef | None = None
     annotations: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -301,13 +299,6 @@ class EditVisuals(Op):
                 for v in link.visuals if not _matches(v.name, self.remove))
             links[name] = replace(link, visuals=visuals)
         return replace(robot, links=links)
-
-    def reads(self) -> tuple[Ref, ...]:
-        refs = [Ref("link", n, "targets") for n in self.targets]
-        refs += [Ref("link", n, "exclude") for n in self.exclude]
-        if self.material:
-            refs.append(Ref("material", self.material, "material"))
-        return tuple(refs)
 
 
 @record(kw_only=True)
@@ -323,10 +314,10 @@ class AddSensor(Op):
     EFFECT_NEEDS_READS = False
 
     type: str
-    name: str
-    link: str | None = None
-    joint: str | None = None
-    frame: str | None = None
+    name: SensorName
+    link: LinkRef | None = None
+    joint: JointRef | None = None
+    frame: LinkRef | None = None
     targets: tuple[str, ...] = ()
     targets_kind: str = "joint"
     position_offset: Vec3 | None = None
@@ -368,12 +359,9 @@ class AddPose(Op):
 
     WHAT = "pose"
 
-    name: str
-    positions: Mapping[str, float] = field(default_factory=dict)
+    name: PoseName
+    positions: Mapping[JointRef, float] = field(default_factory=dict)
     default: float | None = None
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("joint", j, f"positions/{j}") for j in self.positions)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """Values are clamped to the joint's limits (a warning says so); fixed joints are
@@ -419,13 +407,9 @@ class AddSubmechanism(Op):
 
     name: str
     exoskeleton: bool = False
-    joints: tuple[str, ...] = ()
-    links: tuple[str, ...] = ()
+    joints: tuple[JointRef, ...] = ()
+    links: tuple[LinkRef, ...] = ()
     definition: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (*(Ref("joint", j, "joints") for j in self.joints),
-                *(Ref("link", n, "links") for n in self.links))
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("submechanism", [self.name])

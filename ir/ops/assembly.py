@@ -15,6 +15,7 @@ from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
 from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, LinkRef
 from mpc.ir.rename import rename_robot, rename_with
 from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot
 
@@ -125,10 +126,7 @@ class RemoveBeyond(Op):
 
     WHAT = "remove_beyond"
 
-    links: tuple[str, ...]
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, f"links/{i}") for i, n in enumerate(self.links))
+    links: tuple[LinkRef, ...]
 
     def _kept(self, names: Names) -> set[str]:
         below: set[str] = set()
@@ -151,10 +149,7 @@ class TakeLeaf(Op):
 
     WHAT = "take_leaf"
 
-    link: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
+    link: LinkRef
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.keep(names.subtree(self.link), root=self.link,
@@ -264,11 +259,11 @@ class Attach(Op):
     WHAT = "the attaching joint's parent"
 
     child: str
-    parent: str
-    child_link: str | None = None
+    parent: LinkRef
+    child_link: LinkRef | None = None
     parent_written: str = ""
     child_written: str = ""
-    name: str | None = None
+    name: JointName | None = None
     type: str = "fixed"
     origin: Pose = IDENTITY
     r2r: tuple[tuple[float, ...], ...] | None = None

@@ -11,8 +11,9 @@ from collections.abc import Mapping
 from dataclasses import field, replace
 
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Phase, Ref
+from mpc.ir.ops import Effects, Op, Phase
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, LinkName, LinkRef, MaterialRef
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint
 
@@ -32,18 +33,15 @@ class AddFrame(Op):
     WHAT = "new frame"
     EFFECT_NEEDS_READS = False
 
-    link: str
-    parent: str
-    joint: str
+    link: LinkName
+    parent: LinkRef
+    joint: JointName
     type: str = "fixed"
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
     axis: Vec3 | None = None
     mass: float | None = None
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.parent, "parent"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.link in names.links:
@@ -78,10 +76,7 @@ class MakeRoot(Op):
 
     WHAT = "make_root"
 
-    link: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
+    link: LinkRef
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """Turn the joints from the root to `link` around (at q = 0; ir/reroot.py)."""
@@ -107,12 +102,9 @@ class TransformLink(Op):
 
     WHAT = "transform"
 
-    link: str
+    link: LinkRef
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.link == names.root and type(self) is TransformLink:
@@ -191,11 +183,8 @@ class ReparentLink(Op):
 
     WHAT = "reparent_to"
 
-    link: str
-    parent: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"), Ref("link", self.parent, "parent"))
+    link: LinkRef
+    parent: LinkRef
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.parent in names.subtree(self.link):
@@ -228,10 +217,7 @@ class EstimateMissingComs(Op):
 
     WHAT = "estimate_missing_coms"
 
-    links: tuple[str, ...] = ()
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "links") for n in self.links)
+    links: tuple[LinkRef, ...] = ()
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """The COM of a link whose COM is at its origin becomes the centre of volume of its
@@ -273,8 +259,8 @@ class AnnotateLinks(Op):
 
     WHAT = "frames"
 
-    links: tuple[str, ...] = ()
-    material: str | None = None
+    links: tuple[LinkRef, ...] = ()
+    material: MaterialRef | None = None
     annotations: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -287,9 +273,3 @@ class AnnotateLinks(Op):
             links[name] = replace(link, visuals=visuals,
                                   annotations={**link.annotations, **self.annotations})
         return replace(robot, links=links)
-
-    def reads(self) -> tuple[Ref, ...]:
-        refs = [Ref("link", n, "links") for n in self.links]
-        if self.material:
-            refs.append(Ref("material", self.material, "material"))
-        return tuple(refs)

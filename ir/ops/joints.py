@@ -12,6 +12,7 @@ from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, JointRef, LinkRef, MotorName
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 
 MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
@@ -68,7 +69,7 @@ class JointValues:
 class Dependency:
     """q = multiplier · q_joint + offset."""
 
-    joint: str
+    joint: JointRef
     multiplier: float = 1.0
     offset: float = 0.0
 
@@ -101,12 +102,9 @@ class JointDefaults(Op):
     WHAT = "joints $default"
 
     values: JointValues
-    joints: tuple[str, ...] = ()
+    joints: tuple[JointRef, ...] = ()
     backup: bool = False
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("joint", n, "joints") for n in self.joints)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         joints = dict(robot.joints)
@@ -127,7 +125,7 @@ class EditJoint(Op):
 
     WHAT = "joints"
 
-    joint: str
+    joint: JointRef
     values: JointValues = field(default_factory=JointValues)
     type: str | None = None
     axis: Vec3 | None = None
@@ -167,16 +165,13 @@ class SetMotor(Op):
     WHAT = "motor"
     EFFECT_NEEDS_READS = False
 
-    joint: str
-    name: str
+    joint: JointRef
+    name: MotorName
     settings: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         motor = Motor(name=self.name, joint=self.joint, settings=dict(self.settings))
         return replace(robot, motors={**robot.motors, self.name: motor})
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("motor", [self.name])
@@ -191,10 +186,7 @@ class RemoveJoint(Op):
 
     WHAT = "joint removal"
 
-    joint: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"),)
+    joint: JointRef
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """At q = 0: the child's inertial joins the parent's (parallel-axis theorem), its
@@ -264,15 +256,12 @@ class AddCutJoint(Op):
     WHAT = "cut joint"
     EFFECT_NEEDS_READS = False
 
-    joint: str
-    parent: str
-    child: str
+    joint: JointName
+    parent: LinkRef
+    child: LinkRef
     type: str = "fixed"
     constraint_axes: tuple[tuple[str | None, Vec3], ...] = ()
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.parent, "parent"), Ref("link", self.child, "child"))
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.joint in names.joints:
@@ -301,14 +290,11 @@ class MoveJointAxisToIntersection(Op):
 
     PHASE = Phase.JOINTS
 
-    joint: str
-    a: str
-    b: str
+    joint: JointRef
+    a: JointRef
+    b: JointRef
 
     WHAT = "move_joint_axis_to_intersection"
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"), Ref("joint", self.a, "a"), Ref("joint", self.b, "b"))
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         import numpy as np
