@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import field
 
 from mpc.ir.record import record
-from mpc.ir.refs import JointRef, LinkOrJointRef, LinkRef, MotorName, SensorName
+from mpc.ir.refs import JointRef, LinkOrJointRef, LinkRef, MotorName, SensorName, SubmechanismName
 from mpc.ir.robot import Pose
 from mpc.ir.span import Span
 
@@ -64,6 +64,6 @@ class CutJoint:
 class Submechanism:
     """A submechanism or exoskeleton (HyRoDyn's terms): its definition as written."""
 
-    name: str
+    name: SubmechanismName
     exoskeleton: bool = False
     definition: Annotations = field(default_factory=dict)

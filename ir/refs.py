@@ -52,6 +52,7 @@ MaterialName = Annotated[str, Ref(("material",), defines=True)]
 MotorName = Annotated[str, Ref(("motor",), defines=True)]
 SensorName = Annotated[str, Ref(("sensor",), defines=True)]
 PoseName = Annotated[str, Ref(("pose",), defines=True)]
+SubmechanismName = Annotated[str, Ref(("submechanism",), defines=True)]
 
 ALIASES: dict[str, Ref] = {name: value.__metadata__[0] for name, value in dict(globals()).items()
                            if name.endswith(("Ref", "Name")) and hasattr(value, "__metadata__")}

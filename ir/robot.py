@@ -242,8 +242,8 @@ class Robot:
 
     name: str
     root: LinkRef
-    links: Mapping[str, Link]
-    joints: Mapping[str, Joint]
+    links: Mapping[LinkName, Link]
+    joints: Mapping[JointName, Joint]
     materials: Mapping[str, Material] = field(default_factory=dict)
     fragments: tuple[Fragment, ...] = ()
     extra_attrs: Attrs = ()

@@ -14,7 +14,7 @@ from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Phase, Ref
 from mpc.ir.record import record
-from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName
+from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName, SubmechanismName
 from mpc.ir.robot import Collision, Material, Pose, Robot
 
 
@@ -405,7 +405,7 @@ class AddSubmechanism(Op):
     WHAT = "submechanism"
     EFFECT_NEEDS_READS = False
 
-    name: str
+    name: SubmechanismName
     exoskeleton: bool = False
     joints: tuple[JointRef, ...] = ()
     links: tuple[LinkRef, ...] = ()
