@@ -65,7 +65,7 @@ NOT_NAMES: dict[tuple[str, str], str] = {
 
 
 def _classes() -> list[type]:
-    found = list(import_all().values()) + [joints.Dependency, joints.JointValues]
+    found = [*import_all().values(), joints.Dependency, joints.JointValues]
     for module in (robot, extras):
         found += [c for c in vars(module).values() if isinstance(c, type) and dataclasses.is_dataclass(c)
                   and c.__module__ == module.__name__]
