@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from mpc.backends.packages import PackageResolver
+from mpc.backends.smurf_format import MATERIAL_COLOURS, MATERIAL_SCALARS, motor_limits
 from mpc.compiler import source
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
@@ -147,8 +148,6 @@ class _Reader:
     # -- categories ------------------------------------------------------------------------
 
     def _motors(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
-        from mpc.backends.smurf import motor_limits
-
         s = self.state
         if not self.known("joint", e.get("joint"), s.joints, (*at, "joint")):
             return
@@ -235,13 +234,11 @@ class _Reader:
             s.links[name] = replace(s.links[name], annotations={**s.links[name].annotations, **e})
 
     def _materials(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
-        from mpc.backends.smurf import _COLOURS, _MATERIAL_SCALARS
-
         s = self.state
         name = e.pop("name")
         old = s.materials.get(name) or Material(name=name, span=self.doc.value_span(at))
         changes: dict[str, Any] = {}
-        for field, key in (("rgba", "diffuseColor"), *_COLOURS):
+        for field, key in (("rgba", "diffuseColor"), *MATERIAL_COLOURS):
             if key in e:
                 colour = e.pop(key)
                 values = tuple(colour[c] for c in "rgba" if c in colour) if isinstance(colour, dict) else ()
@@ -251,7 +248,7 @@ class _Reader:
                                f"{'' if field == 'rgba' else ' (and a)'}, a: numbers")
                     return
                 changes[field] = tuple(float(v) for v in values)
-        for key in _MATERIAL_SCALARS:
+        for key in MATERIAL_SCALARS:
             if key in e:
                 changes[key] = e.pop(key)
         s.materials[name] = replace(old, **changes, annotations={**old.annotations, **e})

@@ -121,10 +121,7 @@ def _summary(sink: Sink) -> str:
 def print_diagnostics(sink: Sink, fmt: str) -> None:
     from mpc.compiler import render
 
-    if fmt == "json":
-        print(render.as_json(sink.diagnostics), file=sys.stderr)
-    elif sink.diagnostics:
-        print((render.gcc if fmt == "gcc" else render.human)(sink.diagnostics), file=sys.stderr)
+    render.print_diagnostics(sink.diagnostics, fmt)
 
 
 def _compile(args: argparse.Namespace) -> int:
@@ -210,12 +207,12 @@ def _test(args: argparse.Namespace) -> int:
 
     from mpc.backends.packages import PackageResolver
     from mpc.checks import run_model_tests
-    from mpc.compiler.driver import InputLoader, Options, apply, compile_model, load_program
+    from mpc.compiler.driver import Options, apply, compile_model, input_loader, load_program
 
     sink = _sink(args)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
     if args.built is not None:
-        loader = InputLoader(sink, options, (args.definition.resolve(),))
+        loader = input_loader(sink, options, (args.definition.resolve(),))
         program = load_program(args.definition, sink, options, loader=loader)
         robot = apply(program, sink, loader) if program is not None else None
         out = args.built

@@ -11,14 +11,12 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
 from mpc.compiler import inherit, schema, source
 from mpc.compiler.diagnostics import Severity, Sink
-from mpc.compiler.inputs import InputLoader
+from mpc.compiler.inputs import InputLoader, Options
 from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
@@ -28,19 +26,6 @@ from mpc.ir.ops.assembly import r2r_origin
 from mpc.ir.program import CommandExport, Export, JointLimitsExport, Program, RobotExport, SubmodelExport
 from mpc.ir.robot import Robot
 from mpc.ir.span import Span
-
-
-@dataclass
-class Options:
-    """How to compile: where outputs go, how packages are found."""
-
-    out: Path | None = None
-    resolver: PackageResolver = field(default_factory=PackageResolver)
-    # Pipeline runs (compiler/pipeline/): the pipeline's defaults, applied to each definition
-    # after its own defaults chain; and where the output goes once the runner moves it from
-    # `out` (a staging folder) into place, which post_processing commands see as their target.
-    defaults: Callable[[source.Document], source.Document] | None = None
-    target: Path | None = None
 
 
 @dataclass
@@ -75,7 +60,7 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
     if program is None or not passes:
         return None if sink.has_errors() else program
-    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
@@ -96,14 +81,21 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
     program = parse(text, str(path), sink)                              # parse the IR
     if program is None or not passes:
         return program
-    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
 
+def input_loader(sink: Sink, options: Options, stack: tuple[Path, ...],
+                 symbolic: bool = False) -> InputLoader:
+    """The loader of one compilation's inputs, which builds derived_base definitions (or finds
+    their names, `symbolic`) with this module's front end."""
+    return InputLoader(sink, options, stack, symbolic, build=build, names_of=names_of)
+
+
 def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
     """The names of another definition's output, found without building it."""
-    loader = InputLoader(sink, options, stack, symbolic=True)
+    loader = input_loader(sink, options, stack, symbolic=True)
     program = front_end(path, sink, options, Severity.WARNING, loader)
     return symbolic(program, PassContext(sink, loader.names, Severity.WARNING)) if program else None
 
@@ -142,7 +134,7 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
 
 def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
     """The robot another definition describes, built in memory (for derived_base)."""
-    loader = InputLoader(sink, options, stack)
+    loader = input_loader(sink, options, stack)
     program = front_end(path, sink, options, Severity.ERROR, loader)
     return apply(program, sink, loader) if program else None
 
@@ -206,7 +198,7 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | N
             BACKENDS[export.type]().emit(model, export, folder, sink)
         if sink.has_errors():
             return False
-        _replace(staging, out)
+        replace_folder(staging, out)
         return True
     finally:
         if staging.exists():
@@ -237,7 +229,7 @@ def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
     return robot
 
 
-def _replace(new: Path, out: Path) -> None:
+def replace_folder(new: Path, out: Path) -> None:
     """Put `new` where `out` is; the old `out` disappears only after `new` is in place."""
     if not out.exists():
         os.replace(new, out)
@@ -255,7 +247,7 @@ def _replace(new: Path, out: Path) -> None:
 def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     result = Result()
-    loader = InputLoader(sink, options, (path.resolve(),))
+    loader = input_loader(sink, options, (path.resolve(),))
     result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
     if result.program is None:
         return result

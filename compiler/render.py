@@ -6,6 +6,7 @@ file it cannot read (it then prints the header line alone).
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
@@ -85,3 +86,12 @@ def summary(diagnostics: list[Diagnostic]) -> str:
     if warnings:
         parts.append(f"{warnings} warning{'s' * (warnings != 1)}")
     return ", ".join(parts)
+
+
+def print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
+    """Print diagnostics on stderr as `--format` asks: human, gcc or json (json even when
+    there are none: a tool reading it gets `[]`)."""
+    if fmt == "json":
+        print(as_json(diagnostics), file=sys.stderr)
+    elif diagnostics:
+        print((gcc if fmt == "gcc" else human)(diagnostics), file=sys.stderr)

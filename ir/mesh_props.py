@@ -22,6 +22,7 @@ from mpc.ir.geometry import (
     ScaleMesh,
     Sphere,
 )
+from mpc.ir.mesh_readers import MESH_READERS
 
 
 class MeshError(Exception):
@@ -45,10 +46,9 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
         if path is None or not path.is_file():
             raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
         try:
-            if path.suffix.lower() == ".bobj":
-                from mpc.backends import bobj
-
-                mesh = bobj.loads(path.read_bytes())
+            reader = MESH_READERS.get(path.suffix.lower())
+            if reader is not None:
+                mesh = reader(path.read_bytes())
             else:
                 mesh = trimesh.load(path, force="mesh", process=False)
             if path.suffix.lower() == ".dae":

@@ -141,6 +141,10 @@ class PdfExport:
     type: Literal["pdf"] = "pdf"
 
 
+# The joint selections a `joint_limits` export may name instead of joints.
+JOINT_SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
+
+
 @record(slots=True, kw_only=True)
 class JointLimitsExport:
     """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED, ABSTRACT or

@@ -24,12 +24,8 @@ class UsageError(Exception):
 
 
 def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
-    if not diagnostics:
-        return
-    if fmt == "json":
-        print(render.as_json(diagnostics), file=sys.stderr)
-    else:
-        print((render.gcc if fmt == "gcc" else render.human)(diagnostics), file=sys.stderr)
+    if diagnostics:  # nothing at all, not even json's `[]`
+        render.print_diagnostics(diagnostics, fmt)
 
 
 def parse_stages(text: str) -> tuple[str, ...]:
