@@ -190,7 +190,7 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | N
                     model = submodels[export.joints_of]  # its joints, written where the entry is
                 if model is not None and export.add_floating_base:
                     model = _floating(model, export, sink)
-                if model is not None and getattr(export, "correct_inertials", False):
+                if model is not None and export.correct_inertials:
                     model = _physical(model, export, sink)
                 if model is None:
                     continue

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from mpc.compiler.passes import PassContext
+from mpc.compiler.passes.context import PassContext
 from mpc.ir.ops import EditNames, Op
 from mpc.ir.program import Program
 

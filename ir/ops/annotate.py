@@ -12,7 +12,7 @@ from dataclasses import field, replace
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Phase, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName, SubmechanismName
 from mpc.ir.robot import Collision, Material, Pose, Robot

@@ -13,7 +13,7 @@ from typing import Any, Literal
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
-from mpc.ir.ops import Effects, Op, Phase, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.refs import JointName, LinkRef
 from mpc.ir.rename import rename_robot, rename_with

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from dataclasses import field, replace
 
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Phase
+from mpc.ir.ops.base import Effects, Op, Phase
 from mpc.ir.record import record
 from mpc.ir.refs import JointName, LinkName, LinkRef, MaterialRef
 from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot

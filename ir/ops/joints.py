@@ -10,7 +10,7 @@ from dataclasses import field, replace
 
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Phase, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
 from mpc.ir.refs import JointName, JointRef, LinkRef, MotorName
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot

@@ -187,25 +187,22 @@ def test_specs_golden_programs_are_in_the_language_order(golden: Path) -> None:
     assert not list(sink)
 
 
-def test_one_clash_of_many_names_is_one_report(tmp_path: Path) -> None:
-    """Attaching a model to itself unrenamed: one E0304 per kind of name, not one per name."""
+def _arm_definition(folder: Path, assemble: str) -> Path:
+    """A definition of the arm (tests/fixtures.py) with this `assemble` section."""
     from tests.conftest import write
     from tests.fixtures import ARM_URDF
 
-    write(tmp_path / "arm.urdf", ARM_URDF)
-    definition = write(tmp_path / "two.yml", """\
-model:
-  robotname: two
-  modelname: two
-  input_models:
-    arm: {basefile: arm.urdf}
-  assemble:
-    model: arm
-    children:
-      - model: arm
-        joint: {parent: lower, name: wrist}
-""")
+    write(folder / "arm.urdf", ARM_URDF)
+    return write(folder / "arm.yml", "model:\n  robotname: arm\n  modelname: arm\n"
+                 "  input_models:\n    arm: {basefile: arm.urdf}\n" + assemble)
+
+
+def test_one_clash_of_many_names_is_one_report(tmp_path: Path) -> None:
+    """Attaching a model to itself unrenamed: one E0304 per kind of name, not one per name."""
     from mpc.compiler.driver import Options, check_file
+
+    definition = _arm_definition(tmp_path, "  assemble:\n    model: arm\n    children:\n"
+                                 "      - model: arm\n        joint: {parent: lower, name: wrist}\n")
 
     sink = Sink()
     check_file(definition, sink, Options())
@@ -219,18 +216,9 @@ model:
 def test_emit_ir_lowered_is_before_the_passes(tmp_path: Path) -> None:
     """`--emit ir-lowered` keeps the dead remove_beyond that `--emit ir` drops."""
     from mpc.compiler.cli import main
-    from tests.conftest import write
-    from tests.fixtures import ARM_URDF
 
-    write(tmp_path / "arm.urdf", ARM_URDF)
-    definition = write(tmp_path / "cut.yml", """\
-model:
-  robotname: cut
-  modelname: cut
-  input_models:
-    arm: {basefile: arm.urdf}
-  assemble: {model: arm, remove_beyond: lower, take_leaf: upper}
-""")
+    definition = _arm_definition(
+        tmp_path, "  assemble: {model: arm, remove_beyond: lower, take_leaf: upper}\n")
     printed = {}
     for emit in ("ir", "ir-lowered"):
         out, errors = io.StringIO(), io.StringIO()
@@ -240,9 +228,9 @@ model:
                if line.startswith("op ")]
         printed[emit] = (ops, errors.getvalue())
     assert printed["ir-lowered"][0] == ['op load_model input="arm"', 'op remove_beyond links=["lower"]',
-                                        'op take_leaf link="upper"', 'op set_robot_name name="cut"']
+                                        'op take_leaf link="upper"', 'op set_robot_name name="arm"']
     assert printed["ir"][0] == ['op load_model input="arm"', 'op take_leaf link="upper"',
-                                'op set_robot_name name="cut"']
+                                'op set_robot_name name="arm"']
     assert ("warning[W0331]: remove_beyond (line 6) has no effect: after take_leaf (line 6) the robot "
             "is the same without it; it is dropped") in printed["ir"][1]
     assert printed["ir-lowered"][1] == ""
