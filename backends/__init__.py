@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import importlib
 from types import ModuleType
-from typing import Any
-
-from mpc.ir.mesh_readers import MESH_READERS
 
 _MODULES = {
     "urdf": "mpc.backends.urdf",
@@ -29,10 +26,3 @@ class _Lazy:
 
 
 BACKENDS: dict[str, _Lazy] = {name: _Lazy(module) for name, module in _MODULES.items()}
-
-
-def _read_bobj(data: bytes) -> Any:  # a trimesh.Trimesh
-    return importlib.import_module("mpc.backends.bobj").loads(data)
-
-
-MESH_READERS[".bobj"] = _read_bobj  # MARS's binary OBJ, for ir/mesh_props.py

@@ -8,6 +8,7 @@ says how to get the PDF.
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -76,6 +77,23 @@ def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
                      "not the PDF", hint=f"apt-get install graphviz, then: dot -Tpdf {gv.name} -o {name}.pdf")
         return
     done = subprocess.run([dot, "-Tpdf", str(gv), "-o", str(out / f"{name}.pdf")],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, env={**os.environ, "TZ": "UTC"})
     if done.returncode != 0:
         sink.error(export.span, "E0506", f"Graphviz could not render {gv.name}: {done.stderr.strip()}")
+        return
+    _fix_creation_date(out / f"{name}.pdf")
+
+
+def _fix_creation_date(pdf: Path) -> None:
+    """Make the PDF byte-stable: cairo stamps it with the time of rendering (and Debian 12's
+    ignores SOURCE_DATE_EPOCH), so the stamp becomes SOURCE_DATE_EPOCH's time, else the epoch.
+    The date keeps its length, so the PDF's cross-reference offsets stay right."""
+    import re
+    import time
+
+    epoch = os.environ.get("SOURCE_DATE_EPOCH", "")
+    stamp = time.strftime("D:%Y%m%d%H%M%SZ", time.gmtime(int(epoch) if epoch.isdigit() else 0))
+    data = pdf.read_bytes()
+    fixed = re.sub(rb"/CreationDate \(D:\d{14}Z\)", b"/CreationDate (" + stamp.encode() + b")", data)
+    if fixed != data:
+        pdf.write_bytes(fixed)

@@ -7,7 +7,8 @@ file it cannot read (it then prints the header line alone).
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager, redirect_stdout
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.source import source_line
@@ -88,10 +89,31 @@ def summary(diagnostics: list[Diagnostic]) -> str:
     return ", ".join(parts)
 
 
-def print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
-    """Print diagnostics on stderr as `--format` asks: human, gcc or json (json even when
-    there are none: a tool reading it gets `[]`)."""
-    if fmt == "json":
-        print(as_json(diagnostics), file=sys.stderr)
-    elif diagnostics:
-        print((gcc if fmt == "gcc" else human)(diagnostics), file=sys.stderr)
+# With `--format json` the diagnostics of a whole command are one JSON document on stdout; what
+# the command prints besides goes to stderr meanwhile (see `json_document`).
+_collected: list[Diagnostic] | None = None
+
+
+def print_diagnostics(diagnostics: Iterable[Diagnostic], fmt: str) -> None:
+    """Diagnostics as `fmt` (human, gcc or json) on stderr, or into the open JSON document."""
+    diags = list(diagnostics)
+    if fmt == "json" and _collected is not None:
+        _collected.extend(diags)
+    elif fmt == "json":
+        print(as_json(diags), file=sys.stderr)
+    elif diags:
+        print((gcc if fmt == "gcc" else human)(diags), file=sys.stderr)
+
+
+@contextmanager
+def json_document() -> Iterator[None]:
+    """Collect what `print_diagnostics` is given as json into one document, printed on stdout
+    at the end (an empty list when there was none); meanwhile stdout goes to stderr."""
+    global _collected
+    stdout, _collected = sys.stdout, []
+    try:
+        with redirect_stdout(sys.stderr):
+            yield
+    finally:
+        collected, _collected = _collected, None
+        print(as_json(collected), file=stdout)
