@@ -53,20 +53,13 @@ class Sink:
     """Collects diagnostics.
 
     werror: warnings count as errors. fail_fast: raise FailFast on the first error.
-    A diagnostic equal to one reported already (the same finding reached twice, e.g. by two
-    passes or two exports of one robot) is kept once.
     """
 
     werror: bool = False
     fail_fast: bool = False
     diagnostics: list[Diagnostic] = field(default_factory=list)
-    _seen: set[tuple[object, ...]] = field(default_factory=set, repr=False)
 
     def report(self, diagnostic: Diagnostic) -> None:
-        key = (diagnostic.severity, diagnostic.code, diagnostic.span, diagnostic.message)
-        if key in self._seen:
-            return
-        self._seen.add(key)
         if self.werror and diagnostic.severity is Severity.WARNING:
             diagnostic = Diagnostic(
                 Severity.ERROR, diagnostic.code, diagnostic.message, diagnostic.span,

@@ -1,4 +1,4 @@
-"""order_ops: put a program's ops in the language's order (specs/assembly.md "Order of operations").
+"""order_ops: put a program's ops in the language's order (specs/passes.md "Order of operations").
 
 Input: a Program whose ops may be written in any order (an IR file). Output: the same ops in
 the order of their phases (`Op.phase`), stably within a phase; the parts of the assembly depth
@@ -88,7 +88,7 @@ def order_ops(program: Program, ctx: PassContext) -> Program:
             ctx.sink.error(later.span, "E0330", f"{later.kind} (line {later.span.line}) is written "
                            f"after {clash.kind} (line {clash.span.line}), but the language runs it "
                            "first, and the two do not give the same robot in either order",
-                           hint="write the ops in the language's order (specs/assembly.md)")
+                           hint="write the ops in the language's order (specs/passes.md)")
             refused = True
             continue
         # Moving past other parts' ops, or past the robot's name, changes nothing one could see.
