@@ -37,7 +37,7 @@ NOT_NAMES: dict[tuple[str, str], str] = {
         ("Joint", "inner_comments"), ("Robot", "header_comments"), ("Robot", "trailing_comments"))},
     **{(cls, "type"): "a joint, sensor or shape type" for cls in (
         "EditJoint", "AddCutJoint", "AddSensor", "Attach", "AddFrame", "Sensor", "CutJoint")},
-    ("EditCollisions", "shape"): "a shape type",
+    ("EditCollisions", "shape"): "a shape type", ("EditCollisions", "join"): "a mode (union)",
     ("ReplaceJointTypes", "mapping"): "joint type → joint type",
     ("AddCutJoint", "constraint_axes"): "names of constrained directions",
     ("CutJoint", "constraint_axes"): "names of constrained directions",
