@@ -12,30 +12,11 @@ paths and the opaque fragments copied from the input are never reformatted.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 
-# The attributes (URDF) and elements (SDF) whose values are numbers the writers write.
-URDF_KEYS = frozenset({
-    "xyz", "rpy", "size", "radius", "length", "scale", "rgba", "value", "ixx", "ixy", "ixz", "iyy",
-    "iyz", "izz", "lower", "upper", "effort", "velocity", "damping", "friction", "multiplier",
-    "offset", "rising", "falling", "reference_position", "soft_lower_limit", "soft_upper_limit",
-    "k_position", "k_velocity"})
-SDF_KEYS = frozenset({
-    "pose", "mass", "ixx", "ixy", "ixz", "iyy", "iyz", "izz", "size", "radius", "length", "scale",
-    "ambient", "diffuse", "specular", "emissive", "transparency", "xyz", "lower", "upper", "effort",
-    "velocity", "damping", "friction"})
-MJCF_KEYS = frozenset({
-    "pos", "quat", "mass", "diaginertia", "size", "axis", "range", "rgba", "scale", "polycoef",
-    "damping", "frictionloss", "actuatorfrcrange", "ctrlrange"})
-KEYS = {"urdf": URDF_KEYS, "sdf": SDF_KEYS, "mjcf": MJCF_KEYS}
-DEFAULT = "default"
-_FORMAT = re.compile(r"%[-+ 0#]*[0-9]{0,2}(\.[0-9]{1,2})?[eEfFgG]")
+from mpc.ir.float_format_keys import DEFAULT, KEYS, MJCF_KEYS, SDF_KEYS, URDF_KEYS, bad_format
 
-
-def bad_format(fmt: str) -> bool:
-    """Whether `fmt` is not a printf format of one floating-point number (`%.6f`, `%g`, …)."""
-    return not _FORMAT.fullmatch(fmt)
+__all__ = ["DEFAULT", "KEYS", "MJCF_KEYS", "SDF_KEYS", "URDF_KEYS", "Formats", "bad_format"]
 
 
 def _one(token: str, fmt: str) -> str:

@@ -35,12 +35,11 @@ import math
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
-from xml.sax.saxutils import escape
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from mpc.backends import meshes
+from mpc.backends import meshes, xml_escape
 from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
@@ -67,7 +66,7 @@ COMPILER: Pairs = [("angle", "radian"), ("autolimits", "true"), ("inertiafromgeo
 
 
 def _attrs(pairs: Pairs) -> str:
-    return "".join(f' {k}="{escape(v, {chr(34): "&quot;"})}"' for k, v in pairs if v is not None)
+    return "".join(f' {k}="{xml_escape.attribute(v)}"' for k, v in pairs if v is not None)
 
 
 def _quat_rpy(rpy: tuple[float, float, float]) -> Quat:

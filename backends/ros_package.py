@@ -13,10 +13,10 @@ wrote; a file a command wrote is kept.
 from __future__ import annotations
 
 from pathlib import Path
-from xml.sax.saxutils import escape
 
 import yaml
 
+from mpc.backends import xml_escape
 from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.program import RosPackageExport
@@ -33,9 +33,9 @@ def package_xml(export: RosPackageExport, robot: Robot) -> str:
 <package format="3">
   <name>{export.package}</name>
   <version>{export.version}</version>
-  <description>{escape(description)}</description>
+  <description>{xml_escape.text(description)}</description>
   {_TODO_MAINTAINER}
-  <license>{escape(export.license or _TODO_LICENSE)}</license>
+  <license>{xml_escape.text(export.license or _TODO_LICENSE)}</license>
 
   <buildtool_depend>ament_cmake</buildtool_depend>
 

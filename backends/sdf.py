@@ -13,9 +13,8 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
-from xml.sax.saxutils import escape
 
-from mpc.backends import meshes
+from mpc.backends import meshes, xml_escape
 from mpc.backends.float_formats import SDF_KEYS, Formats
 from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
@@ -44,7 +43,7 @@ _MASSLESS = Inertial(mass=0.0, inertia=Inertia(ixx=0.0, ixy=0.0, ixz=0.0, iyy=0.
 
 
 def _attr(value: str) -> str:
-    return escape(value, {'"': "&quot;"})
+    return xml_escape.attribute(value)
 
 
 def _is_empty(link: Link) -> bool:
@@ -170,7 +169,7 @@ class _Writer:
     def leaf(self, depth: int, tag: str, value: str) -> None:
         if self.formats is not None:  # float_fmt_dict (backends/float_formats.py)
             value = self.formats(tag, value) or value
-        self.line(depth, f"<{tag}>{escape(value)}</{tag}>")
+        self.line(depth, f"<{tag}>{xml_escape.text(value)}</{tag}>")
 
     def pose(self, depth: int, pose: Pose | None, always: bool = False) -> None:
         if pose is None or (not always and pose.xyz == (0, 0, 0) and pose.rpy == (0, 0, 0)):
@@ -362,7 +361,7 @@ def to_string(robot: Robot, mesh_name: MeshNamer, version: str = "1.9",
 
 def model_config(robot: Robot, version: str = "1.9") -> str:
     """Gazebo's model.config for the model: name, version, the SDF file, a description."""
-    name = escape(robot.name)
+    name = xml_escape.text(robot.name)
     return (f'<?xml version="1.0" encoding="utf-8"?>\n<model>\n{IND}<name>{name}</name>\n'
             f'{IND}<version>1.0</version>\n{IND}<sdf version="{version}">{name}.sdf</sdf>\n'
             f"{IND}<description>The robot '{name}', written by mpc.</description>\n</model>\n")

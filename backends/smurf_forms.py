@@ -1,5 +1,6 @@
-"""Phobos's SMURF value forms ↔ mpc's values: colours, offsets, and the names Phobos gives
-unnamed visuals and collisions. Shared by the SMURF writer and reader; no file access.
+"""Phobos's SMURF value forms ↔ mpc's values: colours, offsets, the names Phobos gives
+unnamed visuals and collisions, the material keys SMURF holds and URDF does not, and what a
+motor takes from its joint. Shared by the SMURF writer and reader; no file access.
 
 Phobos 2.x writes a colour as `{r, g, b, a}` (older releases: a list), a sensor's
 position_offset as `{x, y, z}` and its orientation_offset as a quaternion `{x, y, z, w}`
@@ -12,6 +13,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from typing import Any
+
+from mpc.ir.robot import Robot
+
+# Material fields SMURF holds and URDF does not, with their SMURF (MARS) key.
+MATERIAL_COLOURS = (("ambient", "ambientColor"), ("specular", "specularColor"), ("emissive", "emissionColor"))
+MATERIAL_SCALARS = ("shininess", "transparency", "normal_texture")
+MOTOR_TYPE = "position"  # Phobos's default control type of a motor
 
 
 def number(value: Any) -> bool:
@@ -81,3 +89,14 @@ def shape_names(link: str, kind: str, names: Sequence[str | None]) -> list[str]:
             seen[name] = 0
         out.append(name)
     return out
+
+
+def motor_limits(robot: Robot, joint: str) -> dict[str, float]:
+    """maxEffort, maxSpeed, maxValue and minValue of a motor: its joint's limits (Phobos)."""
+    j = robot.joints.get(joint)
+    limit = j.limit if j is not None else None
+    if limit is None:
+        return {}
+    values = {"maxEffort": limit.effort, "maxSpeed": limit.velocity, "maxValue": limit.upper,
+              "minValue": limit.lower}
+    return {k: v for k, v in values.items() if v is not None}

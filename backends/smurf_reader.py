@@ -22,7 +22,18 @@ from pathlib import Path
 from typing import Any
 
 from mpc.backends.packages import PackageResolver
-from mpc.backends.smurf_forms import colour_in, floats, number, orientation_in, position_in, shape_names
+from mpc.backends.smurf_forms import (
+    MATERIAL_COLOURS,
+    MATERIAL_SCALARS,
+    MOTOR_TYPE,
+    colour_in,
+    floats,
+    motor_limits,
+    number,
+    orientation_in,
+    position_in,
+    shape_names,
+)
 from mpc.compiler import source
 from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
@@ -154,8 +165,6 @@ class _Reader:
     # -- categories ------------------------------------------------------------------------
 
     def _motors(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
-        from mpc.backends.smurf import MOTOR_TYPE, motor_limits
-
         s = self.state
         if not self.known("joint", e.get("joint"), s.joints, (*at, "joint")):
             return
@@ -273,8 +282,6 @@ class _Reader:
             s.links[name] = replace(s.links[name], annotations={**s.links[name].annotations, **e})
 
     def _materials(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
-        from mpc.backends.smurf import _COLOURS, _MATERIAL_SCALARS
-
         s = self.state
         name = e.pop("name")
         if name == "None" and not e and name not in s.materials:
@@ -283,7 +290,7 @@ class _Reader:
             return
         old = s.materials.get(name) or Material(name=name, span=self.doc.value_span(at))
         changes: dict[str, Any] = {}
-        for field, key in (("rgba", "diffuseColor"), *_COLOURS):
+        for field, key in (("rgba", "diffuseColor"), *MATERIAL_COLOURS):
             if key in e:
                 values = colour_in(e.pop(key), (4,) if field == "rgba" else (3, 4))
                 if values is None:
@@ -291,7 +298,7 @@ class _Reader:
                                f"{', a' if field == 'rgba' else ' (and a)'}: numbers, as a mapping or a list")
                     return
                 changes[field] = values
-        for key in _MATERIAL_SCALARS:
+        for key in MATERIAL_SCALARS:
             if key in e:
                 changes[key] = e.pop(key)
         rgba = changes.get("rgba", old.rgba)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from mpc.backends import xml_escape
 from mpc.backends.float_formats import Formats
 from mpc.backends.xml import fmt_float, fmt_floats
 from mpc.ir.fragments import Fragment
@@ -22,15 +23,8 @@ MeshNamer = Callable[[Mesh], str]
 IND = "  "
 
 
-def _escape(v: str) -> str:
-    """What xml.sax.saxutils.escape(v, {'"': "&quot;", "\\n": "&#10;", "\\t": "&#9;"}) gives; saxutils imports
-    urllib.request and http.client, which `mpc check` (it imports this module through urdf.py) never uses."""
-    return (v.replace("&", "&amp;").replace(">", "&gt;").replace("<", "&lt;").replace('"', "&quot;")
-            .replace("\n", "&#10;").replace("\t", "&#9;"))
-
-
 def _attrs(pairs: list[tuple[str, str | None]] | Attrs) -> str:
-    return "".join(f' {k}="{_escape(v)}"' for k, v in pairs if v is not None)
+    return "".join(f' {k}="{xml_escape.attribute(v)}"' for k, v in pairs if v is not None)
 
 
 def _num(x: float | None) -> str | None:

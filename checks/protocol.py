@@ -12,7 +12,8 @@ import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
-from xml.sax.saxutils import escape, quoteattr
+
+from mpc.backends import xml_escape
 
 Status = Literal["passed", "failed", "waived", "skipped"]
 # Characters XML 1.0 cannot hold, even escaped (a library's console may print them).
@@ -188,11 +189,11 @@ def vector_text(v: object) -> str:
 
 def _xml_text(text: str) -> str:
     """`text` escaped for XML content, with characters XML cannot hold dropped."""
-    return escape(_NOT_XML.sub("", text))
+    return xml_escape.text(_NOT_XML.sub("", text))
 
 
 def _xml_attribute(text: str) -> str:
-    return quoteattr(_NOT_XML.sub("", text))
+    return '"' + xml_escape.attribute(_NOT_XML.sub("", text)) + '"'
 
 
 def _figure(r: Result) -> str:

@@ -24,10 +24,9 @@ ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity
 
 def apply_program(program: Program, sink: Sink) -> Robot | None:
     """The robot the program describes (its inputs read, its ops run), or None."""
-    from mpc.compiler.driver import Options, apply
-    from mpc.compiler.inputs import InputLoader
+    from mpc.compiler.driver import Options, apply, input_loader
 
-    loader = InputLoader(sink, Options(), (Path(program.span.file).resolve(),))
+    loader = input_loader(sink, Options(), (Path(program.span.file).resolve(),))
     return apply(program, sink, loader)
 
 

@@ -55,8 +55,9 @@ def _parser() -> argparse.ArgumentParser:
     comp = sub.add_parser("compile", help="compile a model definition into model files")
     comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
-    comp.add_argument("--emit", choices=("files", "ir"), default="files",
-                      help="what to produce: the model files (default) or the IR as text on stdout")
+    comp.add_argument("--emit", choices=("files", "ir", "ir-lowered"), default="files",
+                      help="what to produce: the model files (default), or the IR as text on stdout: "
+                           "after the passes (ir) or as lowered, before them (ir-lowered)")
     check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")
@@ -128,11 +129,11 @@ def _compile(args: argparse.Namespace) -> int:
 
     sink = _sink(args)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
-    if args.emit == "ir":
+    if args.emit in ("ir", "ir-lowered"):
         from mpc.compiler.driver import load_program
         from mpc.ir.text import dump
 
-        program = load_program(args.definition, sink, options)
+        program = load_program(args.definition, sink, options, passes=args.emit == "ir")
         print_diagnostics(sink, args.format)
         if program is None:
             return 1
@@ -206,12 +207,12 @@ def _test(args: argparse.Namespace) -> int:
 
     from mpc.backends.packages import PackageResolver
     from mpc.checks import run_model_tests
-    from mpc.compiler.driver import InputLoader, Options, apply, compile_model, load_program
+    from mpc.compiler.driver import Options, apply, compile_model, input_loader, load_program
 
     sink = _sink(args)
     options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
     if args.built is not None:
-        loader = InputLoader(sink, options, (args.definition.resolve(),))
+        loader = input_loader(sink, options, (args.definition.resolve(),))
         program = load_program(args.definition, sink, options, loader=loader)
         robot = apply(program, sink, loader) if program is not None else None
         out = args.built

@@ -12,15 +12,13 @@ import glob
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
 from mpc.compiler import inherit, schema, source
 from mpc.compiler.diagnostics import Severity, Sink
 from mpc.compiler.files import OutsideOutput, confined, describe
-from mpc.compiler.inputs import InputLoader
+from mpc.compiler.inputs import InputLoader, Options
 from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
@@ -33,19 +31,6 @@ from mpc.ir.span import Span
 
 
 @dataclass
-class Options:
-    """How to compile: where outputs go, how packages are found."""
-
-    out: Path | None = None
-    resolver: PackageResolver = field(default_factory=PackageResolver)
-    # Pipeline runs (compiler/pipeline/): the pipeline's defaults, applied to each definition
-    # after its own defaults chain; and where the output goes once the runner moves it from
-    # `out` (a staging folder) into place, which post_processing commands see as their target.
-    defaults: Callable[[source.Document], source.Document] | None = None
-    target: Path | None = None
-
-
-@dataclass
 class Result:
     """What a compilation produced: the program, the robot and the output folder."""
 
@@ -55,11 +40,13 @@ class Result:
 
 
 def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
-              loader: InputLoader | None = None, doc: source.Document | None = None) -> Program | None:
+              loader: InputLoader | None = None, doc: source.Document | None = None,
+              passes: bool = True) -> Program | None:
     """Load, resolve defaults, validate, lower and run passes; the program or None.
 
     later: how to report what compiling does not support yet (check: a warning).
     doc: the file, when the caller loaded it already.
+    passes: False: the program as lowered (`--emit ir-lowered`), the passes not run.
     """
     doc = doc or source.load(path, sink)                                  # load sources
     if doc is None:
@@ -73,18 +60,19 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     if ast is None:
         return None
     program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
-    if program is None:
-        return None
-    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    if program is None or not passes:
+        return None if sink.has_errors() else program
+    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
 
 def load_program(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
-                 loader: InputLoader | None = None) -> Program | None:
-    """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints)."""
+                 loader: InputLoader | None = None, passes: bool = True) -> Program | None:
+    """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints);
+    passes: False: as lowered or parsed, the passes (compiler/passes/) not run."""
     if path.suffix != ".ir":
-        return front_end(path, sink, options, later, loader)
+        return front_end(path, sink, options, later, loader, passes=passes)
     from mpc.ir.text import parse
 
     try:
@@ -95,7 +83,9 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
     program = parse(text, str(path), sink)                              # parse the IR
     if program is None or not check_output_names(program, sink):
         return None
-    loader = loader or InputLoader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    if not passes:
+        return program
+    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
     return None if sink.has_errors() else program
 
@@ -120,9 +110,16 @@ def check_output_names(program: Program, sink: Sink) -> bool:
     return ok
 
 
+def input_loader(sink: Sink, options: Options, stack: tuple[Path, ...],
+                 symbolic: bool = False) -> InputLoader:
+    """The loader of one compilation's inputs, which builds derived_base definitions (or finds
+    their names, `symbolic`) with this module's front end."""
+    return InputLoader(sink, options, stack, symbolic, build=build, names_of=names_of)
+
+
 def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
     """The names of another definition's output, found without building it."""
-    loader = InputLoader(sink, options, stack, symbolic=True)
+    loader = input_loader(sink, options, stack, symbolic=True)
     program = front_end(path, sink, options, Severity.WARNING, loader)
     return symbolic(program, PassContext(sink, loader.names, Severity.WARNING)) if program else None
 
@@ -161,7 +158,7 @@ def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
 
 def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
     """The robot another definition describes, built in memory (for derived_base)."""
-    loader = InputLoader(sink, options, stack)
+    loader = input_loader(sink, options, stack)
     program = front_end(path, sink, options, Severity.ERROR, loader)
     return apply(program, sink, loader) if program else None
 
@@ -212,7 +209,7 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | N
         if not _emit_exports(program, robot, staging, out, sink, target):
             return False
         step = "move the build into place"
-        _replace(staging, out)
+        replace_folder(staging, out)
         return True
     except OSError as e:
         sink.error(program.span, "E0660",
@@ -286,7 +283,7 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
                 model = submodels[export.joints_of]  # its joints, written where the entry is
             if model is not None and export.add_floating_base:
                 model = _floating(model, export, sink)
-            if model is not None and getattr(export, "correct_inertials", False):
+            if model is not None and export.correct_inertials:
                 model = _physical(model, export, sink)
             if model is None:
                 continue
@@ -319,7 +316,7 @@ def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
     return robot
 
 
-def _replace(new: Path, out: Path) -> None:
+def replace_folder(new: Path, out: Path) -> None:
     """Put `new` where `out` is; the old `out` disappears only after `new` is in place."""
     if not out.exists():
         os.replace(new, out)
@@ -338,7 +335,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     result = Result()
     try:
-        loader = InputLoader(sink, options, (path.resolve(),))
+        loader = input_loader(sink, options, (path.resolve(),))
         result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
         if result.program is None:
             return result

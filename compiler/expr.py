@@ -14,6 +14,7 @@ from functools import cache
 from typing import TYPE_CHECKING
 
 from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
 from mpc.compiler.source import source_line
 from mpc.ir.record import record
 from mpc.ir.span import Span
@@ -30,61 +31,6 @@ FUNCTIONS: dict[str, tuple[int, int | None, Callable[..., float]]] = {
     "asin": (1, 1, math.asin), "acos": (1, 1, math.acos), "atan": (1, 1, math.atan),
     "atan2": (2, 2, math.atan2), "abs": (1, 1, math.fabs), "min": (2, None, min), "max": (2, None, max),
 }
-
-
-# Nodes. `start`/`end` are 0-based offsets into the expression text (end exclusive);
-# the evaluator turns them into file spans, since the parser never sees the file.
-
-@record(slots=True)
-class Num:
-    """A number literal; value: its float value."""
-
-    value: float
-    start: int
-    end: int
-
-
-@record(slots=True)
-class Name:
-    """A bare name; id: as written (only the constants in CONSTANTS evaluate)."""
-
-    id: str
-    start: int
-    end: int
-
-
-@record(slots=True)
-class Unary:
-    """A sign applied to an operand; op: '+' or '-'."""
-
-    op: str
-    operand: Node
-    start: int
-    end: int
-
-
-@record(slots=True)
-class Binary:
-    """left op right; op: one of + - * / **."""
-
-    op: str
-    left: Node
-    right: Node
-    start: int
-    end: int
-
-
-@record(slots=True)
-class Call:
-    """func(args...); func: the name as written, args: the argument expressions in order."""
-
-    func: str
-    args: tuple[Node, ...]
-    start: int
-    end: int
-
-
-Node = Num | Name | Unary | Binary | Call
 
 
 @cache

@@ -10,7 +10,7 @@ from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 from lark.tree import Meta
 
-from mpc.compiler.expr import Binary, Call, Name, Node, Num, Unary
+from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
 
 _CHAR_HINTS = {"^": "use ** for powers", "π": "write pi"}
 

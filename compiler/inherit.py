@@ -119,11 +119,11 @@ def _merge_chain(doc: Document, chain: list[Document]) -> Document:
     """`doc` with the `default_model`s of `chain` (nearest first) merged under its `model`."""
     out = Document(doc.file, None)
     src_path: Path_ = ("default_model",)
-    model = _copy(chain[-1].data["default_model"], chain[-1], src_path, ("model",), out)
+    model = copy_value(chain[-1].data["default_model"], chain[-1], src_path, ("model",), out)
     for layer in reversed(chain[:-1]):
-        model = _merge(model, layer.data["default_model"], layer, src_path, ("model",), out)
+        model = merge_value(model, layer.data["default_model"], layer, src_path, ("model",), out)
     if "model" in doc.data:
-        model = _merge(model, doc.data["model"], doc, ("model",), ("model",), out)
+        model = merge_value(model, doc.data["model"], doc, ("model",), ("model",), out)
         model_key = doc.keys.get(("model",))
     else:
         model_key = chain[0].keys.get(("default_model",))
@@ -132,60 +132,60 @@ def _merge_chain(doc: Document, chain: list[Document]) -> Document:
     data: dict[str, Any] = {"model": model}
     for key, value in doc.data.items():
         if key not in ("defaults", "model"):
-            data[key] = _copy(value, doc, (key,), (key,), out)
+            data[key] = copy_value(value, doc, (key,), (key,), out)
             _set(out.keys, (key,), doc.keys.get((key,)))
     _set(out.values, (), doc.values.get(()))
     out.data = data
     return out
 
 
-def _merge(old: Any, new: Any, src: Document, src_path: Path_, out_path: Path_, out: Document) -> Any:
+def merge_value(old: Any, new: Any, src: Document, src_path: Path_, out_path: Path_, out: Document) -> Any:
     """`new` (at `src_path` in `src`) over `old` (already at `out_path` in `out`), per the merge rule."""
     if isinstance(old, dict) and isinstance(new, dict):
         result = dict(old)
         for key, value in new.items():
             sub, sub_src = (*out_path, key), (*src_path, key)
             if key in old:
-                result[key] = _merge(old[key], value, src, sub_src, sub, out)
+                result[key] = merge_value(old[key], value, src, sub_src, sub, out)
             else:
-                result[key] = _copy(value, src, sub_src, sub, out)
+                result[key] = copy_value(value, src, sub_src, sub, out)
             _set(out.keys, sub, src.keys.get(sub_src))
     elif isinstance(old, list) and isinstance(new, list):
-        result = old + [_copy(item, src, (*src_path, i), (*out_path, len(old) + i), out)
+        result = old + [copy_value(item, src, (*src_path, i), (*out_path, len(old) + i), out)
                         for i, item in enumerate(new)]
     else:
-        _forget(old, out_path, out)
-        return _copy(new, src, src_path, out_path, out)
+        forget_spans(old, out_path, out)
+        return copy_value(new, src, src_path, out_path, out)
     # A merged container is attributed to the nearer file, where the user last wrote it.
     _set(out.values, out_path, src.values.get(src_path))
     return result
 
 
-def _copy(value: Any, src: Document, src_path: Path_, out_path: Path_, out: Document) -> Any:
+def copy_value(value: Any, src: Document, src_path: Path_, out_path: Path_, out: Document) -> Any:
     """A fresh copy of `value`, recording its spans (and those of everything in it) at `out_path`."""
     _set(out.values, out_path, src.values.get(src_path))
     if isinstance(value, dict):
         result = {}
         for key, item in value.items():
             _set(out.keys, (*out_path, key), src.keys.get((*src_path, key)))
-            result[key] = _copy(item, src, (*src_path, key), (*out_path, key), out)
+            result[key] = copy_value(item, src, (*src_path, key), (*out_path, key), out)
         return result
     if isinstance(value, list):
-        return [_copy(item, src, (*src_path, i), (*out_path, i), out) for i, item in enumerate(value)]
+        return [copy_value(item, src, (*src_path, i), (*out_path, i), out) for i, item in enumerate(value)]
     return value
 
 
-def _forget(value: Any, path: Path_, out: Document) -> None:
+def forget_spans(value: Any, path: Path_, out: Document) -> None:
     """Drop the spans below `path` of a value that is being replaced."""
     if isinstance(value, dict):
         for key, item in value.items():
             out.keys.pop((*path, key), None)
             out.values.pop((*path, key), None)
-            _forget(item, (*path, key), out)
+            forget_spans(item, (*path, key), out)
     elif isinstance(value, list):
         for i, item in enumerate(value):
             out.values.pop((*path, i), None)
-            _forget(item, (*path, i), out)
+            forget_spans(item, (*path, i), out)
 
 
 def _set(table: dict[Path_, Span], path: Path_, span: Span | None) -> None:
@@ -220,7 +220,7 @@ def _substitute(doc: Document, sink: Sink) -> Document:
                 _unknown(name, model, at, sink)
                 return value
             changed = True
-            result = _copy(model[name], doc, ("model", name), path, out)
+            result = copy_value(model[name], doc, ("model", name), path, out)
             # The value keeps the span of the `@key@`; what is inside it, the spans where it was written.
             out.values[path] = at
             return result

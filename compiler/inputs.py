@@ -7,17 +7,35 @@ of derived_base definitions is a diagnostic naming the loop.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
 
+from mpc.backends.packages import PackageResolver
+from mpc.compiler import source
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 from mpc.ir.robot import Robot
 
-if TYPE_CHECKING:
-    from mpc.compiler.driver import Options
+
+@dataclass
+class Options:
+    """How to compile: where outputs go, how packages are found."""
+
+    out: Path | None = None
+    resolver: PackageResolver = field(default_factory=PackageResolver)
+    # Pipeline runs (compiler/pipeline/): the pipeline's defaults, applied to each definition
+    # after its own defaults chain; and where the output goes once the runner moves it from
+    # `out` (a staging folder) into place, which post_processing commands see as their target.
+    defaults: Callable[[source.Document], source.Document] | None = None
+    target: Path | None = None
+
+
+# How a derived_base definition is built, or its names found (compiler/driver.py's `build` and
+# `names_of`, handed to the loader so that loading inputs does not import the driver).
+Build = Callable[[Path, Sink, Options, tuple[Path, ...]], Robot | None]
+FindNames = Callable[[Path, Sink, Options, tuple[Path, ...]], Names | None]
 
 
 @dataclass
@@ -26,12 +44,16 @@ class InputLoader:
 
     stack: the definitions being compiled, outermost first (to find cycles).
     symbolic: find the names of derived_base inputs without building them (`mpc check`).
+    build, names_of: how a derived_base definition is built or its names found
+        (compiler/driver.py `input_loader` gives them).
     """
 
     sink: Sink
     options: Options
     stack: tuple[Path, ...] = ()
     symbolic: bool = False
+    build: Build | None = None
+    names_of: FindNames | None = None
     _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
     _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
 
@@ -58,8 +80,6 @@ class InputLoader:
         return self._robots[key]
 
     def _load(self, inp: Input) -> Robot | None:
-        from mpc.compiler import driver
-
         if inp.kind == "basefile":
             if inp.path is None:  # its package was not found; reported when lowering
                 return None
@@ -68,7 +88,8 @@ class InputLoader:
             assert inp.path is not None
             if self._cycle(inp):
                 return None
-            return driver.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
+            assert self.build is not None, "derived_base inputs need driver.input_loader's loader"
+            return self.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
         path = self._repo_file(inp, fetch=True)
         return None if path is None else self._read(path, inp)
 
@@ -110,13 +131,12 @@ class InputLoader:
         return self._names[key]
 
     def _load_names(self, inp: Input) -> Names | None:
-        from mpc.compiler import driver
-
         if inp.kind == "derived_base" and self.symbolic:
             assert inp.path is not None
             if self._cycle(inp):
                 return None
-            return driver.names_of(inp.path, self.sink, self.options, (*self.stack, inp.path))
+            assert self.names_of is not None, "derived_base inputs need driver.input_loader's loader"
+            return self.names_of(inp.path, self.sink, self.options, (*self.stack, inp.path))
         if inp.kind == "repo" and self._repo_file(inp, fetch=False) is None:
             return None  # `mpc check` does not clone; names are checked once it is cached
         robot = self.robot(inp)

@@ -22,7 +22,7 @@ from mpc.compiler.schema.base import (
     LiteralType,
     Node,
     NodeType,
-    Optional,
+    OptionalType,
     StrType,
     TaggedType,
     Type,
@@ -89,7 +89,7 @@ def _node(cls: type[Node], defs: dict[str, Any]) -> dict[str, Any]:
 
 def _is_ref(t: Type) -> bool:
     """Fields that are one node (or nothing) take their title from the node."""
-    return isinstance(t.inner if isinstance(t, Optional) else t, NodeType)
+    return isinstance(t.inner if isinstance(t, OptionalType) else t, NodeType)
 
 
 def _ref(cls: type[Node], defs: dict[str, Any]) -> dict[str, Any]:
@@ -102,7 +102,7 @@ def _ref(cls: type[Node], defs: dict[str, Any]) -> dict[str, Any]:
 def _type(t: Type, defs: dict[str, Any]) -> dict[str, Any]:
     if isinstance(t, Wrapped):
         return dict(t.json) if t.json is not None else _type(t.inner, defs)
-    if isinstance(t, Optional):
+    if isinstance(t, OptionalType):
         inner = _type(t.inner, defs)
         return {"anyOf": [*inner["anyOf"], {"type": "null"}]} if list(inner) == ["anyOf"] \
             else {"anyOf": [inner, {"type": "null"}]}

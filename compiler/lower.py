@@ -22,7 +22,7 @@ from mpc.compiler.lower_deploy import lower_model_deployment
 from mpc.compiler.lower_edits import EditLowering
 from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import Definition
-from mpc.compiler.schema.assembly import AssembleChild, AttachJoint, NameEditing, _Part
+from mpc.compiler.schema.assembly import AssembleChild, AssemblyEntry, AttachJoint, NameEditing
 from mpc.compiler.schema.base import Node
 from mpc.ir.naming import LINK_SUFFIX, SCOPES, NameRule, bad_pattern, edit_name, takes_link_suffix
 from mpc.ir.ops import (
@@ -66,7 +66,7 @@ def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Pat
     return (base_dir / written).resolve()
 
 
-class _Lowering:
+class Lowering:
     def __init__(self, ast: Definition, base_dir: Path, sink: Sink, resolver: PackageResolver,
                  later: Severity) -> None:
         self.model, self.base_dir, self.sink = ast.model, base_dir, sink
@@ -193,7 +193,7 @@ class _Lowering:
                                       replacements=tuple(pairs)))
         return tuple(rules)
 
-    def part(self, node: _Part, part: str, inputs: dict[str, Input]) -> None:
+    def part(self, node: AssemblyEntry, part: str, inputs: dict[str, Input]) -> None:
         if node.model not in inputs:
             self.sink.error(node.value_span("model"), "E0301",
                             f"model '{node.model}' in {node.SECTION} is not one of the input models "
@@ -420,7 +420,7 @@ class _Lowering:
 
     def float_formats(self, entry: Any) -> tuple[tuple[str, str], ...]:
         """`float_fmt_dict` of a urdf, sdf or mjcf entry, checked (backends/float_formats.py); sorted."""
-        from mpc.backends.float_formats import DEFAULT, KEYS, bad_format
+        from mpc.ir.float_format_keys import DEFAULT, KEYS, bad_format
 
         keys = KEYS[entry.type]
         out = []
@@ -553,7 +553,7 @@ class _Lowering:
         if entry.type == "pdf":
             return PdfExport(span=entry.span)
         joints = tuple(entry.joints)
-        from mpc.backends.joint_limits import SELECTIONS
+        from mpc.ir.program import JOINT_SELECTIONS as SELECTIONS
 
         # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
         submodels = {e.name for e in self.entries() if e.type == "submodel"}
@@ -630,5 +630,5 @@ def _item_span(node: Node, key: str, i: int) -> Span:
 def lower(ast: Definition, base_dir: Path, sink: Sink, resolver: PackageResolver,
           later: Severity = Severity.ERROR) -> Program | None:
     """The program of a validated definition file in `base_dir`; None after errors."""
-    return _Lowering(ast, base_dir, sink, resolver, later).program()
+    return Lowering(ast, base_dir, sink, resolver, later).program()
 

@@ -17,7 +17,7 @@ from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
 from mpc.ir import ops
 
 if TYPE_CHECKING:
-    from mpc.compiler.lower import _Lowering
+    from mpc.compiler.lower import Lowering
     from mpc.ir.ops import SetMotor
     from mpc.ir.ops.joints import JointValues
 
@@ -31,9 +31,9 @@ def _spans(node: Node, *keys: str) -> dict[str, Any]:
 
 
 class EditLowering:
-    """Appends the ops of the editing sections to a _Lowering's op list."""
+    """Appends the ops of the editing sections to a Lowering's op list."""
 
-    def __init__(self, lw: _Lowering) -> None:
+    def __init__(self, lw: Lowering) -> None:
         self.lw, self.model, self.sink = lw, lw.model, lw.sink
 
     def add(self, op: Any) -> None:

@@ -44,9 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from mpc.compiler.cli import print_diagnostics
     from mpc.compiler.diagnostics import Severity, Sink
     from mpc.compiler.driver import Options, load_program
+    from mpc.compiler.render import print_diagnostics
     from mpc.deploy.model import deploy_model
 
     sink = Sink()
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     if program is not None and settings is not None and not sink.has_errors():
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
                               tests_failed=args.tests_failed)
-    print_diagnostics(sink, args.format)
+    print_diagnostics(sink.diagnostics, args.format)
     if result is None or not result.ok:
         print(f"error: could not deploy '{args.definition}'", file=sys.stderr)
         return 1

@@ -166,7 +166,7 @@ MANIFEST = """<package>
 
 def write_manifest(clone: Path, modelname: str, robotname: str, mention: tuple[str, ...]) -> bool:
     """An autoproj manifest.xml when the clone has none (no maintainer URL is made up)."""
-    from xml.sax.saxutils import escape
+    from mpc.backends.xml_escape import text as escape
 
     path = clone / "manifest.xml"
     if path.exists() or path.is_symlink():

@@ -10,46 +10,13 @@
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import Protocol
 
-from mpc.deploy.gitcmd import scrub
+from mpc.deploy.merge_request import MergeRequest
 
 # A push option travels as one pkt-line (at most 65516 bytes); keep well below.
 MAX_OPTION_BYTES = 60000
 _GITLAB_MR_URL = re.compile(r"remote:\s+(https?://\S+/merge_requests/\d+)")
-
-
-@dataclass(frozen=True)
-class MergeRequest:
-    """A merge request from `source` into `target` of the repository at `remote`."""
-
-    remote: str
-    source: str
-    target: str
-    title: str
-    description: str
-    mention: tuple[str, ...]
-
-
-def merge_request(remote: str, source: str, target: str, title: str, text: str, mention: tuple[str, ...],
-                  protocol: str | None, footer: str) -> MergeRequest:
-    """The request from `source` into `target`, its description made by `describe`; the title
-    without credentials too."""
-    return MergeRequest(remote, source, target, scrub(title), describe(text, mention, protocol, footer),
-                        mention)
-
-
-def describe(text: str, mention: tuple[str, ...], protocol: str | None, footer: str) -> str:
-    """The description: the definition's text, the mentions, the test protocol, the footer;
-    without credentials, should the protocol quote an address or a token."""
-    parts = [text.strip()]
-    if mention:
-        parts.append(" ".join(mention))
-    if protocol and protocol.strip():
-        parts.append(protocol.strip())
-    parts.append(footer)
-    return scrub("\n\n".join(parts) + "\n").replace("\0", "")
 
 
 class ForgeAdapter(Protocol):

@@ -17,8 +17,8 @@ import urllib.parse
 import urllib.request
 from typing import Any
 
-from mpc.deploy.forges import MergeRequest
 from mpc.deploy.gitcmd import DeployError
+from mpc.deploy.merge_request import MergeRequest
 
 TOKEN_VARIABLES = ("GITHUB_TOKEN", "GH_TOKEN")
 TIMEOUT = 30

@@ -9,8 +9,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from mpc.deploy import content, lfs, submodules
-from mpc.deploy.forges import adapter, merge_request
+from mpc.deploy.forges import adapter
 from mpc.deploy.gitcmd import scrub, without_credentials
+from mpc.deploy.merge_request import merge_request
 from mpc.deploy.names import check_address
 from mpc.deploy.plan import Plan
 from mpc.deploy.provenance import Provenance, footer

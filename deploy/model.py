@@ -15,8 +15,9 @@ from pathlib import Path
 
 from mpc.compiler.diagnostics import Sink
 from mpc.deploy import content, lfs, names, submodules
-from mpc.deploy.forges import adapter, merge_request
+from mpc.deploy.forges import adapter
 from mpc.deploy.gitcmd import DeployError, scrub
+from mpc.deploy.merge_request import merge_request
 from mpc.deploy.plan import Plan, check_plan_branches, do_not_deploy, make_plan
 from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
 from mpc.deploy.repository import Clone, locked, open_clone, publish

@@ -16,8 +16,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from mpc.deploy.forges import ForgeAdapter, MergeRequest
+from mpc.deploy.forges import ForgeAdapter
 from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git, without_credentials
+from mpc.deploy.merge_request import MergeRequest
 
 ATTEMPTS = 3
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from mpc.deploy.forges import ForgeAdapter, MergeRequest
+from mpc.deploy.forges import ForgeAdapter
 from mpc.deploy.gitcmd import scrub
+from mpc.deploy.merge_request import MergeRequest
 from mpc.deploy.repository import Published
 
 

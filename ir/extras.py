@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from dataclasses import field
 
 from mpc.ir.record import record
+from mpc.ir.refs import JointRef, LinkOrJointRef, LinkRef, MotorName, SensorName, SubmechanismName
 from mpc.ir.robot import Pose
 from mpc.ir.span import Span
 
@@ -21,8 +22,8 @@ Annotations = Mapping[str, object]
 class Motor:
     """A motor driving `joint`; settings: controller gains and limits as written (p, i, d, …)."""
 
-    name: str
-    joint: str
+    name: MotorName
+    joint: JointRef
     settings: Annotations = field(default_factory=dict)
 
 
@@ -30,12 +31,12 @@ class Motor:
 class Sensor:
     """A sensor of `type` on `link` (or `joint`), or over `targets` (joints or links)."""
 
-    name: str
+    name: SensorName
     type: str
-    link: str | None = None
-    joint: str | None = None
-    frame: str | None = None
-    targets: tuple[str, ...] = ()
+    link: LinkRef | None = None
+    joint: JointRef | None = None
+    frame: LinkRef | None = None
+    targets: tuple[LinkOrJointRef, ...] = ()
     position_offset: Vec3 | None = None
     orientation_offset: tuple[float, ...] | None = None
     annotations: Annotations = field(default_factory=dict)
@@ -51,8 +52,8 @@ class CutJoint:
 
     name: str
     type: str
-    parent: str
-    child: str
+    parent: LinkRef
+    child: LinkRef
     origin: Pose
     constraint_axes: tuple[tuple[str | None, Vec3], ...] = ()
     annotations: Annotations = field(default_factory=dict)
@@ -63,6 +64,6 @@ class CutJoint:
 class Submechanism:
     """A submechanism or exoskeleton (HyRoDyn's terms): its definition as written."""
 
-    name: str
+    name: SubmechanismName
     exoskeleton: bool = False
     definition: Annotations = field(default_factory=dict)

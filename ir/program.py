@@ -53,8 +53,20 @@ class Input:
     xacro_args: tuple[tuple[str, str], ...] = ()
 
 
+class ExportEntry:
+    """The base of every export record: an `export_config` entry, or what mpc adds (the SMURF,
+    the ROS package files, a post_processing command). Each is a record of its own fields; this
+    says what every one has (`span`, its `type`) and the defaults of what only some do, so that
+    the driver asks any export the same questions."""
+
+    __slots__ = ()
+    span: Span
+    type: str
+    correct_inertials: bool = False  # make non-physical inertials physical first (URDF, SDF, MJCF)
+
+
 @record(slots=True, kw_only=True)
-class UrdfExport:
+class UrdfExport(ExportEntry):
     """A `type: urdf` entry of export_config.
 
     mesh_format: the format of the meshes it references (`input_type` keeps each
@@ -91,7 +103,7 @@ class UrdfExport:
 
 
 @record(slots=True, kw_only=True)
-class SdfExport:
+class SdfExport(ExportEntry):
     """A `type: sdf` entry: SDFormat `version`, meshes in `mesh_format`; `link_in_smurf`,
     `ros_package`, `additional_meshes`, `enforce_zero`, `copy_package` (`_ros.sdf`,
     `_relpath.sdf`), `correct_inertials` and `float_formats` (keyed by element) as for URDF."""
@@ -114,7 +126,7 @@ class SdfExport:
 
 
 @record(slots=True, kw_only=True)
-class MjcfExport:
+class MjcfExport(ExportEntry):
     """A `type: mjcf` entry: MuJoCo's format; meshes in `mesh_format` (stl or obj: MuJoCo
     reads no DAE); `additional_meshes`, `enforce_zero`, `correct_inertials` as for URDF, and
     `float_formats` keyed by MJCF attribute (`pos`, `quat`, `mass`, …). No package paths:
@@ -133,7 +145,7 @@ class MjcfExport:
 
 
 @record(slots=True, kw_only=True)
-class PdfExport:
+class PdfExport(ExportEntry):
     """A `type: pdf` entry: the kinematic tree as a graph (Graphviz source and PDF)."""
 
     span: Span
@@ -143,8 +155,12 @@ class PdfExport:
     type: Literal["pdf"] = "pdf"
 
 
+# The joint selections a `joint_limits` export may name instead of joints.
+JOINT_SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
+
+
 @record(slots=True, kw_only=True)
-class JointLimitsExport:
+class JointLimitsExport(ExportEntry):
     """A `type: joint_limits` entry: `joints` (ALL, ACTIVE, INDEPENDENT, ACTUATED, ABSTRACT or
     names), written to `file_name`. joints_of: the submodel whose movable joints are listed
     (`joints: <submodel name>`); the file is still written where the entry stands."""
@@ -159,7 +175,7 @@ class JointLimitsExport:
 
 
 @record(slots=True, kw_only=True)
-class SubmodelExport:
+class SubmodelExport(ExportEntry):
     """A `type: submodel` entry: the part of the robot that the exports naming it (their
     `submodel` field) write, into `submodels/<name>/` (ir/submodel.py).
 
@@ -192,7 +208,7 @@ class SubmodelExport:
 
 
 @record(slots=True, kw_only=True)
-class RosPackageExport:
+class RosPackageExport(ExportEntry):
     """The ROS 2 package files (`package.xml`, `CMakeLists.txt`, `config/init_positions_*.yml`),
     added after the other exports when one of them writes `package://` paths.
 
@@ -208,7 +224,7 @@ class RosPackageExport:
 
 
 @record(slots=True, kw_only=True)
-class CommandExport:
+class CommandExport(ExportEntry):
     """A `post_processing` command, run after the files are written (backends/commands.py).
 
     command: the program and its arguments; with `shell`, one string for the shell.
@@ -225,7 +241,7 @@ class CommandExport:
 
 
 @record(slots=True, kw_only=True)
-class SmurfExport:
+class SmurfExport(ExportEntry):
     """The SMURF of one output folder (the model's, or a submodel's): `smurf/<name>.smurf`
     and `smurf/<name>_<category>.yml` (backends/smurf.py). Always written.
 
@@ -252,7 +268,7 @@ class SmurfExport:
 
 
 @record(slots=True, kw_only=True)
-class KccdExport:
+class KccdExport(ExportEntry):
     """A `type: kccd` entry: the collision model KCCD reads (backends/kccd.py).
 
     One convex hull per body: a link whose parent joint is movable and not in

@@ -1,9 +1,10 @@
 """Rename links, joints, collisions and visuals of a Robot, and every reference to them.
 
-References that follow a rename: joint parents and children, mimic targets, the root,
-the names opaque fragments record (gazebo references, transmission joints, plugin
-parameters), and what the SMURF writes (motors, sensors, poses, loop joints,
-submechanisms, dependencies, self-collision pairs). Rename maps need not be complete: absent names stay.
+References that follow a rename: every field typed as a reference (ir/refs.py: joint parents
+and children, mimic targets, the root, motors, sensors, poses, loop joints), the names opaque
+fragments record (gazebo references, transmission joints, plugin parameters), and the free data
+the SMURF writes (submechanisms, dependencies, self-collision pairs). Rename maps need not be
+complete: absent names stay.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import replace
 
 from lxml import etree
 
+from mpc.ir import refs as declared
 from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.robot import Joint, Link, Robot
 from mpc.ir.span import hardened_parser
@@ -57,39 +59,41 @@ def rename_fragment(frag: Fragment, link: Rename, joint: Rename, xmlns: str = ""
 
 def rename_robot(robot: Robot, link: Rename = _same, joint: Rename = _same,
                  collision: Rename = _same, visual: Rename = _same) -> Robot:
-    """`robot` with names mapped; the caller guarantees the maps create no duplicates."""
+    """`robot` with names mapped; the caller guarantees the maps create no duplicates.
+
+    Every field typed as a reference (ir/refs.py) follows: joint ends, mimics, the root, motors,
+    sensors, loop joints, poses. XML fragments and free data (submechanism definitions,
+    annotations) declare nothing and are renamed here by what they are known to hold."""
     xmlns = xmlns_of(robot)
+    by_kind = {"link": link, "joint": joint, "collision": collision, "visual": visual}
+
+    def rename(kinds: tuple[str, ...], name: str) -> str:
+        kind = kinds[0] if len(kinds) == 1 or name in robot.joints else kinds[-1]  # joint, else link
+        return by_kind.get(kind, _same)(name)
 
     def frags(items: tuple[Fragment, ...]) -> tuple[Fragment, ...]:
         return tuple(rename_fragment(f, link, joint, xmlns) for f in items)
 
-    def shapes(items: tuple, rename: Rename) -> tuple:
-        return tuple(replace(s, name=rename(s.name) if s.name else s.name, extras=frags(s.extras))
-                     for s in items)
+    def shapes(items: tuple) -> tuple:
+        return tuple(replace(s, extras=frags(s.extras)) for s in items)
 
     links: dict[str, Link] = {}
     for name, item in robot.links.items():
-        new = link(name)
-        links[new] = replace(item, name=new, extras=frags(item.extras),
-                             visuals=shapes(item.visuals, visual),
-                             collisions=shapes(item.collisions, collision))
-    joints: dict[str, Joint] = {}
-    for name, item in robot.joints.items():
-        new = joint(name)
-        mimic = item.mimic and replace(item.mimic, joint=joint(item.mimic.joint))
-        joints[new] = replace(item, name=new, parent=link(item.parent), child=link(item.child),
-                              mimic=mimic, extras=frags(item.extras))
-    renamed = replace(robot, links=links, joints=joints, root=link(robot.root),
-                      fragments=frags(robot.fragments))
-    return _follow_extras(robot, renamed, link, joint)
+        links[link(name)] = declared.renamed(replace(
+            item, extras=frags(item.extras), visuals=shapes(item.visuals),
+            collisions=shapes(item.collisions)), rename)
+    joints: dict[str, Joint] = {
+        joint(name): declared.renamed(replace(item, extras=frags(item.extras)), rename)
+        for name, item in robot.joints.items()}
+    renamed = declared.renamed(replace(robot, links=links, joints=joints, fragments=frags(robot.fragments)),
+                               rename, only=("root", "motors", "sensors", "cut_joints", "poses"))
+    return _follow_free_data(renamed, link, joint)
 
 
-def _follow_extras(old: Robot, robot: Robot, link: Rename, joint: Rename) -> Robot:
-    """`robot` whose motors, sensors, poses, loop joints, submechanisms, joint dependencies
-    and self-collision pairs name the renamed links and joints (the SMURF writes them).
+def _follow_free_data(robot: Robot, link: Rename, joint: Rename) -> Robot:
+    """`robot` whose submechanisms, joint dependencies and self-collision pairs, free data as
+    written in the definition, name the renamed links and joints (the SMURF writes them).
     Free annotation categories are data mpc does not interpret, and are left as they are."""
-    def either(name: str) -> str:
-        return joint(name) if name in old.joints else link(name)
 
     def submechanism(definition: Mapping[str, object]) -> dict[str, object]:
         out = dict(definition)
@@ -119,13 +123,6 @@ def _follow_extras(old: Robot, robot: Robot, link: Rename, joint: Rename) -> Rob
             for p in pairs]}
     return replace(
         robot, joints={n: depends(j) for n, j in robot.joints.items()}, annotations=annotations,
-        motors={n: replace(m, joint=joint(m.joint)) for n, m in robot.motors.items()},
-        sensors={n: replace(s, link=s.link and link(s.link), joint=s.joint and joint(s.joint),
-                            frame=s.frame and link(s.frame), targets=tuple(map(either, s.targets)))
-                 for n, s in robot.sensors.items()},
-        poses={n: {joint(j): v for j, v in p.items()} for n, p in robot.poses.items()},
-        cut_joints={n: replace(c, parent=link(c.parent), child=link(c.child))
-                    for n, c in robot.cut_joints.items()},
         submechanisms=tuple(replace(sm, definition=submechanism(sm.definition))
                             for sm in robot.submechanisms))
 

@@ -22,6 +22,17 @@ from typing import Any, Literal
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Geometry, Vec3
 from mpc.ir.record import record
+from mpc.ir.refs import (
+    CollisionName,
+    JointName,
+    JointRef,
+    LinkName,
+    LinkRef,
+    MaterialName,
+    MaterialRef,
+    PoseName,
+    VisualName,
+)
 from mpc.ir.span import Span
 
 JointType = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar"]
@@ -74,7 +85,7 @@ class Material:
     texture: "" for a `<texture/>` without filename (iCub writes those), None for none.
     """
 
-    name: str
+    name: MaterialName
     rgba: tuple[float, float, float, float] | None = None
     texture: str | None = None
     ambient: tuple[float, ...] | None = None
@@ -97,9 +108,9 @@ class Visual:
     """
 
     geometry: Geometry
-    name: str | None = None
+    name: VisualName | None = None
     origin: Pose | None = None
-    material: str | None = None
+    material: MaterialRef | None = None
     inline_material: Material | None = None
     geometry_attrs: Attrs = ()
     extra_attrs: Attrs = ()
@@ -113,7 +124,7 @@ class Collision:
     """A collision shape of a link."""
 
     geometry: Geometry
-    name: str | None = None
+    name: CollisionName | None = None
     origin: Pose | None = None
     geometry_attrs: Attrs = ()
     extra_attrs: Attrs = ()
@@ -127,7 +138,7 @@ class Collision:
 class Link:
     """A rigid body. visuals and collisions keep their source order."""
 
-    name: str
+    name: LinkName
     inertial: Inertial | None = None
     visuals: tuple[Visual, ...] = ()
     collisions: tuple[Collision, ...] = ()
@@ -163,7 +174,7 @@ class Dynamics:
 class Mimic:
     """This joint follows `joint`: q = multiplier · q_joint + offset."""
 
-    joint: str
+    joint: JointRef
     multiplier: float | None = None
     offset: float | None = None
 
@@ -194,10 +205,10 @@ class Joint:
     axis: the joint axis in the joint frame, or None when not written (URDF: 1 0 0).
     """
 
-    name: str
+    name: JointName
     type: JointType
-    parent: str
-    child: str
+    parent: LinkRef
+    child: LinkRef
     origin: Pose | None = None
     axis: Vec3 | None = None
     limit: Limit | None = None
@@ -230,9 +241,9 @@ class Robot:
     """
 
     name: str
-    root: str
-    links: Mapping[str, Link]
-    joints: Mapping[str, Joint]
+    root: LinkRef
+    links: Mapping[LinkName, Link]
+    joints: Mapping[JointName, Joint]
     materials: Mapping[str, Material] = field(default_factory=dict)
     fragments: tuple[Fragment, ...] = ()
     extra_attrs: Attrs = ()
@@ -241,7 +252,7 @@ class Robot:
     motors: Mapping[str, Any] = field(default_factory=dict)
     sensors: Mapping[str, Any] = field(default_factory=dict)
     cut_joints: Mapping[str, Any] = field(default_factory=dict)
-    poses: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    poses: Mapping[PoseName, Mapping[JointRef, float]] = field(default_factory=dict)
     submechanisms: tuple[Any, ...] = ()
     submechanisms_file: str | None = None
     annotations: Mapping[str, Mapping[str, object]] = field(default_factory=dict)

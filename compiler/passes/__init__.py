@@ -8,33 +8,22 @@ It never mutates its input.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
-from mpc.compiler.diagnostics import Severity, Sink
-from mpc.ir.names import Names
-from mpc.ir.program import Input, Program
+from mpc.compiler.passes.check_names import check_names
+from mpc.compiler.passes.context import PassContext
+from mpc.compiler.passes.drop_dead_ops import drop_dead_ops
+from mpc.compiler.passes.fold_renames import fold_renames
+from mpc.compiler.passes.order_ops import order_ops
+from mpc.compiler.passes.resolve_inputs import resolve_inputs
+from mpc.ir.program import Program
 
-
-def _unknown(_: Input) -> Names | None:
-    return None
-
-
-@dataclass
-class PassContext:
-    """What every pass may use: the diagnostics sink, the input models' names, and whether
-    what compiling does not support yet is an error (compile) or a warning (check)."""
-
-    sink: Sink
-    input_names: Callable[[Input], Names | None] = field(default=_unknown)
-    later: Severity = Severity.ERROR
-
+__all__ = ["PASSES", "Pass", "PassContext", "run_passes"]
 
 Pass = Callable[[Program, PassContext], Program]
 
-from mpc.compiler.passes.check_names import check_names  # noqa: E402
-from mpc.compiler.passes.resolve_inputs import resolve_inputs  # noqa: E402
-
-PASSES: tuple[Pass, ...] = (resolve_inputs, check_names)
+# The order matters: names are checked on the program the others leave (ordered, folded, with
+# no dead op), so that a report points at what will run.
+PASSES: tuple[Pass, ...] = (resolve_inputs, order_ops, fold_renames, drop_dead_ops, check_names)
 
 
 def run_passes(program: Program, ctx: PassContext) -> Program:

@@ -11,14 +11,19 @@ up and its `effect` gives the names after it, attaches merge parts.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from mpc.compiler.diagnostics import Severity, did_you_mean
-from mpc.compiler.passes import PassContext
+from mpc.compiler.passes.context import PassContext
 from mpc.ir.names import Names
 from mpc.ir.ops import Attach, Effects, LoadModel, Op
 from mpc.ir.program import Program
 
+# Called with each op that ran on known names, its part's names before it and after it.
+Trace = Callable[[Op, Names, Names], None]
 
-def symbolic(program: Program, ctx: PassContext) -> Names | None:
+
+def symbolic(program: Program, ctx: PassContext, trace: Trace | None = None) -> Names | None:
     """The names of the finished robot (None when an input's names are unknown)."""
     parts: dict[str, Names | None] = {}
     origins: dict[str, str] = {}
@@ -44,6 +49,8 @@ def symbolic(program: Program, ctx: PassContext) -> Names | None:
             continue
         if names is not None and (_reads_ok(op, names, ctx) or not type(op).EFFECT_NEEDS_READS):
             parts[op.part] = op.effect(names, effects)
+            if trace is not None:
+                trace(op, names, parts[op.part])
     for kind, ops in unsupported.items():  # once per kind, where it is first used
         uses = f" ({len(ops)} uses)" if len(ops) > 1 else ""
         Effects(ctx.sink, ops[0], ctx.later is Severity.ERROR).unsupported(f"the {kind} operation{uses}")

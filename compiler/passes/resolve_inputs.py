@@ -6,7 +6,7 @@
 
 from __future__ import annotations
 
-from mpc.compiler.passes import PassContext
+from mpc.compiler.passes.context import PassContext
 from mpc.ir.program import Program
 
 READABLE = (".urdf", ".sdf", ".smurf", ".xacro")

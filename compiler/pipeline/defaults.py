@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 # The merge of defaults files, reused so both layers follow one rule.
-from mpc.compiler.inherit import _copy, _forget, _merge
+from mpc.compiler.inherit import copy_value, forget_spans, merge_value
 from mpc.compiler.source import Document
 
 _MERGED = (("test", "default_test"), ("deployment", "default_deployment"))
@@ -52,7 +52,8 @@ class PipelineDefaults:
                 continue
             base = self._take(setting, ("model", key), out, forget=model.get(key))
             if model.get(key) is not None:
-                model[key] = _merge(base, doc.data["model"][key], doc, ("model", key), ("model", key), out)
+                model[key] = merge_value(base, doc.data["model"][key], doc, ("model", key), ("model", key),
+                                         out)
                 if ("model", key) in doc.keys:
                     out.keys[("model", key)] = doc.keys[("model", key)]
             else:
@@ -63,8 +64,8 @@ class PipelineDefaults:
     def _take(self, setting: str, path: tuple[str, ...], out: Document, forget: Any = None) -> Any:
         """A copy of the pipeline's `setting`, its spans recorded at `path` of `out`."""
         if forget is not None:
-            _forget(forget, path, out)
+            forget_spans(forget, path, out)
         src = ("pipeline", setting)
         if src in self.pipeline.keys:
             out.keys[path] = self.pipeline.keys[src]
-        return _copy(self.settings()[setting], self.pipeline, src, path, out)
+        return copy_value(self.settings()[setting], self.pipeline, src, path, out)

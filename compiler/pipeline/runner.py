@@ -299,7 +299,7 @@ class Runner:
         self._done(name)
 
     def _record_outcomes(self, r: _Running, message: dict[str, Any]) -> None:
-        from mpc.compiler.driver import _replace  # the same swap `mpc compile` does
+        from mpc.compiler.driver import replace_folder  # the same swap `mpc compile` does
 
         name = r.model
         record = self.status.models[name]
@@ -310,7 +310,7 @@ class Runner:
             # Without its state, a model is built again: so a state that could not be saved
             # never describes an output it did not make.
             self.store.forget_state(name)
-            _replace(self.store.staging(name) / "out", self.store.output(name))
+            replace_folder(self.store.staging(name) / "out", self.store.output(name))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
                      "mpc": mpc_version(), "stages": {}}

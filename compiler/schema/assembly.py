@@ -113,7 +113,7 @@ class AttachJoint(Node):
     vel: Expr | None = None
 
 
-class _Part(Node):
+class AssemblyEntry(Node):
     """What the root model and each child of `assemble` share."""
 
     model: str
@@ -124,14 +124,14 @@ class _Part(Node):
     children: list[AssembleChild] = []
 
 
-class AssembleChild(_Part):
+class AssembleChild(AssemblyEntry):
     """A model attached to its parent part by `joint`."""
 
     SECTION: ClassVar[str] = "an assemble child"
     joint: AttachJoint
 
 
-class Assemble(_Part):
+class Assemble(AssemblyEntry):
     """The `assemble` section: the root model and, recursively, its children."""
 
     SECTION: ClassVar[str] = "assemble"

@@ -537,7 +537,7 @@ class UnionType(Type):
         return walk.wrong(self, value, path)
 
 
-class Optional(Type):
+class OptionalType(Type):
     """`T | None`: nothing, or a T."""
 
     def __init__(self, inner: Type) -> None:
@@ -554,7 +554,7 @@ class Optional(Type):
         return None if value is None else self.inner.check(value, path, walk)
 
     def bounded(self, low: int | None, high: int | None) -> Type:
-        return Optional(self.inner.bounded(low, high))
+        return OptionalType(self.inner.bounded(low, high))
 
 
 class Wrapped(Type):
@@ -611,7 +611,7 @@ def compile_type(tp: Any) -> Type:
         args = typing.get_args(tp)
         members = [a for a in args if a is not type(None)]
         inner = compile_type(members[0]) if len(members) == 1 else _union(members)
-        return Optional(inner) if type(None) in args else inner
+        return OptionalType(inner) if type(None) in args else inner
     if origin is Literal:
         return LiteralType(typing.get_args(tp))
     if origin is list:

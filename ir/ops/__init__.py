@@ -10,90 +10,10 @@ function Robot → Robot). An op whose `apply` is not written yet says so throug
 
 from __future__ import annotations
 
-import re
-from collections.abc import Mapping
-from dataclasses import field
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any
 
-from mpc.compiler.diagnostics import Sink
-from mpc.ir.names import Kind, Names
-from mpc.ir.record import record
-from mpc.ir.robot import Robot
-from mpc.ir.span import Span
-
-OPS: dict[str, type[Op]] = {}
-ROOT = "root"
-
-
-@record(slots=True)
-class Ref:
-    """A name an op needs: its kind, the name, and the op field that holds it (for spans)."""
-
-    kind: Kind
-    name: str
-    field: str = ""
-    written: str = ""  # the name as the user wrote it, when an edit changed it
-
-
-class Effects:
-    """What an op's `effect` may report, at the op's span or one of its fields.
-
-    later_is_error: whether a part of the language that `apply` does not support yet is
-    an error (compiling) or a warning (`mpc check`).
-    """
-
-    def __init__(self, sink: Sink, op: Op, later_is_error: bool = True) -> None:
-        self.sink, self.op, self.later_is_error = sink, op, later_is_error
-
-    def error(self, code: str, message: str, field: str = "") -> None:
-        self.sink.error(self.op.span_of(field), code, message)
-
-    def unsupported(self, what: str, field: str = "") -> None:
-        if self.later_is_error:
-            self.sink.error(self.op.span_of(field), "E0202", f"{what} is not supported yet")
-        else:
-            self.sink.warning(self.op.span_of(field), "W0202",
-                              f"{what} is not supported by `mpc compile` yet")
-
-
-# Ops are not slotted: `slots=True` makes the dataclass decorator build a second class,
-# after `__init_subclass__` has already registered the first one in OPS.
-@record(kw_only=True)
-class Op:
-    """Base of every IR operation. span: the YAML that asked for this op."""
-
-    kind: ClassVar[str] = "op"
-    SUPPORTED: ClassVar[bool] = True
-    WHAT: ClassVar[str] = ""  # how messages name the op; default: its kind in words
-    EFFECT_NEEDS_READS: ClassVar[bool] = True  # False: `effect` is sound even if a read is missing
-    span: Span
-    part: str = ROOT
-    spans: Mapping[str, Span] = field(default_factory=dict)
-
-    def __init_subclass__(cls) -> None:
-        cls.kind = re.sub(r"(?<!^)(?=[A-Z])", "_", cls.__name__).lower()
-        OPS[cls.kind] = cls
-
-    @classmethod
-    def what(cls) -> str:
-        return cls.WHAT or cls.kind.replace("_", " ")
-
-    def span_of(self, field: str) -> Span:
-        """The span of one of the op's fields, else of the op."""
-        return self.spans.get(field, self.span)
-
-    def reads(self) -> tuple[Ref, ...]:
-        """Names that must exist when the op runs."""
-        return ()
-
-    def effect(self, names: Names, effects: Effects) -> Names:
-        """The names after the op, computed from the names before it."""
-        return names
-
-    def apply(self, robot: Robot, effects: Effects) -> Robot:
-        """The robot after the op; problems only the values reveal go to `effects`."""
-        raise NotImplementedError
-
+from mpc.ir.names import Names
+from mpc.ir.ops.base import OPS, ROOT, Effects, Op, Phase, Ref
 
 # The op classes live in the modules below and register in OPS when their module is imported.
 # A module is imported when one of its names is first asked for (`from mpc.ir.ops import AddFrame`,
@@ -201,6 +121,7 @@ __all__ = [
     "MoveJointAxisToIntersection",
     "Names",
     "Op",
+    "Phase",
     "ReduceMeshes",
     "Ref",
     "RemoveBeyond",

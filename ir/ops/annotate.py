@@ -12,8 +12,9 @@ from dataclasses import field, replace
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName, SubmechanismName
 from mpc.ir.robot import Collision, Material, Pose, Robot
 
 
@@ -46,10 +47,12 @@ def _link_or_collision(names: Names, name: str, effects: Effects, field_name: st
 class EditMaterial(Op):
     """Edit material `name`, or create it; colours are rgba (0..1)."""
 
+    PHASE = Phase.MATERIALS
+
     WHAT = "material"
     EFFECT_NEEDS_READS = False
 
-    name: str
+    name: MaterialName
     diffuse: tuple[float, ...] | None = None
     ambient: tuple[float, ...] | None = None
     specular: tuple[float, ...] | None = None
@@ -88,8 +91,10 @@ class EditCollisions(Op):
         union (one closed mesh, concave where they are).
     """
 
+    PHASE = Phase.COLLISIONS
+
     target: str = ""
-    exclude: tuple[str, ...] = ()
+    exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
     shape: str | None = None
     oriented: bool = True
@@ -98,9 +103,6 @@ class EditCollisions(Op):
     join: bool | str = False
     bitmask: int | None = None
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "exclude") for n in self.exclude)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.target:
@@ -233,6 +235,8 @@ class AutoBitmask(Op):
     listing the link pairs that may collide.
     """
 
+    PHASE = Phase.COLLISIONS
+
     never: tuple[tuple[str, str], ...] = ()
     always: tuple[tuple[str, str], ...] = ()
 
@@ -283,12 +287,14 @@ class AutoBitmask(Op):
 class EditVisuals(Op):
     """Edit the visuals of `targets` (all links but `exclude` when empty)."""
 
+    PHASE = Phase.VISUALS
+
     WHAT = "visuals"
 
-    targets: tuple[str, ...] = ()
-    exclude: tuple[str, ...] = ()
+    targets: tuple[LinkRef, ...] = ()
+    exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
-    material: str | None = None
+    material: MaterialRef | None = None
     annotations: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -303,13 +309,6 @@ class EditVisuals(Op):
             links[name] = replace(link, visuals=visuals)
         return replace(robot, links=links)
 
-    def reads(self) -> tuple[Ref, ...]:
-        refs = [Ref("link", n, "targets") for n in self.targets]
-        refs += [Ref("link", n, "exclude") for n in self.exclude]
-        if self.material:
-            refs.append(Ref("material", self.material, "material"))
-        return tuple(refs)
-
 
 @record(kw_only=True)
 class AddSensor(Op):
@@ -318,14 +317,16 @@ class AddSensor(Op):
     targets: joints (Joint*, MotorCurrent) or links (Node*); ("All",) for every movable joint.
     """
 
+    PHASE = Phase.SENSORS
+
     WHAT = "sensor"
     EFFECT_NEEDS_READS = False
 
     type: str
-    name: str
-    link: str | None = None
-    joint: str | None = None
-    frame: str | None = None
+    name: SensorName
+    link: LinkRef | None = None
+    joint: JointRef | None = None
+    frame: LinkRef | None = None
     targets: tuple[str, ...] = ()
     targets_kind: str = "joint"
     position_offset: Vec3 | None = None
@@ -363,14 +364,13 @@ class AddSensor(Op):
 class AddPose(Op):
     """A named joint configuration; `default` fills the movable joints not listed."""
 
+    PHASE = Phase.POSES
+
     WHAT = "pose"
 
-    name: str
-    positions: Mapping[str, float] = field(default_factory=dict)
+    name: PoseName
+    positions: Mapping[JointRef, float] = field(default_factory=dict)
     default: float | None = None
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("joint", j, f"positions/{j}") for j in self.positions)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """Values are clamped to the joint's limits (a warning says so); fixed joints are
@@ -409,18 +409,16 @@ class AddSubmechanism(Op):
     definition: the definition as written, for the submechanisms file.
     """
 
+    PHASE = Phase.SUBMECHANISMS
+
     WHAT = "submechanism"
     EFFECT_NEEDS_READS = False
 
-    name: str
+    name: SubmechanismName
     exoskeleton: bool = False
-    joints: tuple[str, ...] = ()
-    links: tuple[str, ...] = ()
+    joints: tuple[JointRef, ...] = ()
+    links: tuple[LinkRef, ...] = ()
     definition: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (*(Ref("joint", j, "joints") for j in self.joints),
-                *(Ref("link", n, "links") for n in self.links))
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("submechanism", [self.name])
@@ -434,6 +432,8 @@ class AddSubmechanism(Op):
 class SubmechanismsFile(Op):
     """Use the submechanisms file at `path` as it is."""
 
+    PHASE = Phase.SUBMECHANISMS
+
     path: str
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -443,6 +443,8 @@ class SubmechanismsFile(Op):
 @record(kw_only=True)
 class AddAnnotations(Op):
     """A free annotation category `category` (SMURF `<robot>_<category>.yml`)."""
+
+    PHASE = Phase.ANNOTATIONS
 
     category: str
     content: Annotations = field(default_factory=dict)
@@ -457,6 +459,8 @@ class CompleteSubmechanisms(Op):
     """Cover every joint no submechanism names (Phobos does this when any is given): each
     connected group of uncovered movable joints becomes a `serial` chain, each group of
     uncovered fixed joints a `fixed` chain, in depth-first order, marked `auto_gen`."""
+
+    PHASE = Phase.SUBMECHANISMS
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         from mpc.ir.tree import depth_first

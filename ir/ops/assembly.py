@@ -13,8 +13,9 @@ from typing import Any, Literal
 from mpc.compiler.diagnostics import did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, LinkRef
 from mpc.ir.rename import rename_robot, rename_with
 from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot
 
@@ -25,7 +26,13 @@ Vec3 = tuple[float, float, float]
 class LoadModel(Op):
     """Start part `part` from input model `input` (the driver reads it)."""
 
+    PHASE = Phase.LOAD
+
     input: str
+
+
+_SECTION_OF_KIND = {"link": Phase.FRAMES, "joint": Phase.JOINTS, "collision": Phase.COLLISIONS,
+                    "visual": Phase.VISUALS}
 
 
 @record(kw_only=True)
@@ -40,6 +47,8 @@ class EditNames(Op):
         after the rest, so NAME_DUPLICATES sees the joints' new names.
     """
 
+    PHASE = Phase.NAMES
+
     WHAT = "name_editing"
 
     rules: tuple[NameRule, ...]
@@ -47,6 +56,13 @@ class EditNames(Op):
     only: tuple[str, ...] = ()
     joint_equals_link_name: bool = False
     append_link_suffix: str = ""
+
+    def phase(self) -> Phase:
+        """An assembly entry's name_editing renames every kind; a section's renames one kind,
+        in that section (`frames` links, `joints` joints…)."""
+        if len(self.kinds) != 1:
+            return Phase.NAMES
+        return _SECTION_OF_KIND.get(self.kinds[0], Phase.NAMES)
 
     def _edit(self, kind: str):
         only = frozenset(self.only)
@@ -106,12 +122,11 @@ class EditNames(Op):
 class RemoveBeyond(Op):
     """Keep the links up to and including `links`; remove everything below them."""
 
+    PHASE = Phase.REMOVE_BEYOND
+
     WHAT = "remove_beyond"
 
-    links: tuple[str, ...]
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, f"links/{i}") for i, n in enumerate(self.links))
+    links: tuple[LinkRef, ...]
 
     def _kept(self, names: Names) -> set[str]:
         below: set[str] = set()
@@ -130,12 +145,11 @@ class RemoveBeyond(Op):
 class TakeLeaf(Op):
     """Keep the subtree rooted at `link`; it becomes the root."""
 
+    PHASE = Phase.TAKE_LEAF
+
     WHAT = "take_leaf"
 
-    link: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
+    link: LinkRef
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.keep(names.subtree(self.link), root=self.link,
@@ -143,6 +157,15 @@ class TakeLeaf(Op):
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         return keep_links(robot, Names.of(robot).subtree(self.link), self.link)
+
+
+def _named(kind: str, names: list[str], shown: int = 5) -> str:
+    """`link 'a'`, or `3 links ('a', 'b', 'c')`, or `20 links ('a', …, 'e' and 15 more)`."""
+    if len(names) == 1:
+        return f"{kind} '{names[0]}'"
+    listed = ", ".join(f"'{n}'" for n in names[:shown])
+    more = f" and {len(names) - shown} more" if len(names) > shown else ""
+    return f"{len(names)} {kind}s ({listed}{more})"
 
 
 def _as_written(name: str, written: str) -> str:
@@ -193,6 +216,8 @@ class Mirror(Op):
     name_replacements: (pattern, replacement) pairs applied to every name.
     """
 
+    PHASE = Phase.MIRROR
+
     plane: Vec3 = (0.0, 1.0, 0.0)
     flip_axis: Literal[0, 1, 2] = 1
     exclude_meshes: tuple[str, ...] = ()
@@ -229,14 +254,16 @@ class Attach(Op):
         part's tree only (`resolved`).
     """
 
+    PHASE = Phase.ATTACH
+
     WHAT = "the attaching joint's parent"
 
     child: str
-    parent: str
-    child_link: str | None = None
+    parent: LinkRef
+    child_link: LinkRef | None = None
     parent_written: str = ""
     child_written: str = ""
-    name: str | None = None
+    name: JointName | None = None
     type: str = "fixed"
     origin: Pose = IDENTITY
     r2r: tuple[tuple[float, ...], ...] | None = None
@@ -246,6 +273,9 @@ class Attach(Op):
 
     def reads(self) -> tuple[Ref, ...]:
         return (Ref("link", self.parent, "parent", self.parent_written),)
+
+    def parts(self) -> tuple[str, ...]:
+        return (self.part, self.child)
 
     def resolved(self, parent: Names, child: Names) -> Attach:
         """The op naming its links as NAME_DUPLICATES left them: `X_Link` for a link `X` that
@@ -280,8 +310,9 @@ class Attach(Op):
         joint = self.joint_name(child.root)
         for kind, a, b in (("link", parent.links, child.links),
                            ("joint", frozenset(parent.joints), frozenset(child.joints))):
-            for name in sorted(a & b):
-                effects.error("E0304", f"{kind} '{name}' would exist twice after attaching: in "
+            twice = sorted(a & b)  # one mistake (a part not renamed) is one report, however many names
+            if twice:
+                effects.error("E0304", f"{_named(kind, twice)} would exist twice after attaching: in "
                               f"{origins[0]} and in {origins[1]}; rename one with name_editing")
         if joint in parent.joints or joint in child.joints:
             effects.error("E0304", f"the attaching joint '{joint}' would exist twice: a joint of "

@@ -12,8 +12,9 @@ from dataclasses import field, replace
 from typing import TYPE_CHECKING
 
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops.base import Effects, Op, Phase
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, LinkName, LinkRef, MaterialRef
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint
 
@@ -31,21 +32,20 @@ class AddFrame(Op):
     mass: when given, the link gets a point mass (inertia diag(1e-6)).
     """
 
+    PHASE = Phase.FRAMES
+
     WHAT = "new frame"
     EFFECT_NEEDS_READS = False
 
-    link: str
-    parent: str
-    joint: str
+    link: LinkName
+    parent: LinkRef
+    joint: JointName
     type: str = "fixed"
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
     axis: Vec3 | None = None
     mass: float | None = None
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.parent, "parent"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.link in names.links:
@@ -76,12 +76,11 @@ class AddFrame(Op):
 class MakeRoot(Op):
     """Make `link` the root: the joints on the path to it are turned around."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "make_root"
 
-    link: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
+    link: LinkRef
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """Turn the joints from the root to `link` around (at q = 0; ir/reroot.py)."""
@@ -103,14 +102,13 @@ class MakeRoot(Op):
 class TransformLink(Op):
     """Move `link` with its visuals, collisions and inertial by X (xyz, rpy) in its own frame."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "transform"
 
-    link: str
+    link: LinkRef
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.link == names.root and type(self) is TransformLink:
@@ -185,13 +183,12 @@ def move_frame(robot: Robot, link_name: str, T: Pose) -> Robot:
 class ReparentLink(Op):
     """Hang `link` below `parent`, keeping its pose in the root frame (at q = 0)."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "reparent_to"
 
-    link: str
-    parent: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.link, "link"), Ref("link", self.parent, "parent"))
+    link: LinkRef
+    parent: LinkRef
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.parent in names.subtree(self.link):
@@ -220,12 +217,11 @@ class EstimateMissingComs(Op):
     """Set the COM of each of `links` (all when empty) whose COM is at its origin, from its
     collision geometry."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "estimate_missing_coms"
 
-    links: tuple[str, ...] = ()
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "links") for n in self.links)
+    links: tuple[LinkRef, ...] = ()
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """The COM of a link whose COM is at its origin becomes the centre of volume of the
@@ -252,12 +248,11 @@ class EstimateMissingInertia(Op):
     """Fill the inertia tensor of each of `links` (all when empty) that has a mass and a
     missing or zero inertia, from its collision geometry."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "estimate_missing_inertia"
 
-    links: tuple[str, ...] = ()
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("link", n, "links") for n in self.links)
+    links: tuple[LinkRef, ...] = ()
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """The inertia becomes the union's (uniform density) scaled to the link's mass, about
@@ -305,10 +300,12 @@ def collision_solid(op: Op, link: str, collisions: Sequence[Collision], effects:
 class AnnotateLinks(Op):
     """Free annotations (for SMURF) on `links` (all when empty); material: set the visuals'."""
 
+    PHASE = Phase.FRAMES
+
     WHAT = "frames"
 
-    links: tuple[str, ...] = ()
-    material: str | None = None
+    links: tuple[LinkRef, ...] = ()
+    material: MaterialRef | None = None
     annotations: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
@@ -321,9 +318,3 @@ class AnnotateLinks(Op):
             links[name] = replace(link, visuals=visuals,
                                   annotations={**link.annotations, **self.annotations})
         return replace(robot, links=links)
-
-    def reads(self) -> tuple[Ref, ...]:
-        refs = [Ref("link", n, "links") for n in self.links]
-        if self.material:
-            refs.append(Ref("material", self.material, "material"))
-        return tuple(refs)

@@ -10,8 +10,9 @@ from dataclasses import field, replace
 
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
-from mpc.ir.ops import Effects, Op, Ref
+from mpc.ir.ops.base import Effects, Op, Phase, Ref
 from mpc.ir.record import record
+from mpc.ir.refs import JointName, JointRef, LinkRef, MotorName
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 
 MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
@@ -68,7 +69,7 @@ class JointValues:
 class Dependency:
     """q = multiplier · q_joint + offset."""
 
-    joint: str
+    joint: JointRef
     multiplier: float = 1.0
     offset: float = 0.0
 
@@ -76,6 +77,8 @@ class Dependency:
 @record(kw_only=True)
 class ReplaceJointTypes(Op):
     """Every joint of type `old` becomes type `new`, for each (old, new) pair."""
+
+    PHASE = Phase.JOINTS
 
     mapping: tuple[tuple[str, str], ...]
 
@@ -94,15 +97,14 @@ class JointDefaults(Op):
     annotations: set where the joint has no annotation of that key.
     """
 
+    PHASE = Phase.JOINTS
+
     WHAT = "joints $default"
 
     values: JointValues
-    joints: tuple[str, ...] = ()
+    joints: tuple[JointRef, ...] = ()
     backup: bool = False
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return tuple(Ref("joint", n, "joints") for n in self.joints)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         joints = dict(robot.joints)
@@ -119,9 +121,11 @@ class JointDefaults(Op):
 class EditJoint(Op):
     """Set values of `joint`: type, axis, limits and dynamics, mimic, dependencies, annotations."""
 
+    PHASE = Phase.JOINTS
+
     WHAT = "joints"
 
-    joint: str
+    joint: JointRef
     values: JointValues = field(default_factory=JointValues)
     type: str | None = None
     axis: Vec3 | None = None
@@ -156,19 +160,18 @@ class EditJoint(Op):
 class SetMotor(Op):
     """Put a motor on `joint` (`active`, `motor`): name (default `<joint>_motor`) and settings."""
 
+    PHASE = Phase.JOINTS
+
     WHAT = "motor"
     EFFECT_NEEDS_READS = False
 
-    joint: str
-    name: str
+    joint: JointRef
+    name: MotorName
     settings: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         motor = Motor(name=self.name, joint=self.joint, settings=dict(self.settings))
         return replace(robot, motors={**robot.motors, self.name: motor})
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"),)
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("motor", [self.name])
@@ -179,12 +182,11 @@ class RemoveJoint(Op):
     """Remove `joint`: its child link merges into the parent link (mass, COM and inertia
     combined, visuals and collisions moved), the child's children hang from the parent."""
 
+    PHASE = Phase.JOINTS
+
     WHAT = "joint removal"
 
-    joint: str
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"),)
+    joint: JointRef
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """At q = 0: the child's inertial joins the parent's (parallel-axis theorem), its
@@ -249,18 +251,17 @@ class AddCutJoint(Op):
     constraint_axes: (name, axis) pairs of the constrained directions.
     """
 
+    PHASE = Phase.JOINTS
+
     WHAT = "cut joint"
     EFFECT_NEEDS_READS = False
 
-    joint: str
-    parent: str
-    child: str
+    joint: JointName
+    parent: LinkRef
+    child: LinkRef
     type: str = "fixed"
     constraint_axes: tuple[tuple[str | None, Vec3], ...] = ()
     annotations: Annotations = field(default_factory=dict)
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("link", self.parent, "parent"), Ref("link", self.child, "child"))
 
     def effect(self, names: Names, effects: Effects) -> Names:
         if self.joint in names.joints:
@@ -287,14 +288,13 @@ class MoveJointAxisToIntersection(Op):
     moves: the link's content stays where it is. This changes the kinematics on purpose
     (aligning, say, an exoskeleton's shoulder axes with the human's)."""
 
-    joint: str
-    a: str
-    b: str
+    PHASE = Phase.JOINTS
+
+    joint: JointRef
+    a: JointRef
+    b: JointRef
 
     WHAT = "move_joint_axis_to_intersection"
-
-    def reads(self) -> tuple[Ref, ...]:
-        return (Ref("joint", self.joint, "joint"), Ref("joint", self.a, "a"), Ref("joint", self.b, "b"))
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         import numpy as np

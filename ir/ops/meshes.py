@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from mpc.ir.geometry import Mesh, ReduceMesh, ScaleMesh
-from mpc.ir.ops import Effects, Op
+from mpc.ir.ops.base import Effects, Op, Phase
 from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
@@ -29,6 +29,8 @@ class ReduceMeshes(Op):
     """Decimate every mesh (quadric decimation, fast-simplification) to `faces` faces each,
     or to `ratio` of its faces."""
 
+    PHASE = Phase.MESHES
+
     faces: int | None = None
     ratio: float | None = None
 
@@ -42,6 +44,8 @@ class ReduceMeshes(Op):
 @record(kw_only=True)
 class ApplyScale(Op):
     """Bake each mesh's scale into its file; the element then has none."""
+
+    PHASE = Phase.MESHES
 
     WHAT = "apply_scale"
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from mpc.ir.ops import Effects, Op
+from mpc.ir.ops.base import Effects, Op, Phase
 from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
@@ -12,6 +12,8 @@ from mpc.ir.robot import Robot
 @record(kw_only=True)
 class SetRobotName(Op):
     """Name the robot `name` (the `robotname` of the definition)."""
+
+    PHASE = Phase.ROBOT_NAME
 
     name: str
 

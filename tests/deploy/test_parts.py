@@ -166,8 +166,9 @@ def test_git_never_works_on_a_repository_around_its_folder(tmp_path: Path) -> No
 
 
 def test_no_nul_byte_reaches_git(tmp_path: Path) -> None:
-    from mpc.deploy.forges import GitLab, MergeRequest, describe
+    from mpc.deploy.forges import GitLab
     from mpc.deploy.gitcmd import DeployError, Git
+    from mpc.deploy.merge_request import MergeRequest, describe
 
     description = describe("text\0", ("@a",), "proto\0col", "footer")
     assert description == "text\n\n@a\n\nprotocol\n\nfooter\n"

@@ -1,0 +1,205 @@
+"""Declared references: which fields of the IR's records name a link, joint, collision, visual,
+material, motor, sensor or pose, and one walk over them.
+
+A field declares what it names by its type: `link: LinkRef` names a link that must exist,
+`name: LinkName` is the name of a link the record defines (an op that adds one, or the link
+itself), `targets: tuple[Ref.to("joint", "link"), ...]` a joint, else a link of that name.
+The declarations are read from the annotation text (the IR modules use
+`from __future__ import annotations`), without typing.get_type_hints: `mpc check` imports
+the IR on every editor save, and resolving hints is slow.
+
+`refs(obj)` lists what a record names (op `reads()`, name checks), `renamed(obj, rename)` gives
+the record with every declared reference passed through `rename(kinds, name)` (ir/rename.py).
+What this does not do: decide what a name means (that is the op's), or look into free data
+(annotations, submechanism definitions as written), which declare nothing.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import sys
+from collections.abc import Callable, Iterator, Mapping
+from typing import Annotated, Any
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class Ref:
+    """The mark of a field that names an element: the kinds it may be (the first one that has
+    the name, in this order), and whether the record defines the name rather than uses it."""
+
+    kinds: tuple[str, ...]
+    defines: bool = False
+
+    @classmethod
+    def to(cls, *kinds: str) -> Any:
+        """A string naming an element of one of `kinds`."""
+        return Annotated[str, cls(kinds)]
+
+
+LinkRef = Annotated[str, Ref(("link",))]
+JointRef = Annotated[str, Ref(("joint",))]
+CollisionRef = Annotated[str, Ref(("collision",))]
+VisualRef = Annotated[str, Ref(("visual",))]
+MaterialRef = Annotated[str, Ref(("material",))]
+MotorRef = Annotated[str, Ref(("motor",))]
+LinkOrJointRef = Annotated[str, Ref(("joint", "link"))]
+LinkName = Annotated[str, Ref(("link",), defines=True)]
+CollisionName = Annotated[str, Ref(("collision",), defines=True)]
+VisualName = Annotated[str, Ref(("visual",), defines=True)]
+JointName = Annotated[str, Ref(("joint",), defines=True)]
+MaterialName = Annotated[str, Ref(("material",), defines=True)]
+MotorName = Annotated[str, Ref(("motor",), defines=True)]
+SensorName = Annotated[str, Ref(("sensor",), defines=True)]
+PoseName = Annotated[str, Ref(("pose",), defines=True)]
+SubmechanismName = Annotated[str, Ref(("submechanism",), defines=True)]
+
+ALIASES: dict[str, Ref] = {name: value.__metadata__[0] for name, value in dict(globals()).items()
+                           if name.endswith(("Ref", "Name")) and hasattr(value, "__metadata__")}
+
+# A field's shape, parsed from its annotation: ("ref", Ref) | ("record",) | ("seq", shape) |
+# ("map", key shape, value shape) | ("opt", shape); None: nothing declared in it.
+Shape = tuple[Any, ...] | None
+Rename = Callable[[tuple[str, ...], str], str]  # (the kinds it may be, name) → new name
+
+_TOKEN = re.compile(r"\s*([\w.]+|\[|\]|,|\||\.\.\.)")
+_CONTAINERS = {"tuple": "seq", "list": "seq", "Sequence": "seq", "frozenset": "seq",
+               "Mapping": "map", "dict": "map"}
+_SHAPES: dict[type, tuple[tuple[str, Shape], ...]] = {}
+
+
+def _parse(text: str, module: dict[str, Any]) -> Shape:
+    """The shape of one annotation: which parts of the value are references or records."""
+    tokens = _TOKEN.findall(text)
+    pos = 0
+
+    def union() -> Shape:
+        nonlocal pos
+        options = [single()]
+        while pos < len(tokens) and tokens[pos] == "|":
+            pos += 1
+            options.append(single())
+        found = [o for o in options if o is not None]
+        if not found:
+            return None
+        return ("opt", found[0]) if len(options) > 1 else found[0]
+
+    def single() -> Shape:
+        nonlocal pos
+        name = tokens[pos]
+        pos += 1
+        args: list[Shape] = []
+        if pos < len(tokens) and tokens[pos] == "[":
+            pos += 1
+            while tokens[pos] != "]":
+                if tokens[pos] in (",", "..."):
+                    pos += 1
+                    continue
+                args.append(union())
+            pos += 1
+        if name in ALIASES:
+            return ("ref", ALIASES[name])
+        kind = _CONTAINERS.get(name.rsplit(".", 1)[-1])
+        if kind == "seq":
+            inner = [a for a in args if a is not None]
+            return ("seq", inner[0]) if inner else None
+        if kind == "map" and len(args) == 2 and (args[0] is not None or args[1] is not None):
+            return ("map", args[0], args[1])
+        target = module.get(name)
+        if isinstance(target, type) and dataclasses.is_dataclass(target) and shapes(target):
+            return ("record",)
+        if name == "Any":  # a value the module does not import at run time: look at it
+            return ("record",)
+        return None
+
+    return union()
+
+
+def shapes(cls: type) -> tuple[tuple[str, Shape], ...]:
+    """The fields of a record class that hold references or records, with their shapes."""
+    found = _SHAPES.get(cls)
+    if found is None:
+        module = vars(sys.modules[cls.__module__])
+        found = tuple((f.name, shape) for f in dataclasses.fields(cls)
+                      if (shape := _parse(f.type if isinstance(f.type, str) else f.type.__name__, module))
+                      is not None)
+        _SHAPES[cls] = found
+    return found
+
+
+def refs(obj: Any, path: str = "") -> Iterator[tuple[Ref, str, str]]:
+    """(declaration, name, field path) of every reference in a record, nested ones too; the path
+    is `field`, `field/i` for an item, `field/key` for a mapping's key or value."""
+    for name, shape in shapes(type(obj)):
+        yield from _refs(getattr(obj, name), shape, f"{path}{name}")
+
+
+def _refs(value: Any, shape: Shape, path: str) -> Iterator[tuple[Ref, str, str]]:
+    if value is None or shape is None:
+        return
+    tag = shape[0]
+    if tag == "ref":
+        if isinstance(value, str) and value:  # "" names nothing (a default: none, or all)
+            yield shape[1], value, path
+    elif tag == "opt":
+        yield from _refs(value, shape[1], path)
+    elif tag == "seq":
+        for i, item in enumerate(value):
+            yield from _refs(item, shape[1], f"{path}/{i}")
+    elif tag == "map":
+        for key, item in value.items():
+            yield from _refs(key, shape[1], f"{path}/{key}")
+            yield from _refs(item, shape[2], f"{path}/{key}")
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        yield from refs(value, f"{path}/")
+    elif isinstance(value, tuple | list):
+        for i, item in enumerate(value):
+            yield from _refs(item, shape, f"{path}/{i}")
+    elif isinstance(value, Mapping):
+        for key, item in value.items():
+            yield from _refs(item, shape, f"{path}/{key}")
+
+
+def renamed(obj: Any, rename: Rename, only: tuple[str, ...] = ()) -> Any:
+    """The record with every declared reference and name renamed (the same object when none
+    changed); only: these fields of it (all when empty)."""
+    changes = {}
+    for name, shape in shapes(type(obj)):
+        if only and name not in only:
+            continue
+        old = getattr(obj, name)
+        new = _renamed(old, shape, rename)
+        if new is not old:
+            changes[name] = new
+    return dataclasses.replace(obj, **changes) if changes else obj
+
+
+def _renamed(value: Any, shape: Shape, rename: Rename) -> Any:
+    if value is None or shape is None:
+        return value
+    tag = shape[0]
+    if tag == "ref":
+        if not isinstance(value, str) or not value:
+            return value
+        new = rename(shape[1].kinds, value)
+        return value if new == value else new
+    if tag == "opt":
+        return _renamed(value, shape[1], rename)
+    if tag == "seq":
+        items = [_renamed(item, shape[1], rename) for item in value]
+        return value if all(a is b for a, b in zip(items, value, strict=True)) else type(value)(items)
+    if tag == "map":
+        pairs = [(_renamed(k, shape[1], rename), _renamed(v, shape[2], rename)) for k, v in value.items()]
+        same = all(k is k0 and v is v0 for (k, v), (k0, v0) in zip(pairs, value.items(), strict=True))
+        return value if same else dict(pairs)
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return renamed(value, rename)
+    if isinstance(value, tuple | list):
+        items = [_renamed(item, shape, rename) for item in value]
+        return value if all(a is b for a, b in zip(items, value, strict=True)) else type(value)(items)
+    if isinstance(value, Mapping):
+        pairs = [(k, _renamed(v, shape, rename)) for k, v in value.items()]
+        same = all(v is v0 for (_, v), v0 in zip(pairs, value.values(), strict=True))
+        return value if same else dict(pairs)
+    return value
+
