@@ -1,0 +1,110 @@
+"""The visual diff of `mpc test`: UR5 with its forearm moved by 5 cm against its release.
+The protocol references pictures that exist; the moved link is coloured (reference palette:
+orange in the new model, blue in the release), the unchanged links are grey."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from mpc.checks.pictures import CHANGED_NEW, UNCHANGED
+from tests.checks.helpers import compile_ok, definition, edited_urdf, floats, fmt, joint_el, run, write
+from tests.conftest import ERD
+
+UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"
+RENDER = "  export_config:\n    - type: urdf\n    - type: render\n      size: [120, 90]\n      views: [iso, side]\n"
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def picture(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(io.BytesIO(path.read_bytes())).convert("RGB")).astype(int)
+
+
+def orange(p: np.ndarray) -> int:
+    """Pixels of the new model's colour for changed links (shaded: red well above blue)."""
+    return int(np.sum((p[..., 0] - p[..., 2] > 60) & (p[..., 0] > p[..., 1])))
+
+
+def blue(p: np.ndarray) -> int:
+    return int(np.sum(p[..., 2] - p[..., 0] > 60))
+
+
+def grey(p: np.ndarray) -> int:
+    """Shaded grey robot pixels: not the white background, no hue."""
+    spread = p.max(axis=2) - p.min(axis=2)
+    return int(np.sum((spread < 12) & (p.max(axis=2) < 235)))
+
+
+def built_and_tested(tmp_path: Path, basefile: Path) -> Path:
+    """Release: UR5 compiled into tmp_path/ref; then `basefile` tested against it. The output."""
+    write(tmp_path / "ref.yml", definition(UR5, "ur5", "      - compare_amount_joints\n"))
+    compile_ok(tmp_path / "ref.yml", tmp_path / "ref")
+    text = definition(basefile, "ur5", "      - compare_link_transformations\n",
+                      compare=f"      path: {tmp_path / 'ref'}\n")
+    text = text.replace("  export_config:\n    - type: urdf\n      mesh_format: input_type\n", RENDER)
+    write(tmp_path / "new.yml", text)
+    protocol = run(tmp_path / "new.yml", tmp_path / "new", tmp_path / "work")
+    protocol.write(tmp_path / "new")
+    return tmp_path / "new"
+
+
+def test_moved_forearm_is_coloured_in_the_pictures(tmp_path: Path) -> None:
+    def move_forearm(root) -> None:
+        origin = joint_el(root, "elbow_joint").find("origin")
+        xyz = floats(origin.get("xyz"))
+        origin.set("xyz", fmt([xyz[0], xyz[1], xyz[2] + 0.05]))
+
+    moved = edited_urdf(UR5, tmp_path / "moved" / "ur5.urdf", move_forearm)
+    out = built_and_tested(tmp_path, moved)
+    markdown = (out / "test_protocol.md").read_text()
+    assert "Changed links: `forearm_link` (moved by 0.05 m, turned by 0 rad)." in markdown
+    referenced = [line.split("](")[1].split(")")[0] for line in markdown.split("![")[1:]]
+    assert referenced == [f"test_pictures/{v}_{s}.png" for v in ("iso", "side")
+                          for s in ("release", "new", "overlay")]
+    for path in referenced:
+        assert (out / path).is_file()  # relative to the protocol
+    report = json.loads((out / "test_protocol.json").read_text())
+    assert report["pictures"]["changed_links"] == {"forearm_link": "moved by 0.05 m, turned by 0 rad"}
+    assert report["pictures"]["views"]["side"] == {s: f"test_pictures/side_{s}.png"
+                                                   for s in ("release", "new", "overlay")}
+    junit = (out / "test_protocol.junit.xml").read_text()
+    assert '<property name="picture" value="test_pictures/iso_overlay.png"/>' in junit
+    assert "[[ATTACHMENT|test_pictures/side_new.png]]" in junit
+
+    new, release = picture(out / "test_pictures/side_new.png"), picture(out / "test_pictures/side_release.png")
+    assert new.shape == (90, 120, 3)
+    # The forearm (a long tube of UR5's arm) is coloured, orange now and blue in the release …
+    assert orange(new) > 150 and blue(new) == 0
+    assert blue(release) > 150 and orange(release) == 0
+    # … and it is the only coloured link: the other links (base, shoulder, upper arm, wrists)
+    # are grey and cover more of the picture than the forearm; every robot pixel is orange or
+    # grey but for the anti-aliased edges.
+    assert grey(new) > orange(new)
+    robot = int(np.sum(np.any(new < 245, axis=2)))
+    assert orange(new) + grey(new) > 0.9 * robot
+    overlay = picture(out / "test_pictures/side_overlay.png")
+    assert np.any(overlay != new) and np.any(overlay != release)
+    assert orange(overlay) < orange(new) and blue(overlay) < blue(release)  # at half strength
+    assert UNCHANGED[0] == UNCHANGED[1] == UNCHANGED[2] and CHANGED_NEW[0] - CHANGED_NEW[2] > 0.5
+
+
+def test_an_unchanged_model_is_all_grey(tmp_path: Path) -> None:
+    out = built_and_tested(tmp_path, UR5)
+    report = json.loads((out / "test_protocol.json").read_text())
+    assert report["pictures"]["changed_links"] == {}
+    assert "Changed links: none." in (out / "test_protocol.md").read_text()
+    for view in ("iso", "side"):
+        for side in ("release", "new", "overlay"):
+            p = picture(out / f"test_pictures/{view}_{side}.png")
+            assert orange(p) == 0 and blue(p) == 0 and grey(p) > 300, (view, side)
+        assert (out / f"test_pictures/{view}_release.png").read_bytes() == \
+            (out / f"test_pictures/{view}_new.png").read_bytes()
