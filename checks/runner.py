@@ -11,8 +11,7 @@ import traceback
 from collections.abc import Callable
 from pathlib import Path
 
-from mpc.checks import bullet, dynamics, masses, process, topology, validity  # noqa: F401  (registration)
-from mpc.checks import pictures
+from mpc.checks import bullet, dynamics, masses, pictures, process, topology, validity  # noqa: F401  (registration)
 from mpc.checks.models import Model, load_built, load_compare
 from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
