@@ -1,24 +1,28 @@
 """ir.Robot → the kinematic tree as a graph: `<name>.pdf.gv` (Graphviz) and `<name>.pdf`.
 
 Links are boxes; joints are ellipses labelled with their type, axis and origin (and their
-mimic); joints of a submechanism are filled with that submechanism's colour. The PDF is
-rendered by Graphviz's `dot`; without it the .gv file is still written and a warning
-says how to get the PDF.
+mimic), numbers rounded for reading (four significant digits, round-off below 1e-9 as 0);
+joints of a submechanism are filled with that submechanism's colour. In a test run
+(checks/pictures.py) the links that changed against the release are filled orange, the others
+grey, as in the pictures. The PDF is rendered by Graphviz's `dot`; without it the .gv file is
+still written and a warning says how to get the PDF.
 """
 
 from __future__ import annotations
 
 import shutil
 import subprocess
+from collections.abc import Collection, Iterable
 from pathlib import Path
 
-from mpc.backends.xml import fmt_floats, write_path
+from mpc.backends.xml import write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.program import PdfExport
 from mpc.ir.robot import Joint, Robot
 from mpc.ir.tree import depth_first
 
 # Fill colours for submechanisms, in order (Graphviz's X11 names, light enough for text).
+CHANGED, UNCHANGED = "#f2591a", "#d9d9d9"  # a test run's links: checks/pictures.py's palette
 PALETTE = ("lightblue", "palegreen", "lightsalmon", "khaki", "plum", "lightcyan", "peachpuff",
            "lightpink", "wheat", "honeydew", "lavender", "mistyrose")
 
@@ -28,20 +32,32 @@ def _quote(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
 
 
+def readable(x: float) -> str:
+    """A number for reading: four significant digits, round-off (below 1e-9) as 0, no `-0`."""
+    if abs(x) < 1e-9:
+        return "0"
+    return f"{x:.4g}"
+
+
+def _readable(values: Iterable[float]) -> str:
+    return " ".join(readable(float(v)) for v in values)
+
+
 def _joint_label(joint: Joint) -> str:
     lines = [joint.name, joint.type]
     if joint.type not in ("fixed", "floating"):
-        lines.append("axis " + fmt_floats(joint.axis or (1.0, 0.0, 0.0)))
+        lines.append("axis " + _readable(joint.axis or (1.0, 0.0, 0.0)))
     if joint.origin is not None:
-        lines.append("xyz " + fmt_floats(joint.origin.xyz))
-        lines.append("rpy " + fmt_floats(joint.origin.rpy))
+        lines.append("xyz " + _readable(joint.origin.xyz))
+        lines.append("rpy " + _readable(joint.origin.rpy))
     if joint.mimic is not None:
         lines.append(f"mimics {joint.mimic.joint}")
     return "\n".join(lines)
 
 
-def to_gv(robot: Robot) -> str:
-    """The Graphviz source of the kinematic tree, in the canonical order."""
+def to_gv(robot: Robot, changed: Collection[str] | None = None) -> str:
+    """The Graphviz source of the kinematic tree, in the canonical order; with `changed` (a
+    test run's changed links) those links filled orange and the others grey."""
     colour: dict[str, str] = {}
     for i, sm in enumerate(robot.submechanisms):
         for key in ("jointnames_spanningtree", "jointnames"):
@@ -49,7 +65,9 @@ def to_gv(robot: Robot) -> str:
                 colour.setdefault(str(joint), PALETTE[i % len(PALETTE)])
     out = [f"digraph {_quote(robot.name)} {{", '  rankdir="TB";', '  node [fontsize=10];']
     for joint, link in depth_first(robot):
-        out.append(f"  {_quote('link:' + link)} [shape=box, label={_quote(link)}];")
+        fill = "" if changed is None else \
+            f', style=filled, fillcolor="{CHANGED if link in changed else UNCHANGED}"'
+        out.append(f"  {_quote('link:' + link)} [shape=box, label={_quote(link)}{fill}];")
         if joint is None:
             continue
         style = f', style=filled, fillcolor="{colour[joint.name]}"' if joint.name in colour else ""
@@ -63,6 +81,17 @@ def to_gv(robot: Robot) -> str:
                    f'[style=dashed, label={_quote(name + " (loop)")}];')
     out.append("}")
     return "\n".join(out) + "\n"
+
+
+def render_pdf(gv: str) -> bytes | str:
+    """The PDF of a Graphviz source, or why not (no `dot`, or its complaint)."""
+    dot = shutil.which("dot")
+    if dot is None:
+        return "'dot' (Graphviz) is not installed"
+    done = subprocess.run([dot, "-Tpdf"], input=gv.encode(), capture_output=True)
+    if done.returncode != 0:
+        return f"Graphviz could not render the tree: {done.stderr.decode(errors='replace').strip()}"
+    return done.stdout
 
 
 def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:

@@ -34,6 +34,7 @@ UNCHANGED = (0.62, 0.62, 0.62, 1.0)
 FOLDER = "test_pictures"  # beside the protocol
 DEFAULT_SIZE = (480, 360)
 SIDES = ("release", "new", "overlay")
+TREE = "kinematic_tree.pdf"  # the model's pdf export, its changed links coloured
 
 
 @dataclass
@@ -49,6 +50,15 @@ class VisualDiff:
     def path(self, view: str, side: str) -> str:
         """A picture's path relative to the protocol."""
         return f"{FOLDER}/{view}_{side}.png"
+
+    @property
+    def tree(self) -> str:
+        """The coloured kinematic tree's path relative to the protocol, or "" without one."""
+        return f"{FOLDER}/{TREE}" if TREE in self.files else ""
+
+    @property
+    def drawn(self) -> bool:
+        return any(name.endswith(".png") for name in self.files)
 
 
 def _turned(a: Pose | None, b: Pose | None) -> tuple[float, float]:
@@ -128,10 +138,12 @@ def changed_links(old: Robot, new: Robot, tol: Tolerances) -> dict[str, str]:
     return out
 
 
-def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, sink: Sink) -> VisualDiff:
+def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, sink: Sink,
+         tree: bool = False) -> VisualDiff:
     """The visual diff of `new` against its release `old`, drawn with the views and size of
     the model's render export (default: iso, front and side at 480×360); a reason instead of
-    pictures when they cannot be drawn (no EGL, a model MuJoCo cannot load)."""
+    pictures when they cannot be drawn (no EGL, a model MuJoCo cannot load). tree: also the
+    kinematic tree as a PDF with the changed links coloured (the model has a pdf export)."""
     from mpc.backends.scene import GLMissing, Scene, frame, png
 
     views = render.views if render is not None else ("iso", "front", "side")
@@ -168,6 +180,14 @@ def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, s
                 s.close()
     if out.problem:
         sink.warning(span, "W0720", f"the test protocol has no pictures: {out.problem}")
+    if tree:
+        from mpc.backends.pdf import render_pdf, to_gv
+
+        pdf = render_pdf(to_gv(new, changed=set(out.changed)))
+        if isinstance(pdf, bytes):
+            out.files[TREE] = pdf
+        else:
+            sink.warning(span, "W0721", f"the test protocol has no kinematic tree: {pdf}")
     return out
 
 

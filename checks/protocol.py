@@ -144,8 +144,10 @@ class Protocol:
         p = self.pictures
         if p is None:
             return []
+        tree = [] if not p.tree else [
+            "", f"The kinematic tree, changed links in orange: [{p.tree}]({p.tree})"]
         if p.problem:
-            return ["", f"No pictures: {_cell(p.problem)}"]
+            return ["", f"No pictures: {_cell(p.problem)}", *tree]
         changed = ", ".join(f"`{link}` ({why})" for link, why in p.changed.items()) or "none"
         lines = ["", "### Pictures", "", "Links changed beyond the tolerances are coloured (blue in the "
                  "release, orange in the new model); the others are grey. The overlay shows both.",
@@ -154,18 +156,20 @@ class Protocol:
         for view in p.views:
             cells = " | ".join(f"![{view}, {side}]({p.path(view, side)})" for side in _SIDES)
             lines.append(f"| {view} | {cells} |")
-        return lines
+        return lines + tree
 
     def picture_files(self) -> list[str]:
         """The pictures' paths, relative to the protocol."""
         p = self.pictures
-        return [] if p is None else [p.path(v, s) for v in p.views for s in _SIDES if p.files]
+        if p is None:
+            return []
+        return [p.path(v, s) for v in p.views for s in _SIDES if p.drawn] + ([p.tree] if p.tree else [])
 
     def to_json(self) -> dict[str, object]:
         p = self.pictures
         pictures = None if p is None else {
-            "views": {v: {s: p.path(v, s) for s in _SIDES} for v in p.views} if p.files else {},
-            "changed_links": p.changed, "problem": p.problem}
+            "views": {v: {s: p.path(v, s) for s in _SIDES} for v in p.views} if p.drawn else {},
+            "kinematic_tree": p.tree or None, "changed_links": p.changed, "problem": p.problem}
         return {
             "model": self.model, "failed": self.failed, "counts": self.counts(),
             "compare": self.compare, "waiver": self.waiver, "pictures": pictures,
@@ -226,7 +230,7 @@ class Protocol:
             target.unlink()
         elif target.exists():
             shutil.rmtree(target)
-        if self.pictures is None or not self.pictures.files:
+        if self.pictures is None or not self.pictures.files:  # pictures, or the tree alone
             return
         target.mkdir()
         for name, data in sorted(self.pictures.files.items()):

@@ -17,7 +17,7 @@ from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
 from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.program import ModelTest, Program, TestPlan
+from mpc.ir.program import ModelTest, PdfExport, Program, TestPlan
 from mpc.ir.robot import Robot
 
 ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity")
@@ -75,8 +75,9 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
 def _pictures(ctx: Context) -> VisualDiff:
     """The visual diff against the release (checks/pictures.py); a bug in it is its reason."""
     try:
+        tree = any(isinstance(e, PdfExport) and not e.submodel for e in ctx.program.exports)
         return pictures.draw(ctx.compare.robot, ctx.built.robot, ctx.tol,
-                             pictures.render_export(ctx.program.exports), ctx.sink)
+                             pictures.render_export(ctx.program.exports), ctx.sink, tree=tree)
     except Exception as e:
         return VisualDiff(problem=_bug(e))
 

@@ -2,8 +2,8 @@
 and their relative links in the merge request's description rewritten to the forge's raw
 address of the pushed commit, so that GitLab's and GitHub's review pages show them.
 
-It links only the pictures mpc wrote (`test_pictures/<name>.png`); other links of the
-description stay as they are. It knows GitHub's (`/raw/<sha>/…`) and GitLab's
+It links only the files mpc wrote (`test_pictures/<name>.png`, the kinematic tree's `.pdf`);
+other links of the description stay as they are. It knows GitHub's (`/raw/<sha>/…`) and GitLab's
 (`/-/raw/<sha>/…`) addresses; a remote without a web host (a path, file://) keeps the links
 relative, and the description says where the pictures are.
 """
@@ -19,8 +19,8 @@ from mpc.deploy.forges import MergeRequest
 from mpc.deploy.gitcmd import DeployError
 
 FOLDER = "test_pictures"  # as checks/pictures.py writes it, beside the protocol
-_LINK = re.compile(r"\]\((" + FOLDER + r"/[A-Za-z0-9_.-]+\.png)\)")
-_PICTURE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\.png")
+_LINK = re.compile(r"\]\((" + FOLDER + r"/[A-Za-z0-9_.-]+\.(?:png|pdf))\)")
+_PICTURE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\.(?:png|pdf)")
 
 
 def web_address(remote: str) -> str | None:
@@ -55,7 +55,7 @@ def link_pictures(request: MergeRequest, forge: str, sha: str) -> MergeRequest:
 
 
 def copy_pictures(source: Path, clone: Path) -> None:
-    """The PNG files of `source` (the folder beside the protocol) into `clone/test_pictures/`,
+    """The PNG and PDF files of `source` (the folder beside the protocol) into `clone/test_pictures/`,
     replacing what was there. Only regular files named like mpc's pictures are taken; a
     symbolic link is E0850 (it could publish any file of the machine)."""
     target = clone / FOLDER

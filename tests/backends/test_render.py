@@ -79,7 +79,8 @@ def test_ur5_collision_pictures_differ_from_visual_ones(tmp_path: Path) -> None:
     assert result.robot is not None
     export = RenderExport(span=Span.of_file("x.yml"), views=("iso",), size=(96, 72))
     sink = Sink()
-    drawn = {g: draw_all(result.robot, _with(export, geometry=g), sink) for g in ("visual", "collision", "both")}
+    drawn = {g: draw_all(result.robot, _with(export, geometry=g), sink)
+             for g in ("visual", "collision", "both")}
     assert not sink.diagnostics
     visual, collision, both = (pixels(drawn[g]["zero_iso.png"]) for g in ("visual", "collision", "both"))
     assert np.mean(np.any(visual != collision, axis=2)) > 0.02
@@ -121,7 +122,8 @@ def test_talos_pictures_zero_pose_and_geometries(tmp_path: Path) -> None:
     ("views: [iso, fronts]", "E0572", (13, 20),
      "render view 'fronts' is none of iso, front, side, back, top; did you mean 'front'?"),
     ("views: [iso, iso]", "E0572", (13, 20), "render view 'iso' is listed twice"),
-    ("size: [10, 4]", "E0573", (13, 13), "size [10, 4] is not [width, height] in pixels, each from 16 to 4096"),
+    ("size: [10, 4]", "E0573", (13, 13),
+     "size [10, 4] is not [width, height] in pixels, each from 16 to 4096"),
     ("background: pink", "E0574", (13, 19), "background 'pink' is no colour: write one of white, "
      "black, grey, gray or [r, g, b] with each from 0 to 1"),
     ("poses: [zero, sitting]", "E0575", (12, 7), "render pose 'sitting' is neither 'zero' nor a pose "

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import io
 import json
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,8 @@ from tests.checks.helpers import compile_ok, definition, edited_urdf, floats, fm
 from tests.conftest import ERD
 
 UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"
-RENDER = "  export_config:\n    - type: urdf\n    - type: render\n      size: [120, 90]\n      views: [iso, side]\n"
+RENDER = ("  export_config:\n    - type: urdf\n    - type: pdf\n    - type: render\n      size: [120, 90]\n"
+          "      views: [iso, side]\n")
 
 
 @pytest.fixture(autouse=True)
@@ -42,6 +44,14 @@ def grey(p: np.ndarray) -> int:
     """Shaded grey robot pixels: not the white background, no hue."""
     spread = p.max(axis=2) - p.min(axis=2)
     return int(np.sum((spread < 12) & (p.max(axis=2) < 235)))
+
+
+def tree_page(out: Path, tmp_path: Path) -> np.ndarray:
+    """The protocol's kinematic tree PDF as a picture (poppler's pdftoppm)."""
+    pdf = out / "test_pictures/kinematic_tree.pdf"
+    subprocess.run(["pdftoppm", "-png", "-r", "40", "-singlefile", str(pdf), str(tmp_path / "tree")],
+                   check=True)
+    return picture(tmp_path / "tree.png")
 
 
 def built_and_tested(tmp_path: Path, basefile: Path) -> Path:
@@ -76,11 +86,28 @@ def test_moved_forearm_is_coloured_in_the_pictures(tmp_path: Path) -> None:
     assert report["pictures"]["changed_links"] == {"forearm_link": "moved by 0.05 m, turned by 0 rad"}
     assert report["pictures"]["views"]["side"] == {s: f"test_pictures/side_{s}.png"
                                                    for s in ("release", "new", "overlay")}
+    # the kinematic tree (the model has a pdf export), the moved link filled orange, the others grey
+    assert report["pictures"]["kinematic_tree"] == "test_pictures/kinematic_tree.pdf"
+    assert "[test_pictures/kinematic_tree.pdf](test_pictures/kinematic_tree.pdf)" in markdown
+    assert (out / "test_pictures/kinematic_tree.pdf").read_bytes().startswith(b"%PDF")
+    from mpc.backends.pdf import CHANGED as TREE_CHANGED
+    from mpc.backends.pdf import UNCHANGED as TREE_GREY
+    from mpc.backends.pdf import to_gv
+    from mpc.backends.urdf_reader import read
+    from mpc.compiler.diagnostics import Sink
+
+    gv = to_gv(read(moved, Sink()), changed={"forearm_link"})
+    assert gv.count(f'fillcolor="{TREE_CHANGED}"') == 1
+    box = f'"link:forearm_link" [shape=box, label="forearm_link", style=filled, fillcolor="{TREE_CHANGED}"]'
+    assert box in gv
+    assert gv.count(f'fillcolor="{TREE_GREY}"') == gv.count("[shape=box") - 1
+    assert orange(tree_page(out, tmp_path)) > 200  # one orange box on the page
     junit = (out / "test_protocol.junit.xml").read_text()
     assert '<property name="picture" value="test_pictures/iso_overlay.png"/>' in junit
     assert "[[ATTACHMENT|test_pictures/side_new.png]]" in junit
 
-    new, release = picture(out / "test_pictures/side_new.png"), picture(out / "test_pictures/side_release.png")
+    new = picture(out / "test_pictures/side_new.png")
+    release = picture(out / "test_pictures/side_release.png")
     assert new.shape == (90, 120, 3)
     # The forearm (a long tube of UR5's arm) is coloured, orange now and blue in the release …
     assert orange(new) > 150 and blue(new) == 0
@@ -102,6 +129,7 @@ def test_an_unchanged_model_is_all_grey(tmp_path: Path) -> None:
     report = json.loads((out / "test_protocol.json").read_text())
     assert report["pictures"]["changed_links"] == {}
     assert "Changed links: none." in (out / "test_protocol.md").read_text()
+    assert orange(tree_page(out, tmp_path)) == 0
     for view in ("iso", "side"):
         for side in ("release", "new", "overlay"):
             p = picture(out / f"test_pictures/{view}_{side}.png")

@@ -22,7 +22,8 @@ PROTOCOL = """\
 
 | view | release | new | overlay |
 |---|---|---|---|
-| iso | ![iso, release](test_pictures/iso_release.png) | ![iso, new](test_pictures/iso_new.png) | ![iso, overlay](test_pictures/iso_overlay.png) |
+| iso | ![iso, release](test_pictures/iso_release.png) | ![iso, new](test_pictures/iso_new.png) \
+| ![iso, overlay](test_pictures/iso_overlay.png) |
 
 Also see [the docs](docs/x.png).
 """

@@ -94,8 +94,8 @@ def test_view_draws_the_robot_and_a_slider_moves_it(tmp_path: Path) -> None:
 
         requested = [e["params"]["request"]["url"] for e in browser.events
                      if e.get("method") == "Network.requestWillBeSent"]
-        assert requested and all(u.startswith((url, "data:", "blob:" + url.rstrip("/"))) for u in requested), \
-            [u[:80] for u in requested]
+        local = (url, "data:", "blob:" + url.rstrip("/"))
+        assert requested and all(u.startswith(local) for u in requested), [u[:80] for u in requested]
     finally:
         browser.close()
         process.send_signal(signal.SIGINT)
