@@ -86,6 +86,16 @@ def _drawable(robot: Robot) -> Robot:
     return replace(robot, links=links)
 
 
+def _mesh_files(robot: Robot, workdir: Path, sink: Sink, span: Span) -> dict[Any, str] | None:
+    """The robot's meshes in `workdir`: STL files stay STL (MuJoCo reads them fastest, with
+    shared vertices), the others become OBJ (MuJoCo reads no DAE); None after an error."""
+    as_obj, as_stl = meshes.plan(robot, "obj", sink, span), meshes.plan(robot, "stl", sink, span)
+    if as_obj is None or as_stl is None:
+        return None
+    files = {k: as_stl[k] if not k[1] and k[0].suffix.lower() == ".stl" else rel for k, rel in as_obj.items()}
+    return files if meshes.copy(files, workdir, sink, span, robot) else None
+
+
 def _gl_context(width: int, height: int) -> Any:
     """An EGL context (mujoco.egl); GLMissing with the reason when there is none."""
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
@@ -134,7 +144,7 @@ class Scene:
         from mpc.backends import mjcf
 
         robot = _drawable(robot)
-        files = meshes.write(robot, "obj", (), workdir, sink, span)
+        files = _mesh_files(robot, workdir, sink, span)
         if files is None:
             return None
         text = mjcf.to_string(robot, meshes.namer(files, ""))

@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 import tempfile
 import time
-from pathlib import Path
 
 from mpc.backends.packages import PackageResolver
 from mpc.backends.render import draw_all
