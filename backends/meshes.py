@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "1"  # changes when the way meshes are computed changes, so old cache entries go unused
+ENGINE = "2"  # changes when the way meshes are computed changes, so old cache entries go unused
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
@@ -66,10 +66,6 @@ def mesh_uses(robot: Robot) -> Iterator[MeshUse]:
             for item in items:
                 if isinstance(item.geometry, Mesh):
                     yield MeshUse(name, kind, item.geometry)
-
-
-def _digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()[:10]
 
 
 # Extensions of the formats the language names; `mars_obj` is OBJ content (Phobos's intended
@@ -178,16 +174,27 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             todo[cached] = (src, ops, cached)
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
-    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None and problems else {}
+    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
+
+    def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
+        use = users.get((src, ops))
+        return ((use.mesh.span or export_span) if use else export_span,
+                f" of a {use.element} of link '{use.link}'" if use else "")
+
     for source, dest, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
-            use = users.get((src, ops))
-            where = f" of a {use.element} of link '{use.link}'" if use else ""
-            sink.error(use.mesh.span if use and use.mesh.span else export_span, "E0603",
-                       f"cannot compute mesh '{rel}'{where} from '{src}': {problems[source]}")
+            span, of = where(src, ops)
+            sink.error(span, "E0603", f"cannot compute mesh '{rel}'{of} from '{src}': {problems[source]}")
             ok = False
             continue
+        ignored = _ignored_path(source)
+        if ignored.is_file():  # the cache entry records what its computation ignored
+            src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
+            span, of = where(src, ops)
+            sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
+                         f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
+                         hint="the geometry is complete; only materials or textures are missing")
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(source, dest)
     return ok
@@ -221,11 +228,13 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
+    ignored: list[str] = []
     try:
-        mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False)
+        mesh = as_trimesh(Mesh(source=MeshSource(uri=str(src), path=src), ops=ops), scaled=False,
+                          ignored=ignored)
     except MeshError as e:
         return str(e)
-    if len(mesh.faces) == 0:  # e.g. pycollada failed on a texture and trimesh gave an empty scene
+    if len(mesh.faces) == 0:
         return "it has no triangles after reading"
     if dest.suffix == ".bobj":
         from mpc.backends import bobj
@@ -234,10 +243,21 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> str | None:
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     dest.parent.mkdir(parents=True, exist_ok=True)
-    partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
-    partial.write_bytes(data if isinstance(data, bytes) else data.encode())
-    os.replace(partial, dest)
+    if ignored:  # written before the entry, so that an entry never lacks its record
+        _write_atomically(_ignored_path(dest), "".join(f"{line}\n" for line in sorted(set(ignored))).encode())
+    _write_atomically(dest, data if isinstance(data, bytes) else data.encode())
     return None
+
+
+def _ignored_path(entry: Path) -> Path:
+    """Where a cache entry records the broken references its computation ignored (W0605)."""
+    return entry.with_name(entry.name + ".ignored")
+
+
+def _write_atomically(dest: Path, data: bytes) -> None:
+    partial = dest.with_name(f".{dest.name}.{os.getpid()}.part")
+    partial.write_bytes(data)
+    os.replace(partial, dest)
 
 
 def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,

@@ -1,7 +1,8 @@
 """`package://` and relative mesh filenames → files on disk.
 
 A package is looked up, in this order, in the package map given by the user
-(`--package NAME=DIR`), in ROS_PACKAGE_PATH, in the `share/` folders of the Python
+(`--package NAME=DIR`), in ROS_PACKAGE_PATH, in `<prefix>/share` of each prefix of
+AMENT_PREFIX_PATH (a sourced ROS 2 workspace), in the `share/` folders of the Python
 environment (where pip-installed robot packages such as example-robot-data live,
 under `cmeel.prefix/share`), and last among the folders above the model file
 (the way PyBullet finds them). Each package name is looked up once.
@@ -31,6 +32,10 @@ def _environment_share_dirs() -> list[Path]:
     return seen
 
 
+def _path_list(variable: str) -> list[str]:
+    return [p for p in os.environ.get(variable, "").split(os.pathsep) if p]
+
+
 @dataclass
 class PackageResolver:
     """Finds the folder of a ROS package by name (see the module docstring)."""
@@ -41,8 +46,9 @@ class PackageResolver:
 
     def __post_init__(self) -> None:
         if self.search_path is None:
-            ros = [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-            self.search_path = ros + _environment_share_dirs()
+            ros = [Path(p) for p in _path_list("ROS_PACKAGE_PATH")]
+            ament = [Path(p) / "share" for p in _path_list("AMENT_PREFIX_PATH")]
+            self.search_path = ros + ament + _environment_share_dirs()
 
     def find(self, package: str, near: Path | None = None) -> Path | None:
         """The folder of `package`, or None."""
@@ -75,7 +81,8 @@ class PackageResolver:
                 return MeshSource(
                     uri=uri, path=None,
                     unresolved=f"package '{package}' was not found (searched the package map, "
-                    "ROS_PACKAGE_PATH, the Python environment and the folders above the model)",
+                    "ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, the Python environment and the folders "
+                    "above the model)",
                 )
             return MeshSource(uri=uri, path=folder / rest)
         if uri.startswith("file://"):

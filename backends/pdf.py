@@ -10,6 +10,7 @@ still written and a warning says how to get the PDF.
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from collections.abc import Collection, Iterable
@@ -84,27 +85,43 @@ def to_gv(robot: Robot, changed: Collection[str] | None = None) -> str:
 
 
 def render_pdf(gv: str) -> bytes | str:
-    """The PDF of a Graphviz source, or why not (no `dot`, or its complaint)."""
+    """The PDF of a Graphviz source, byte-stable (`_stable`), or why not (no `dot`, or its
+    complaint)."""
     dot = shutil.which("dot")
     if dot is None:
         return "'dot' (Graphviz) is not installed"
-    done = subprocess.run([dot, "-Tpdf"], input=gv.encode(), capture_output=True)
+    done = subprocess.run([dot, "-Tpdf"], input=gv.encode(), capture_output=True,
+                          env={**os.environ, "TZ": "UTC"})
     if done.returncode != 0:
-        return f"Graphviz could not render the tree: {done.stderr.decode(errors='replace').strip()}"
-    return done.stdout
+        return done.stderr.decode(errors="replace").strip() or f"dot exited with {done.returncode}"
+    return _stable(done.stdout)
 
 
 def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
     """Write `<name>.pdf.gv` and, with `dot`, `<name>.pdf` in the export's root folder."""
     name = export.filename or robot.name
     gv = out / f"{name}.pdf.gv"
-    write_path(gv, to_gv(robot))
+    text = to_gv(robot)
+    write_path(gv, text)
     dot = shutil.which("dot")
     if dot is None:
         sink.warning(export.span, "W0502", f"'dot' (Graphviz) is not installed: wrote {gv.name} but "
                      "not the PDF", hint=f"apt-get install graphviz, then: dot -Tpdf {gv.name} -o {name}.pdf")
         return
-    done = subprocess.run([dot, "-Tpdf", str(gv), "-o", str(out / f"{name}.pdf")],
-                          capture_output=True, text=True)
-    if done.returncode != 0:
-        sink.error(export.span, "E0506", f"Graphviz could not render {gv.name}: {done.stderr.strip()}")
+    pdf = render_pdf(text)
+    if isinstance(pdf, str):
+        sink.error(export.span, "E0506", f"Graphviz could not render {gv.name}: {pdf}")
+        return
+    (out / f"{name}.pdf").write_bytes(pdf)
+
+
+def _stable(data: bytes) -> bytes:
+    """The PDF made byte-stable: cairo stamps it with the time of rendering (and Debian 12's
+    ignores SOURCE_DATE_EPOCH), so the stamp becomes SOURCE_DATE_EPOCH's time, else the epoch.
+    The date keeps its length, so the PDF's cross-reference offsets stay right."""
+    import re
+    import time
+
+    epoch = os.environ.get("SOURCE_DATE_EPOCH", "")
+    stamp = time.strftime("D:%Y%m%d%H%M%SZ", time.gmtime(int(epoch) if epoch.isdigit() else 0))
+    return re.sub(rb"/CreationDate \(D:\d{14}Z\)", b"/CreationDate (" + stamp.encode() + b")", data)

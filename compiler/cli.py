@@ -61,8 +61,7 @@ def _parser() -> argparse.ArgumentParser:
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")
     schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
-    schema.add_argument("-o", "--out", type=Path, default=Path("specs/model-definition.schema.json"),
-                        help="where to write it (default: specs/model-definition.schema.json); - for stdout")
+    schema.add_argument("-o", "--out", type=Path, help="the file to write it to (default: stdout)")
     # mpc deploy (deploy/command.py)
     from mpc.deploy.command import add_arguments as deploy_arguments
 
@@ -126,10 +125,7 @@ def _summary(sink: Sink) -> str:
 def print_diagnostics(sink: Sink, fmt: str) -> None:
     from mpc.compiler import render
 
-    if fmt == "json":
-        print(render.as_json(sink.diagnostics), file=sys.stderr)
-    elif sink.diagnostics:
-        print((render.gcc if fmt == "gcc" else render.human)(sink.diagnostics), file=sys.stderr)
+    render.print_diagnostics(sink.diagnostics, fmt)
 
 
 def _compile(args: argparse.Namespace) -> int:
@@ -193,7 +189,7 @@ def _schema(args: argparse.Namespace) -> int:
     from mpc.compiler.jsonschema import render as render_schema
 
     text = render_schema()
-    if str(args.out) == "-":
+    if args.out is None or str(args.out) == "-":
         sys.stdout.write(text)
     else:
         args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -263,11 +259,24 @@ def _pipeline(args: argparse.Namespace) -> int:
     return command.run(args) if args.command == "run" else command.ci(args)
 
 
+def _json_on_stdout(args: argparse.Namespace) -> bool:
+    """`--format json` makes stdout one JSON document of diagnostics, unless stdout carries
+    something else already: the IR of `--emit ir`, the JSON lines of `--log-format json`."""
+    return (getattr(args, "format", None) == "json" and getattr(args, "emit", None) != "ir"
+            and getattr(args, "log_format", None) != "json")
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    command = {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
+               "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command]
     try:
-        return {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
-                "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command](args)
+        if _json_on_stdout(args):
+            from mpc.compiler.render import json_document
+
+            with json_document():
+                return command(args)
+        return command(args)
     except KeyboardInterrupt:
         return 130
     except Exception as e:  # a bug in mpc, not a user mistake

@@ -6,7 +6,9 @@ file it cannot read (it then prints the header line alone).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import sys
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager, redirect_stdout
 
 from mpc.compiler.diagnostics import Diagnostic, Severity
 from mpc.compiler.source import source_line
@@ -85,3 +87,33 @@ def summary(diagnostics: list[Diagnostic]) -> str:
     if warnings:
         parts.append(f"{warnings} warning{'s' * (warnings != 1)}")
     return ", ".join(parts)
+
+
+# With `--format json` the diagnostics of a whole command are one JSON document on stdout; what
+# the command prints besides goes to stderr meanwhile (see `json_document`).
+_collected: list[Diagnostic] | None = None
+
+
+def print_diagnostics(diagnostics: Iterable[Diagnostic], fmt: str) -> None:
+    """Diagnostics as `fmt` (human, gcc or json) on stderr, or into the open JSON document."""
+    diags = list(diagnostics)
+    if fmt == "json" and _collected is not None:
+        _collected.extend(diags)
+    elif fmt == "json":
+        print(as_json(diags), file=sys.stderr)
+    elif diags:
+        print((gcc if fmt == "gcc" else human)(diags), file=sys.stderr)
+
+
+@contextmanager
+def json_document() -> Iterator[None]:
+    """Collect what `print_diagnostics` is given as json into one document, printed on stdout
+    at the end (an empty list when there was none); meanwhile stdout goes to stderr."""
+    global _collected
+    stdout, _collected = sys.stdout, []
+    try:
+        with redirect_stdout(sys.stderr):
+            yield
+    finally:
+        collected, _collected = _collected, None
+        print(as_json(collected), file=stdout)

@@ -3,8 +3,6 @@ primitives, centres of mass from collision volumes. Imported only by those ops."
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import trimesh
 
@@ -28,9 +26,12 @@ class MeshError(Exception):
     """A mesh file cannot be read (the caller turns it into a diagnostic)."""
 
 
-def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
+def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | None = None) -> trimesh.Trimesh:
     """The shape in its own frame with its mesh ops applied; scaled unless told not to
-    (a URDF keeps the scale on the element, so files are written unscaled)."""
+    (a URDF keeps the scale on the element, so files are written unscaled).
+
+    ignored: receives the broken references of a DAE file that were ignored to read it.
+    """
     if isinstance(geometry, Box):
         return trimesh.creation.box(extents=geometry.size)
     if isinstance(geometry, Cylinder):
@@ -49,10 +50,14 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
                 from mpc.backends import bobj
 
                 mesh = bobj.loads(path.read_bytes())
+            elif path.suffix.lower() == ".dae":
+                from mpc.backends import collada
+
+                mesh, broken = collada.read(path)
+                if ignored is not None:
+                    ignored.extend(broken)
             else:
                 mesh = trimesh.load(path, force="mesh", process=False)
-            if path.suffix.lower() == ".dae":
-                mesh.apply_scale(_collada_unit(path))
         except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
             raise MeshError(f"cannot read mesh '{path}': {e}") from None
     for n, op in enumerate(geometry.ops):
@@ -76,7 +81,7 @@ def as_trimesh(geometry: Geometry, scaled: bool = True) -> trimesh.Trimesh:
         elif isinstance(op, JoinShapes):
             pieces = [] if mesh is None else [mesh]
             for shape, xyz, rpy in op.parts:
-                piece = as_trimesh(shape)
+                piece = as_trimesh(shape, ignored=ignored)
                 piece.apply_transform(tf.pose_to_matrix(xyz, rpy))
                 pieces.append(piece)
             mesh = trimesh.util.concatenate(pieces)
@@ -140,11 +145,3 @@ def scaled(shape: Geometry, factor: float) -> Geometry:
     assert isinstance(shape, Sphere)
     return Sphere(radius=factor * shape.radius)
 
-
-def _collada_unit(path: Path) -> float:
-    """Metres per unit of a COLLADA file (its <unit meter=…>), 1 when it has none."""
-    import re
-
-    head = path.read_bytes()[:4096].decode("utf-8", errors="replace")
-    m = re.search(r"<unit\b[^>]*\bmeter=\"([0-9.eE+-]+)\"", head)
-    return float(m.group(1)) if m else 1.0

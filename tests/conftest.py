@@ -7,17 +7,25 @@ so no diagnostic goes unnoticed.
 
 from __future__ import annotations
 
+import os
 import textwrap
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 from mpc.backends.packages import PackageResolver
 from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
 from mpc.compiler.driver import Options, Result, compile_model
 
+# Property tests are bounded: a fixed number of examples and no per-example deadline (the
+# machines are shared; a slow example is not a failure). `HYPOTHESIS_PROFILE=long` digs deeper.
+settings.register_profile("bounded", max_examples=100, deadline=None)
+settings.register_profile("long", max_examples=5000, deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "bounded"))
+
 ERD_PACKAGE = PackageResolver().find("example-robot-data")
-assert ERD_PACKAGE is not None, "example-robot-data is not installed (pip install '.[dev]')"
+assert ERD_PACKAGE is not None, "example-robot-data is not installed (bash scripts/setup.sh)"
 ERD = ERD_PACKAGE / "robots"
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.compiler import render
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink, did_you_mean
+from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
 from mpc.compiler.pipeline.plan import Plan, load_plan
 
 if TYPE_CHECKING:
@@ -23,13 +23,6 @@ class UsageError(Exception):
     """A command line that cannot be run (exit status 2)."""
 
 
-def _print_diagnostics(diagnostics: list[Diagnostic], fmt: str) -> None:
-    if not diagnostics:
-        return
-    if fmt == "json":
-        print(render.as_json(diagnostics), file=sys.stderr)
-    else:
-        print((render.gcc if fmt == "gcc" else render.human)(diagnostics), file=sys.stderr)
 
 
 def parse_stages(text: str) -> tuple[str, ...]:
@@ -68,7 +61,7 @@ def select(plan: Plan, only: list[str]) -> tuple[str, ...]:
 
 def _load(args: argparse.Namespace, sink: Sink) -> Plan | None:
     plan = load_plan(args.pipeline, sink)
-    _print_diagnostics(sink.diagnostics, getattr(args, "format", "human"))
+    render.print_diagnostics(sink.diagnostics, getattr(args, "format", "human"))
     return plan
 
 
@@ -135,13 +128,14 @@ def run(args: argparse.Namespace) -> int:
 def _print_model_diagnostics(status: RunStatus, fmt: str) -> None:
     """Each model's diagnostics under its name; with `--format json`, one list for tools."""
     if fmt == "json":
-        _print_diagnostics([d for n in sorted(status.models) for d in status.models[n].diagnostics()], "json")
+        render.print_diagnostics((d for n in sorted(status.models) for d in status.models[n].diagnostics()),
+                                 "json")
         return
     for name in sorted(status.models):
         diagnostics = status.models[name].diagnostics()
         if diagnostics and fmt == "human":
             print(f"── {name} ({status.models[name].definition})", file=sys.stderr)
-        _print_diagnostics(diagnostics, fmt)
+        render.print_diagnostics(diagnostics, fmt)
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -163,7 +157,7 @@ def ci(args: argparse.Namespace) -> int:
         return 2
     errors = [d for m in plan.models.values() for d in m.diagnostics if d.severity is Severity.ERROR]
     if errors:
-        _print_diagnostics(errors, "human")
+        render.print_diagnostics(errors, "human")
         print("mpc ci: error: the pipeline has errors; no CI file was written", file=sys.stderr)
         return 1
     here = Path.cwd()

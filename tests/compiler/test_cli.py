@@ -65,9 +65,43 @@ def test_gcc_and_json_formats(tmp_path: Path) -> None:
                           "model 'base' does not exist [E0601]\n")
     js = mpc("compile", spec, "--format", "json")
     assert js.returncode == 1
-    [d] = json.loads(js.stderr)
+    assert js.stderr == ""
+    [d] = json.loads(js.stdout)
     assert d["code"] == "E0601" and d["severity"] == "error"
     assert d["span"] == {"file": str(spec), "line": 6, "col": 17, "end_line": 6, "end_col": 31}
+
+
+def test_json_is_one_document_on_stdout_and_the_rest_goes_to_stderr(tmp_path: Path) -> None:
+    arm(tmp_path)
+    good = write(tmp_path / "good.yml", definition("arm.urdf", "stl", "arm"))
+    bad = write(tmp_path / "bad.yml", definition("missing.urdf"))
+    built = mpc("compile", good, "-o", tmp_path / "out", "--format", "json")
+    assert built.returncode == 0, built.stderr
+    assert json.loads(built.stdout) == []
+    assert built.stderr == (f"compiled '{good}' into '{tmp_path}/out': smurf/arm.smurf, urdf/arm.urdf "
+                            "and 1 mesh files\n")
+    checked = mpc("check", good, bad, bad, "--format", "json")
+    assert checked.returncode == 1
+    assert [(d["code"], d["span"]["file"]) for d in json.loads(checked.stdout)] == [
+        ("E0601", str(bad)), ("E0601", str(bad))]
+    ir = mpc("compile", bad, "--emit", "ir", "--format", "json")  # stdout is the IR's
+    assert (ir.returncode, ir.stdout) == (1, "")
+    assert [d["code"] for d in json.loads(ir.stderr)] == ["E0601"]
+
+
+def test_version_and_schema_go_to_stdout(tmp_path: Path) -> None:
+    from mpc.compiler.jsonschema import render
+    from mpc.compiler.version import mpc_version
+
+    version = mpc("--version")
+    assert (version.returncode, version.stdout) == (0, f"mpc {mpc_version()}\n")
+    assert mpc_version() != "unknown"
+    schema = mpc("schema", cwd=tmp_path)
+    assert (schema.returncode, schema.stdout) == (0, render())
+    assert list(tmp_path.iterdir()) == []  # nothing written where the user stands
+    written = mpc("schema", "-o", tmp_path / "s.json")
+    assert (written.returncode, written.stdout) == (0, f"wrote {tmp_path / 's.json'}\n")
+    assert (tmp_path / "s.json").read_text() == render()
 
 
 def test_broken_urdf_points_into_the_urdf(tmp_path: Path) -> None:
@@ -99,3 +133,26 @@ def test_check_imports_no_heavy_library() -> None:
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     assert run.stderr == ""
     assert run.stdout.splitlines()[-1] == "0 []"
+
+
+def test_package_paths_are_found_in_a_sourced_ros2_workspace(tmp_path: Path) -> None:
+    """AMENT_PREFIX_PATH: each prefix's `share/<package>`, as `ros2 pkg prefix` finds it."""
+    import os
+
+    from tests.fixtures import ARM_URDF, tetra_stl
+
+    tetra_stl(tmp_path / "ws/install/arm_description/share/arm_description/meshes/tetra.stl")
+    write(tmp_path / "models/arm.urdf",
+          ARM_URDF.replace("meshes/tetra.stl", "package://arm_description/meshes/tetra.stl"))
+    spec = write(tmp_path / "models/model.yml", definition("arm.urdf", "stl", "arm"))
+    missing = mpc("compile", spec, "-o", tmp_path / "out", "--format", "gcc")
+    assert missing.returncode == 1
+    assert "package 'arm_description' was not found (searched the package map, ROS_PACKAGE_PATH, " \
+           "AMENT_PREFIX_PATH, the Python environment and the folders above the model)" in missing.stderr
+    env = {**os.environ, "AMENT_PREFIX_PATH": f"{tmp_path}/ws/install/other{os.pathsep}"
+                                              f"{tmp_path}/ws/install/arm_description"}
+    found = subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o",
+                            str(tmp_path / "out")], capture_output=True, text=True, env=env)
+    assert found.returncode == 0, found.stderr
+    assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (
+        tmp_path / "ws/install/arm_description/share/arm_description/meshes/tetra.stl").read_bytes()
