@@ -129,5 +129,5 @@ class SubmodelExport(_Export):
 
 
 # Told apart by `type` (compiler/schema/base.py: TaggedType).
-ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | JointLimitsExport
-               | KccdExport | SubmodelExport | RenderExport)
+ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | RenderExport
+               | JointLimitsExport | KccdExport | SubmodelExport)
