@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "2"  # changes when the way meshes are computed changes, so old cache entries go unused
+ENGINE = "3"  # changes when the way meshes are computed changes, so old cache entries go unused
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 

@@ -365,32 +365,44 @@ class _Writer:
                                        ("axis", last[1]), *common])
 
     def _emit_body(self, depth: int, joint: Joint | None, link: Link, top: bool) -> None:
-        """The link's body at `joint`'s origin: inertial, joint, geoms, then child bodies."""
-        pose = _pose_pairs(joint.origin if joint is not None else None)
-        self.out.append(f"{IND * depth}<body{self.attrs([('name', link.name), *pose])}>")
-        d = depth + 1
-        if link.inertial is not None:
-            self._emit_inertial(d, link.inertial)
-        if joint is not None:
-            self._emit_joint(d, joint, top)
-        self._emit_content(d, link)
-        self.out.append(f"{IND * depth}</body>")
+        """The link's body at `joint`'s origin (inertial, joint, geoms), then the bodies below it,
+        depth-first. A loop, not recursion: a chain of thousands of links is a valid model."""
+        todo: list[tuple[int, Joint | None, Link] | str] = [(depth, joint, link)]
+        while todo:
+            item = todo.pop()
+            if isinstance(item, str):  # a closing tag
+                self.out.append(item)
+                continue
+            depth, joint, link = item
+            pose = _pose_pairs(joint.origin if joint is not None else None)
+            self.out.append(f"{IND * depth}<body{self.attrs([('name', link.name), *pose])}>")
+            d = depth + 1
+            if link.inertial is not None:
+                self._emit_inertial(d, link.inertial)
+            if joint is not None:
+                self._emit_joint(d, joint, top)
+            self._emit_geoms(d, link)
+            todo.append(f"{IND * depth}</body>")
+            todo.extend((d, j, self.robot.links[j.child]) for j in reversed(self._child_bodies(link)))
 
-    def _emit_content(self, depth: int, link: Link, top: bool = False) -> None:
-        """Geoms, then child bodies; `top`: the children are bodies of the world."""
+    def _emit_geoms(self, depth: int, link: Link) -> None:
+        """The link's geoms, then its sites."""
         for shape in (*link.visuals, *link.collisions):
             self._emit_geom(depth, shape)
         for name, pose in self.sites.get(link.name, []):
             self.leaf(depth, "site", [("name", name), *_pose_pairs(pose), ("group", "5")])
-        for j in self.children.get(link.name, []):
-            if j.name not in self.hoisted:
-                self._emit_body(depth, j, self.robot.links[j.child], top)
+
+    def _child_bodies(self, link: Link) -> list[Joint]:
+        """The joints to the bodies nested in the link's body (hoisted ones are the world's)."""
+        return [j for j in self.children.get(link.name, []) if j.name not in self.hoisted]
 
     def _emit_worldbody(self) -> None:
         root = self.robot.links[self.robot.root]
         self.out.append(f"{IND}<worldbody>")
         if root.name == "world":  # the URDF convention for the fixed frame: MuJoCo's world body
-            self._emit_content(2, root, top=True)
+            self._emit_geoms(2, root)
+            for j in self._child_bodies(root):  # the children are bodies of the world
+                self._emit_body(2, j, self.robot.links[j.child], top=True)
         else:
             self._emit_body(2, None, root, top=False)
             for name in sorted(self.hoisted):

@@ -23,7 +23,7 @@ from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.compiler.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
-from mpc.ir.kinematics import link_in_root, matrix_pose
+from mpc.ir.kinematics import links_in_root, matrix_pose
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
 from mpc.ir.span import Span
@@ -156,6 +156,7 @@ class _Writer:
     def __init__(self, robot: Robot, mesh_name: MeshNamer, formats: Formats | None = None) -> None:
         self.robot, self.mesh_name, self.formats = robot, mesh_name, formats
         self.links, self.joints = sdf_names(robot)
+        self.X_R = links_in_root(robot)  # SDF poses are in the model frame
         self.out: list[str] = []
 
     def line(self, depth: int, text: str) -> None:
@@ -180,7 +181,7 @@ class _Writer:
         self.line(depth, f'<link name="{_attr(self.links[link.name])}">')
         d = depth + 1
         self.comments(d, link.inner_comments)
-        self.pose(d, matrix_pose(link_in_root(self.robot, link.name)), always=True)
+        self.pose(d, matrix_pose(self.X_R[link.name]), always=True)
         self._emit_inertial(d, link.inertial or _MASSLESS)
         for kind, items in (("visual", link.visuals), ("collision", link.collisions)):
             used: set[str] = set()

@@ -7,9 +7,12 @@
   triangle inequality A + B ≥ C, with a tolerance relative to the largest moment (1e-6:
   what the six written digits of a URDF inertia can carry);
 - the COM lies inside the bounding box of the link's collision shapes (grown by `distance`);
-- a link with collision shapes has mass.
+- a link with collision shapes has mass;
+- plausibility, for each link whose collision shapes make a closed solid (their union,
+  ir/solids.py): the implied density (mass / volume) lies in a range, and each principal
+  moment is within a factor of the solid's at that mass (uniform density). W0710, W0711.
 
-Findings are warnings (W0701, the test passes) unless the test is listed as
+Findings are warnings (W0701, W0710, W0711; the test passes) unless the test is listed as
 `- physical_validity: error`, which makes them failures.
 """
 
@@ -22,7 +25,7 @@ from mpc.checks.registry import Context, register
 from mpc.checks.topology import MOVABLE
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
 from mpc.ir.kinematics import pose_matrix
-from mpc.ir.program import ModelTest
+from mpc.ir.program import DENSITY, FACTOR, ModelTest
 from mpc.ir.robot import Inertia, Robot
 from mpc.ir.span import Span
 from mpc.ir.tree import child_joints
@@ -82,8 +85,54 @@ def collision_box(robot: Robot, link: str) -> tuple[np.ndarray, np.ndarray] | No
     return allp.min(axis=0), allp.max(axis=0)
 
 
-def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
-    """(link, problem) for every finding, in link order."""
+def findings(robot: Robot, distance: float, density: tuple[float, float] = DENSITY,
+             factor: float = FACTOR) -> list[tuple[str, str, str]]:
+    """(link, diagnostic code, problem) for every finding, in link order: W0701's, then the
+    plausibility ones."""
+    out = [(link, "W0701", problem) for link, problem in _validity(robot, distance)]
+    for name in sorted(robot.links):
+        out += [(name, code, problem) for code, problem in plausibility(robot, name, density, factor)]
+    return out
+
+
+def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: float
+                 ) -> list[tuple[str, str]]:
+    """(code, problem) for a link with mass whose collision shapes are a closed solid: the
+    implied density outside `density` (W0710); a principal moment more than `factor` away from
+    the solid's at the link's mass (W0711). Nothing for other links (unreadable or open meshes:
+    the figures would be guesses)."""
+    link = robot.links[name]
+    inertial = link.inertial
+    if inertial is None or inertial.mass <= 0 or not link.collisions:
+        return []
+    from mpc.ir.mesh_props import MeshError
+    from mpc.ir.solids import principal, solid, union
+
+    try:
+        whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in link.collisions])
+    except MeshError:
+        return []
+    volume = whole.props.mass
+    if not whole.closed or volume <= 0:
+        return []
+    out = []
+    rho = inertial.mass / volume
+    if not density[0] <= rho <= density[1]:
+        out.append(("W0710", f"implied density {rho:.4g} kg/m³ (mass {inertial.mass:.4g} kg in "
+                             f"{volume:.4g} m³ of collision solid) lies outside "
+                             f"{density[0]:g}–{density[1]:g} kg/m³"))
+    declared = principal_moments(inertial.inertia)
+    expected = principal(whole.props) * rho
+    if declared[0] > 0 and expected[0] > 0:
+        ratio = np.maximum(declared / expected, expected / declared)
+        if float(np.max(ratio)) > factor:
+            out.append(("W0711", f"principal moments {vector_text(declared)} kg·m² differ from the collision "
+                                 f"solid's {vector_text(expected)} kg·m² at its mass by up to a factor of "
+                                 f"{float(np.max(ratio)):.4g} (more than {factor:g})"))
+    return out
+
+
+def _validity(robot: Robot, distance: float) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     children = child_joints(robot)
 
@@ -134,19 +183,19 @@ def findings(robot: Robot, distance: float) -> list[tuple[str, str]]:
 @register("physical_validity")
 def physical_validity(ctx: Context, test: ModelTest) -> Result:
     robot = ctx.built.robot
-    found = findings(robot, ctx.tol.distance)
-    details = tuple(f"{link}: {problem}" for link, problem in found)
+    found = findings(robot, ctx.tol.distance, test.density, test.inertia_factor)
+    details = tuple(f"{link}: {problem}" for link, _, problem in found)
     figure = float(len(found))
     if not found:
         return passed(test.name, f"{len(robot.links)} links: masses, inertias and COMs are possible",
                       figure=0.0, unit="findings", tolerances=ctx.bound("distance", "m"))
-    first = first_of([f"link '{link}' {problem}" for link, problem in found])
+    first = first_of([f"link '{link}' {problem}" for link, _, problem in found])
     if test.as_error:
         return failed(test.name, first, figure=figure, unit="findings", tolerances=ctx.bound("distance", "m"),
                       details=details)
-    for link, problem in found:
+    for link, code, problem in found:
         span = robot.links[link].span or Span.of_file(str(ctx.built.path))
-        ctx.sink.warning(span, "W0701", f"link '{link}' {problem}")
+        ctx.sink.warning(span, code, f"link '{link}' {problem}")
     return passed(test.name, f"{len(found)} warnings: {first}", figure=figure, unit="findings",
                   tolerances=ctx.bound("distance", "m"), details=details)
 

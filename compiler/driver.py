@@ -259,6 +259,9 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
     if result.robot is None:
         return result
+    from mpc.backends.solid_checks import check_closed
+
+    check_closed(result.robot, sink, result.program.span)  # meshes that an op left open (W0582)
     out = options.out or Path("build") / result.program.modelname
     if emit(result.program, result.robot, out, sink, options.target):  # emit, rename into place
         result.out = out

@@ -183,6 +183,9 @@ class EditLowering:
         if d.estimate_missing_coms:
             self.add(ops.EstimateMissingComs(span=d.key_span("estimate_missing_coms"), links=links,
                                              spans=spans))
+        if d.estimate_missing_inertia:
+            self.add(ops.EstimateMissingInertia(span=d.key_span("estimate_missing_inertia"), links=links,
+                                                spans=spans))
         if (d.entries and not is_new) or d.material:
             self.add(ops.AnnotateLinks(span=d.span, links=links, material=d.material,
                                        annotations={} if is_new else d.entries, spans=spans))

@@ -13,7 +13,7 @@ from typing import Any
 from mpc.compiler.diagnostics import Sink
 from mpc.compiler.expr import evaluate
 from mpc.compiler.schema.release import TestSection
-from mpc.ir.program import CompareTarget, ModelTest, TestPlan, Tolerances
+from mpc.ir.program import DENSITY, FACTOR, CompareTarget, ModelTest, TestPlan, Tolerances
 from mpc.ir.span import Span
 
 # Tests that take a pair of links [left, right] (and optionally a mirror plane).
@@ -154,11 +154,7 @@ class _TestLowering:
                 return None
             return None if value is None else ModelTest(name=name, span=span, dynamics=dynamics, value=value)
         if name == "physical_validity":
-            if arg not in ("error", "warning"):
-                self.sink.error(span, "E0703", f"{what}: the argument is 'error' (findings fail the "
-                                f"test) or 'warning', got {arg!r}")
-                return None
-            return ModelTest(name=name, span=span, as_error=arg == "error")
+            return self.validity(span, arg)
         if name in ("compare_link_positions", "compare_torques"):
             links = [arg] if isinstance(arg, str) else arg
             if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
@@ -169,6 +165,41 @@ class _TestLowering:
         if name in PAIR_TESTS:
             return self.pair(test, arg)
         return self.configuration(test, arg)
+
+    def validity(self, span: Span, arg: Any) -> ModelTest | None:
+        """physical_validity: `error` or `warning`, or {severity, density: [min, max] kg/m³,
+        inertia_factor} (the plausibility bounds; checks/validity.py)."""
+        what = "test 'physical_validity'"
+        settings = arg if isinstance(arg, dict) else {"severity": arg}
+        unknown = set(settings) - {"severity", "density", "inertia_factor"}
+        if unknown:
+            self.sink.error(span, "E0703", f"{what}: unknown key '{sorted(unknown)[0]}' (it takes "
+                            "'severity', 'density' and 'inertia_factor')")
+            return None
+        severity = settings.get("severity", "warning")
+        if severity not in ("error", "warning"):
+            self.sink.error(span, "E0703", f"{what}: the argument is 'error' (findings fail the "
+                            f"test) or 'warning', got {severity!r}")
+            return None
+        density, factor = DENSITY, FACTOR
+        if "density" in settings:
+            values = settings["density"]
+            got = [self.number(v, span, f"{what} density") for v in values] \
+                if isinstance(values, list) else []
+            if len(got) != 2 or None in got or not 0 <= got[0] < got[1]:  # type: ignore[operator]
+                self.sink.error(span, "E0703", f"{what}: 'density' is the range of plausible densities "
+                                "[min, max] in kg/m³, 0 ≤ min < max, e.g. [100, 25000]")
+                return None
+            density = (got[0], got[1])  # type: ignore[assignment]
+        if "inertia_factor" in settings:
+            value = self.number(settings["inertia_factor"], span, f"{what} inertia_factor")
+            if value is None or value < 1:
+                if value is not None:
+                    self.sink.error(span, "E0703", f"{what}: 'inertia_factor' is at least 1, got {value:g}")
+                return None
+            factor = value
+        return ModelTest(name="physical_validity", span=span, as_error=severity == "error", density=density,
+                         inertia_factor=factor)
 
     def pair(self, test: ModelTest, arg: Any) -> ModelTest | None:
         what = f"test '{test.name}'"

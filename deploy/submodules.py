@@ -102,4 +102,25 @@ def write_files(p: Pinned, folder: Path) -> None:
     buffer.seek(0)
     folder.mkdir(parents=True, exist_ok=True)
     with tarfile.open(fileobj=buffer) as tar:
+        _extract_data(tar, folder)
+
+
+def _extract_data(tar: tarfile.TarFile, folder: Path) -> None:
+    """Extract with tarfile's "data" filter: nothing lands or links outside `folder`, and only
+    files, folders and links are made. The filter exists from Python 3.11.4 on; Debian 12's
+    python3 is 3.11.2, where the same rules are applied here (TarError when one is broken)."""
+    if hasattr(tarfile, "data_filter"):
         tar.extractall(folder, filter="data")
+        return
+    root = folder.resolve()
+    for member in tar.getmembers():
+        member.name = member.name.lstrip("/")  # as the filter does: an absolute name lands inside
+        dest = (root / member.name).resolve()
+        inside = dest.is_relative_to(root)
+        if member.issym() or member.islnk():
+            link = (dest.parent if member.issym() else root) / member.linkname
+            inside = inside and link.resolve().is_relative_to(root)
+        if not inside:
+            raise tarfile.TarError(f"'{member.name}' would be written or link outside '{folder}'")
+        if member.isfile() or member.isdir() or member.issym() or member.islnk():
+            tar.extract(member, root, set_attrs=False)

@@ -80,9 +80,14 @@ class ConvexHull:
 @record(slots=True)
 class JoinShapes:
     """Mesh op: the mesh becomes the union of `parts`, each a shape with its pose (xyz, rpy)
-    in this mesh's frame. The source file then only names the result."""
+    in this mesh's frame. The source file then only names the result.
+
+    solid: the solid (boolean) union, one closed mesh (ir/solids.py); otherwise the parts'
+    triangles side by side (what a convex hull of them needs).
+    """
 
     parts: tuple[tuple[Geometry, Vec3, Vec3], ...]
+    solid: bool = False
 
 
 @record(slots=True)

@@ -6,7 +6,7 @@ import numpy as np
 
 from mpc.ir import transforms as tf
 from mpc.ir.robot import Pose, Robot
-from mpc.ir.tree import joints_up
+from mpc.ir.tree import depth_first, joints_up
 
 
 def pose_matrix(pose: Pose | None) -> np.ndarray:
@@ -17,6 +17,16 @@ def link_in_root(robot: Robot, link: str) -> np.ndarray:
     """X_RL at q = 0: the product of the joint origins from the root down to `link`."""
     chain = [pose_matrix(joint.origin) for joint in joints_up(robot, link)]
     return tf.compose(*reversed(chain)) if chain else np.eye(4)
+
+
+def links_in_root(robot: Robot) -> dict[str, np.ndarray]:
+    """X_RL of every link at q = 0, from the root down: linear in the number of links, where
+    `link_in_root` for each link is quadratic in the tree's depth. The products are the same,
+    in the same order, so the numbers equal `link_in_root`'s to the bit."""
+    X_R: dict[str, np.ndarray] = {}
+    for joint, link in depth_first(robot):
+        X_R[link] = np.eye(4) if joint is None else X_R[joint.parent] @ pose_matrix(joint.origin)
+    return X_R
 
 
 def matrix_pose(X: np.ndarray) -> Pose:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.kinematics import link_in_root, matrix_pose, pose_matrix
+from mpc.ir.kinematics import links_in_root, matrix_pose, pose_matrix
 from mpc.ir.ops import Effects
 from mpc.ir.ops.joints import RemoveJoint
 from mpc.ir.robot import Pose, Robot
@@ -49,7 +49,7 @@ def merge_joints(robot: Robot, names: Iterable[str], sink: Sink, span: Span) -> 
             link = into[link]
         return link
 
-    X_R = {link: link_in_root(robot, link) for link in robot.links}
+    X_R = links_in_root(robot)
 
     def moved(link: str, pose: Pose | None) -> Pose:
         """A pose given in `link`, expressed in the link it merged into."""

@@ -1,5 +1,5 @@
 """Shapes as triangle meshes (trimesh), for the ops that need geometry: bounding
-primitives, centres of mass from collision volumes. Imported only by those ops."""
+primitives, and the meshes ir/solids.py makes solids of. Imported only by those ops."""
 
 from __future__ import annotations
 
@@ -75,9 +75,17 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
         elif isinstance(op, ReduceMesh):
             target = op.faces if op.faces is not None else int(len(mesh.faces) * (op.ratio or 1.0))
             if 4 <= target < len(mesh.faces):
+                # An STL file is a triangle soup: decimated unmerged, its triangles come apart
+                # and a closed mesh comes out open (W0582).
+                mesh.merge_vertices()
                 mesh = mesh.simplify_quadric_decimation(face_count=target)
         elif isinstance(op, ScaleMesh):
             mesh.apply_scale(np.asarray(op.scale))
+        elif isinstance(op, JoinShapes) and op.solid:
+            from mpc.ir.solids import solid, to_trimesh, union
+
+            mesh = to_trimesh(union([(solid(shape), tf.pose_to_matrix(xyz, rpy))
+                                     for shape, xyz, rpy in op.parts]).manifold)
         elif isinstance(op, JoinShapes):
             pieces = [] if mesh is None else [mesh]
             for shape, xyz, rpy in op.parts:
@@ -88,19 +96,6 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
     if scaled and geometry.scale is not None:
         mesh.apply_scale(np.asarray(geometry.scale))
     return mesh
-
-
-def volume_and_centre(geometry: Geometry) -> tuple[float, np.ndarray]:
-    """(volume, centre of volume) in the shape's frame; for an open mesh, its convex hull's."""
-    if isinstance(geometry, Box):
-        return float(np.prod(geometry.size)), np.zeros(3)
-    if isinstance(geometry, Cylinder):
-        return float(np.pi * geometry.radius**2 * geometry.length), np.zeros(3)
-    if isinstance(geometry, Sphere):
-        return float(4.0 / 3.0 * np.pi * geometry.radius**3), np.zeros(3)
-    mesh = as_trimesh(geometry)
-    solid = mesh if mesh.is_volume else mesh.convex_hull
-    return float(abs(solid.volume)), np.asarray(solid.center_mass, dtype=float)
 
 
 def bounding(geometry: Geometry, shape: str, oriented: bool) -> tuple[Geometry, np.ndarray]:

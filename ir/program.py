@@ -357,6 +357,10 @@ class CompareTarget:
     ignore_failing_tests_for: str = ""
 
 
+DENSITY = (100.0, 25000.0)  # kg/m³ a link may plausibly have: foam-filled shells to tungsten
+FACTOR = 10.0  # how far a principal moment may be from its collision solid's at the same mass
+
+
 @record(slots=True, kw_only=True)
 class ModelTest:
     """One entry of `tests` (or of `hyrodynChecks`, then `dynamics`).
@@ -365,7 +369,9 @@ class ModelTest:
     symmetry checks). value: the expected figure (total_mass). plane: the mirror plane's
     normal (symmetry checks). angle, angles, joint_angles: the configuration that
     move_hyrodyn_model sets (one value for every joint, one per joint, or by joint name).
-    as_error: physical_validity findings fail instead of warning.
+    as_error: physical_validity findings fail instead of warning. density: the range of
+    plausible densities (kg/m³) and inertia_factor: how far principal moments may be from
+    the collision solid's, for physical_validity.
     """
 
     name: str
@@ -378,6 +384,8 @@ class ModelTest:
     angles: tuple[float, ...] = ()
     joint_angles: Mapping[str, float] | None = None
     as_error: bool = False
+    density: tuple[float, float] = DENSITY
+    inertia_factor: float = FACTOR
 
 
 @record(slots=True, kw_only=True)

@@ -11,7 +11,10 @@ trap 'rm -rf "$work"' EXIT
 UV_VERSION=$(sed -n 's/^UV_VERSION=//p' scripts/setup.sh)
 uv="${XDG_CACHE_HOME:-$HOME/.cache}/mpc/uv-$UV_VERSION/bin/uv"
 export UV_PYTHON_DOWNLOADS=never
-"$uv" build --wheel --out-dir "$work/dist" --quiet "$repo"
+# Built from a copy of the tracked files: setuptools leaves build/ behind in the tree it builds.
+mkdir "$work/src"
+git ls-files -z | xargs -0 cp --parents -t "$work/src"
+"$uv" build --wheel --out-dir "$work/dist" --quiet "$work/src"
 "$uv" venv --quiet --python "${PYTHON:-python3}" "$work/venv"
 # The wheel's dependencies at the versions of the lock, so that a user's install and CI agree.
 "$uv" export --quiet --frozen --no-dev --no-emit-project --no-hashes -o "$work/constraints.txt" --project "$repo"

@@ -63,6 +63,7 @@ class FrameDef(Node):
     reparent_to: str | None = None
     make_root: bool = False
     estimate_missing_coms: bool | None = None
+    estimate_missing_inertia: bool | None = None
     material: str | None = None
     name_editing: NameEditing | None = None
     # a new frame, given as `joint: {parent, xyz, rpy, type}` or flat (`parent`, `jointname`, …)
@@ -183,7 +184,7 @@ class CollisionDef(Node):
     shape: ShapeName | None = None
     oriented: bool = True
     scale: Expr = 1
-    join: bool = False
+    join: bool | Literal["union"] = False
     bitmask: int | None = None
     ccfm: Expr | None = None
 

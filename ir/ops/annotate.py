@@ -84,7 +84,8 @@ class EditCollisions(Op):
         with `replace` (`apply_primitives`) it replaces the shape, otherwise it is recorded
         next to it as the `primitives` annotation (Phobos's meaning). `convex`: the mesh's
         convex hull. `remove`: as remove: true. `mesh`: unchanged.
-    join: merge the link's collisions into one convex hull (not supported yet).
+    join: merge the link's collisions into one: True their convex hull, "union" their solid
+        union (one closed mesh, concave where they are).
     """
 
     target: str = ""
@@ -94,7 +95,7 @@ class EditCollisions(Op):
     oriented: bool = True
     scale: float = 1.0
     replace: bool = False
-    join: bool = False
+    join: bool | str = False
     bitmask: int | None = None
     annotations: Annotations = field(default_factory=dict)
 
@@ -128,7 +129,7 @@ class EditCollisions(Op):
                     elif edited is not None:
                         kept.append(edited)
             if self.join and len(kept) > 1:
-                joined = _join(name, kept, effects)
+                joined = _join(self, name, kept, effects)
                 kept = [joined] if joined is not None else kept
             links[name] = replace(link, collisions=tuple(kept))
         return replace(robot, links=links)
@@ -182,10 +183,17 @@ def _decomposed(c: Collision, link: str, effects: Effects) -> list[Collision]:
             for i in range(count)]
 
 
-def _join(link: str, collisions: list[Collision], effects: Effects) -> Collision | None:
-    """One collision: the convex hull of all of them, in the frame of the first mesh."""
+def _join(op: EditCollisions, link: str, collisions: list[Collision], effects: Effects) -> Collision | None:
+    """One collision: the convex hull of all of them (`join: true`) or their solid union
+    (`join: union`, its repairs and convex-hull stand-ins reported now), in the frame of the
+    first mesh."""
     from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh
     from mpc.ir.kinematics import compose_poses, inverse_pose
+    from mpc.ir.ops.frames import collision_solid
+
+    union = op.join == "union"
+    if union and collision_solid(op, link, collisions, effects, "target") is None:
+        return None
 
     first = next((c for c in collisions if isinstance(c.geometry, Mesh)), None)
     if first is None:
@@ -199,7 +207,8 @@ def _join(link: str, collisions: list[Collision], effects: Effects) -> Collision
         X = compose_poses(X_inv, c.origin)
         parts.append((c.geometry, X.xyz, X.rpy))
     mesh = Mesh(source=first.geometry.source, span=first.geometry.span,
-                ops=(JoinShapes(tuple(parts)), ConvexHull()))
+                ops=(JoinShapes(tuple(parts), solid=True),) if union
+                else (JoinShapes(tuple(parts)), ConvexHull()))
     return replace(first, name=first.name or f"{link}_joined", geometry=mesh,
                    annotations={k: v for c in collisions for k, v in c.annotations.items()})
 

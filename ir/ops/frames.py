@@ -7,14 +7,18 @@ of link L in its parent P, T the transform the definition gives. An op whose
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import field, replace
+from typing import TYPE_CHECKING
 
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Ref
 from mpc.ir.record import record
-from mpc.ir.robot import Inertia, Inertial, Joint, Link, Pose, Robot
+from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint
+
+if TYPE_CHECKING:
+    from mpc.ir.solids import Solid
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]
@@ -224,13 +228,9 @@ class EstimateMissingComs(Op):
         return tuple(Ref("link", n, "links") for n in self.links)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
-        """The COM of a link whose COM is at its origin becomes the centre of volume of its
-        collision shapes (each a solid of uniform density); the inertia tensor is kept."""
-        import numpy as np
-
-        from mpc.ir.kinematics import pose_matrix
-        from mpc.ir.mesh_props import MeshError, volume_and_centre
-
+        """The COM of a link whose COM is at its origin becomes the centre of volume of the
+        solid union of its collision shapes (uniform density, overlaps counted once); the
+        inertia tensor is kept."""
         links = dict(robot.links)
         for name in self.links or tuple(robot.links):
             link = links[name]
@@ -238,21 +238,67 @@ class EstimateMissingComs(Op):
             if inertial is None or not link.collisions or (
                     inertial.origin is not None and any(inertial.origin.xyz)):
                 continue
-            total, moment = 0.0, np.zeros(3)
-            try:
-                for c in link.collisions:
-                    volume, centre = volume_and_centre(c.geometry)
-                    total += volume
-                    moment += volume * (pose_matrix(c.origin) @ np.append(centre, 1.0))[:3]
-            except MeshError as e:
-                effects.error("E0602", f"estimate_missing_coms of link '{name}': {e}", "links")
+            whole = collision_solid(self, name, link.collisions, effects)
+            if whole is None or whole.props.mass <= 0:
                 continue
-            if total <= 0:
-                continue
-            com = tuple(float(x) for x in moment / total)
+            com = tuple(float(x) for x in whole.props.com)
             origin = replace(inertial.origin or Pose(), xyz=com, written=(True, True))
             links[name] = replace(link, inertial=replace(inertial, origin=origin))
         return replace(robot, links=links)
+
+
+@record(kw_only=True)
+class EstimateMissingInertia(Op):
+    """Fill the inertia tensor of each of `links` (all when empty) that has a mass and a
+    missing or zero inertia, from its collision geometry."""
+
+    WHAT = "estimate_missing_inertia"
+
+    links: tuple[str, ...] = ()
+
+    def reads(self) -> tuple[Ref, ...]:
+        return tuple(Ref("link", n, "links") for n in self.links)
+
+    def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """The inertia becomes the union's (uniform density) scaled to the link's mass, about
+        the union's centre of volume, turned into the inertial frame; the COM is kept."""
+        from mpc.ir.kinematics import pose_matrix
+
+        links = dict(robot.links)
+        for name in self.links or tuple(robot.links):
+            link = links[name]
+            inertial = link.inertial
+            if inertial is None or inertial.mass <= 0 or not link.collisions or any(
+                    getattr(inertial.inertia, k) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")):
+                continue
+            whole = collision_solid(self, name, link.collisions, effects)
+            if whole is None or whole.props.mass <= 0:
+                continue
+            R = pose_matrix(inertial.origin or Pose())[:3, :3]
+            I_C = R.T @ whole.props.I @ R * (inertial.mass / whole.props.mass)
+            values = {k: float(I_C[a, b]) for k, (a, b) in (("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)),
+                                                        ("iyy", (1, 1)), ("iyz", (1, 2)), ("izz", (2, 2)))}
+            links[name] = replace(link, inertial=replace(inertial, inertia=Inertia(**values)))
+        return replace(robot, links=links)
+
+
+def collision_solid(op: Op, link: str, collisions: Sequence[Collision], effects: Effects,
+                    field: str = "links") -> Solid | None:
+    """The solid union of a link's collisions in the link frame (ir/solids.py); warns about
+    convex-hull stand-ins (W0580) and repaired meshes (W0581) at the op's `field`; None after
+    an unreadable mesh (E0602)."""
+    from mpc.ir.kinematics import pose_matrix
+    from mpc.ir.mesh_props import MeshError
+    from mpc.ir.solids import solid, union
+
+    try:
+        whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in collisions])
+    except MeshError as e:
+        effects.error("E0602", f"{op.what()} of link '{link}': {e}", field)
+        return None
+    for code, note in whole.notes:
+        effects.sink.warning(op.span_of(field), code, f"{op.what()} of link '{link}': {note}")
+    return whole
 
 
 @record(kw_only=True)

@@ -82,9 +82,6 @@ MESH_REFUSED: dict[str, tuple[str, str]] = {
     "b1_description/urdf/b1.urdf": ("trunk.dae gives an STL of 250k faces", STL_FACES),
     "b1_description/urdf/b1-z1.urdf": ("trunk.dae gives an STL of 250k faces", STL_FACES),
     "go1_description/urdf/go1.urdf": ("trunk.dae gives an STL of 351k faces", STL_FACES),
-    # pycollada fails on a missing texture surface; trimesh then reads no triangles at all.
-    "anymal_b_simple_description/robots/anymal.urdf": ("anymal_foot.dae converts to 0 faces", STL_FACES),
-    "anymal_b_simple_description/robots/anymal-kinova.urdf": ("as anymal.urdf", STL_FACES),
 }
 # Converting OBJ needs Pillow (trimesh reads OBJ materials), which mpc does not install; OBJ
 # meshes are copied as they are when the export's format is obj.
@@ -174,6 +171,12 @@ def _assert_same_robot(source: Path, robot: Robot, model: mujoco.MjModel) -> Non
         assert model.body_mass[body] == link.inertial.mass
 
 
+# Models with a DAE mesh whose material references are broken (W0605: read all the same): the
+# ANYmal foot's texture was not shipped.
+BROKEN_DAE = {"anymal_b_simple_description/robots/anymal.urdf",
+              "anymal_b_simple_description/robots/anymal-kinova.urdf"}
+
+
 def test_the_lists_above_name_real_models() -> None:
     assert set(BAD_INERTIA) | set(MESH_REFUSED) | OBJ_EXPORT <= set(GOOD)
     assert len(set(GOOD) - set(BAD_INERTIA) - set(MESH_REFUSED)) == 47  # the models MuJoCo loads
@@ -183,7 +186,10 @@ def test_the_lists_above_name_real_models() -> None:
 def test_model_loads_in_mujoco_as_the_same_robot(model: str, emitted: Callable[[str, str], Emitted]) -> None:
     e = emitted(model, "obj" if model in OBJ_EXPORT else "stl")
     codes = sorted(d.code for d in e.diagnostics)
-    assert set(codes) <= {"W0500", "E0504"} and codes.count("W0500") <= 1, [d.message for d in e.diagnostics]
+    broken_dae = {"W0605"} if model in BROKEN_DAE else set()
+    assert set(codes) - broken_dae <= {"W0500", "E0504"} and codes.count("W0500") <= 1, \
+        [d.message for d in e.diagnostics]
+    assert ("W0605" in codes) == bool(broken_dae)
     # Canonical: the same robot gives the same text, and to_string is what emit wrote.
     assert mjcf.to_string(e.robot, e.namer) == e.xml.read_text()
     flagged = _flagged(e.diagnostics)

@@ -75,6 +75,18 @@ def test_every_argument_form_and_the_ir_round_trip(tmp_path: Path, diags: Diags)
      "{joint: value}"),
     ("    tests:\n      - physical_validity: loud\n", "E0703",
      "test 'physical_validity': the argument is 'error' (findings fail the test) or 'warning', got 'loud'"),
+    ("    tests:\n      - physical_validity: {severity: loud}\n", "E0703",
+     "test 'physical_validity': the argument is 'error' (findings fail the test) or 'warning', got 'loud'"),
+    ("    tests:\n      - physical_validity: {density: [100]}\n", "E0703",
+     "test 'physical_validity': 'density' is the range of plausible densities [min, max] in kg/m³, "
+     "0 ≤ min < max, e.g. [100, 25000]"),
+    ("    tests:\n      - physical_validity: {density: [500, 100]}\n", "E0703",
+     "test 'physical_validity': 'density' is the range of plausible densities [min, max] in kg/m³, "
+     "0 ≤ min < max, e.g. [100, 25000]"),
+    ("    tests:\n      - physical_validity: {inertia_factor: 0.5}\n", "E0703",
+     "test 'physical_validity': 'inertia_factor' is at least 1, got 0.5"),
+    ("    tests:\n      - physical_validity: {densty: [1, 2]}\n", "E0703",
+     "test 'physical_validity': unknown key 'densty' (it takes 'severity', 'density' and 'inertia_factor')"),
     ("    tests:\n      - hyrodynChecks: [{symmetry_check: {links: [a, b], plane: [0, 0, 0]}}]\n", "E0703",
      "test 'symmetry_check': 'plane' is the normal of the mirror plane, three numbers not all zero, "
      "e.g. [0, 1, 0]"),
@@ -110,3 +122,13 @@ def test_a_waiver_is_lower_case_and_zero_tolerances_are_exact(tmp_path: Path, di
                 "{git: a.git, ignore_failing_tests_for: '82B92A86'}\n    tests: []\n", diags)
     assert p.test.compare.ignore_failing_tests_for == "82b92a86"
     assert (p.test.tolerances.mass, p.test.tolerances.distance) == (0.0, 0.0)
+
+
+def test_physical_validity_settings_survive_the_ir_text(tmp_path: Path, diags: Diags) -> None:
+    p = program(tmp_path, "    tests:\n      - physical_validity: {severity: error, density: [50, 3e4], "
+                "inertia_factor: 4}\n", diags)
+    assert p is not None and p.test is not None
+    [validity] = p.test.tests
+    assert (validity.as_error, validity.density, validity.inertia_factor) == (True, (50.0, 30000.0), 4.0)
+    back = parse(dump(p), "arm.ir", diags)
+    assert back is not None and back.test == p.test

@@ -16,9 +16,10 @@ from tests.conftest import ERD
 
 
 def flagged(path: Path) -> dict[str, str]:
+    """The W0701 findings (possibility; the plausibility ones are tested below)."""
     robot = read(path, Sink())
     assert robot is not None
-    return dict(findings(robot, 0.003))
+    return {link: problem for link, code, problem in findings(robot, 0.003) if code == "W0701"}
 
 
 def test_talos_links_with_mass_but_no_inertia_are_flagged() -> None:
@@ -61,7 +62,7 @@ def test_findings_are_warnings_unless_configured_as_errors(tmp_path: Path) -> No
     sink = Sink()
     protocol = run(tmp_path / "w.yml", tmp_path / "w", tmp_path / "work", sink)
     validity = result(protocol, "physical_validity")
-    assert (validity.status, validity.figure) == ("passed", 3.0)
+    assert (validity.status, validity.figure) == ("passed", 6.0)  # and three implausible densities
     warnings = [d for d in sink.diagnostics if d.code == "W0701"]
     assert [d.severity for d in warnings] == [Severity.WARNING] * 3
     assert warnings[0].span.file.endswith("talos.urdf")  # the written model, at the link
@@ -82,7 +83,7 @@ def test_a_moving_link_without_mass_and_a_com_outside_its_shapes(tmp_path: Path)
     write(tmp_path / "f.urdf", urdf)
     robot = read(tmp_path / "f.urdf", Sink())
     assert robot is not None
-    found = findings(robot, 0.003)
+    found = [(link, problem) for link, code, problem in findings(robot, 0.003) if code == "W0701"]
     assert found[:2] == [("coupler", "moves with joint 'coupler_joint' but neither it nor a link beyond "
                                      "it has mass"),
                          ("coupler", "has collision shapes but no mass")]
@@ -95,3 +96,95 @@ def test_a_massless_link_between_joints_of_a_3_dof_joint_is_not_a_finding() -> N
     """example-robot-data's human: each ankle, wrist, hip and shoulder is three revolute joints
     with massless `…_virtual` links between them; the mass is beyond them, so they are fine."""
     assert flagged(ERD / "human_description/robots/human.urdf") == {}
+
+
+# -- plausibility: the declared mass properties against the collision solid ------------------
+
+CUBE = """
+<robot name="cube">
+  <link name="base"/>
+  <joint name="j" type="revolute"><parent link="base"/><child link="body"/><axis xyz="0 0 1"/>
+    <limit effort="1" velocity="1" lower="-1" upper="1"/></joint>
+  <link name="body">
+    <inertial><origin xyz="COM"/><mass value="MASS"/>
+      <inertia ixx="I" ixy="0" ixz="0" iyy="I" iyz="0" izz="I"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+</robot>
+"""
+
+
+def _cube(tmp_path: Path, com: str = "0 0 0", mass: float = 2.0, inertia: float | None = None) -> Path:
+    """A 10 cm cube of `mass` (2 kg: 2000 kg/m³) with its own inertia unless told otherwise."""
+    i = inertia if inertia is not None else mass * 0.01 / 6
+    return write(tmp_path / "cube.urdf", CUBE.replace("COM", com).replace("MASS", repr(mass))
+                 .replace('"I"', f'"{i!r}"'))
+
+
+def _found(path: Path, **settings) -> list[tuple[str, str, str]]:
+    robot = read(path, Sink())
+    assert robot is not None
+    return findings(robot, 0.003, **settings)
+
+
+def test_a_plausible_link_gives_nothing(tmp_path: Path) -> None:
+    assert _found(_cube(tmp_path)) == []
+
+
+def test_a_com_1_m_outside_its_link_is_flagged_with_its_figures(tmp_path: Path) -> None:
+    assert _found(_cube(tmp_path, com="1.05 0 0")) == [
+        ("body", "W0701", "COM (1.05, 0, 0) m lies 1 m outside the collision bounding box "
+                          "(-0.05, -0.05, -0.05)…(0.05, 0.05, 0.05) m")]
+
+
+def test_an_implausible_density_is_flagged_within_a_configurable_range(tmp_path: Path) -> None:
+    """50 kg in a litre: 50 g/cm³, what a unit mistake in CAD export gives."""
+    cube = _cube(tmp_path, mass=50.0)
+    assert _found(cube) == [("body", "W0710", "implied density 5e+04 kg/m³ (mass 50 kg in 0.001 m³ of "
+                                              "collision solid) lies outside 100–25000 kg/m³")]
+    assert _found(cube, density=(100.0, 60000.0)) == []
+
+
+def test_principal_moments_far_from_the_geometrys_are_flagged(tmp_path: Path) -> None:
+    """The cube's moments are m·a²/6 = 0.00333 kg·m²; twenty times that is flagged at the
+    default factor (10), not with a factor of 30."""
+    cube = _cube(tmp_path, inertia=20 * 2.0 * 0.01 / 6)
+    assert _found(cube) == [("body", "W0711", "principal moments (0.06667, 0.06667, 0.06667) kg·m² differ "
+                                              "from the collision solid's (0.003333, 0.003333, 0.003333) "
+                                              "kg·m² at its mass by up to a factor of 20 (more than 10)")]
+    assert _found(cube, factor=30.0) == []
+
+
+def test_plausibility_on_talos_and_ur5() -> None:
+    """What the plausibility check finds on real models (they are in the report of issue 23):
+    TALOS's camera and force-torque tool frames weigh 10 g and 1 g in 222 and 19 cm³ (densities
+    45 and 52 kg/m³); UR5's wrist inertias are 142 to 263 times what their collision meshes
+    give at their masses (ur_description's well-known cylinder inertias). With a range and a
+    factor that accept these, both are silent."""
+    def plausibility(path: Path, **settings) -> dict[str, str]:
+        return {link: code for link, code, _ in _found(path, **settings) if code != "W0701"}
+
+    talos, ur5 = ERD / "talos_data/robots/talos_full_v2.urdf", ERD / "ur_description/urdf/ur5_robot.urdf"
+    assert plausibility(talos) == {"rgbd_link": "W0710", "wrist_left_ft_tool_link": "W0710",
+                                   "wrist_right_ft_tool_link": "W0710"}
+    assert plausibility(ur5) == {"wrist_1_link": "W0711", "wrist_2_link": "W0711", "wrist_3_link": "W0711"}
+    assert plausibility(talos, density=(40.0, 25000.0)) == {}
+    assert plausibility(ur5, factor=300.0) == {}
+
+
+def test_the_protocol_lists_the_figures_and_the_settings_come_from_the_definition(tmp_path: Path) -> None:
+    cube = _cube(tmp_path, mass=50.0)
+    tests = "      - physical_validity: {density: [100, 60000]}\n"
+    write(tmp_path / "w.yml", definition(cube, "cube", tests))
+    sink = Sink()
+    validity = result(run(tmp_path / "w.yml", tmp_path / "w", tmp_path / "work", sink), "physical_validity")
+    assert (validity.status, validity.figure) == ("passed", 0.0)
+    write(tmp_path / "e.yml", definition(cube, "cube", "      - physical_validity:\n"
+                                                       "          severity: error\n"
+                                                       "          inertia_factor: 2\n"))
+    protocol = run(tmp_path / "e.yml", tmp_path / "e", tmp_path / "work")
+    validity = result(protocol, "physical_validity")
+    assert validity.status == "failed"
+    assert validity.details == ("body: implied density 5e+04 kg/m³ (mass 50 kg in 0.001 m³ of collision "
+                                "solid) lies outside 100–25000 kg/m³",)
+    assert "body: implied density 5e+04 kg/m³" in protocol.markdown()

@@ -40,4 +40,4 @@ def test_the_ir_text_knows_every_op_in_a_fresh_process() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     every = sorted(getattr(ops, name).kind for names in ops._MODULES.values() for name in names)
     assert done.stdout.split() == every
-    assert len(every) == 33
+    assert len(every) == 34
