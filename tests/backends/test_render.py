@@ -148,3 +148,12 @@ def test_no_egl_is_an_error_naming_what_to_install(tmp_path: Path, diags: Diags,
     d = diags.take_error("E0570")
     assert d.message.startswith("cannot draw robot 'bot' without a display: MuJoCo found no EGL")
     assert d.hint is not None and "apt-get install libegl1 libgl1-mesa-dri" in d.hint
+
+
+def test_two_render_exports_in_one_folder(tmp_path: Path, diags: Diags) -> None:
+    path = write(tmp_path / "bot.yml", definition(UR5, robotname="bot")
+                 + "    - type: render\n    - type: render\n      views: top\n")
+    assert compile_model(path, diags, Options(out=tmp_path / "out")).out is None
+    d = diags.take_error("E0576")
+    assert d.message == "two render exports would write render/"
+    assert (d.span.line, d.span.col) == (13, 7) and d.notes[0][0].line == 12
