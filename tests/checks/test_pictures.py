@@ -136,3 +136,26 @@ def test_an_unchanged_model_is_all_grey(tmp_path: Path) -> None:
             assert orange(p) == 0 and blue(p) == 0 and grey(p) > 300, (view, side)
         assert (out / f"test_pictures/{view}_release.png").read_bytes() == \
             (out / f"test_pictures/{view}_new.png").read_bytes()
+
+
+def test_without_egl_the_protocol_says_so_and_the_tests_still_count(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from mpc.compiler.diagnostics import Sink
+    from tests.fixtures import arm
+
+    urdf = arm(tmp_path)
+    write(tmp_path / "ref.yml", definition(urdf, "arm", "      - compare_amount_joints\n"))
+    compile_ok(tmp_path / "ref.yml", tmp_path / "ref")
+    write(tmp_path / "new.yml", definition(urdf, "arm", "      - compare_amount_joints\n",
+                                           compare=f"      path: {tmp_path / 'ref'}\n"))
+    monkeypatch.setenv("PYOPENGL_PLATFORM", "glx")  # a desktop's setting: mpc draws through EGL only
+    sink = Sink()
+    protocol = run(tmp_path / "new.yml", tmp_path / "new", tmp_path / "work", sink)
+    protocol.write(tmp_path / "new")
+    assert not protocol.failed and protocol.pictures is not None
+    [warning] = [d for d in sink.diagnostics if d.code == "W0720"]
+    assert warning.message.startswith("the test protocol has no pictures: no EGL to draw with")
+    markdown = (tmp_path / "new/test_protocol.md").read_text()
+    assert "No pictures: no EGL to draw with (PYOPENGL_PLATFORM is 'glx'" in markdown
+    assert not (tmp_path / "new/test_pictures").exists()
+    assert json.loads((tmp_path / "new/test_protocol.json").read_text())["pictures"]["views"] == {}
