@@ -11,6 +11,7 @@ _MODULES = {
     "sdf": "mpc.backends.sdf",
     "smurf": "mpc.backends.smurf",
     "pdf": "mpc.backends.pdf",
+    "render": "mpc.backends.render",
     "joint_limits": "mpc.backends.joint_limits",
     "kccd": "mpc.backends.kccd",
     "ros_package": "mpc.backends.ros_package",

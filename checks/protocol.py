@@ -9,15 +9,20 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from mpc.backends import xml_escape
+
+if TYPE_CHECKING:
+    from mpc.checks.pictures import VisualDiff
 
 Status = Literal["passed", "failed", "waived", "skipped"]
 # Characters XML 1.0 cannot hold, even escaped (a library's console may print them).
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+_SIDES = ("release", "new", "overlay")  # the pictures of each view (checks/pictures.py)
 _SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
 
 
@@ -85,6 +90,7 @@ class Protocol:
     results: list[Result] = field(default_factory=list)
     compare: str = ""  # what the model was compared with (repository @ commit, or folder)
     waiver: str = ""  # why failures are waived, when they are
+    pictures: VisualDiff | None = None  # the visual diff against the compare model
 
     def add(self, result: Result) -> None:
         """Record `result`; a repeated name gets a suffix; a failure becomes a waiver when
@@ -124,6 +130,7 @@ class Protocol:
         for r in self.results:
             lines.append(f"| `{r.name}` | {_SIGN[r.status]} | {_figure(r)} | {_tolerance(r)} | "
                          f"{_cell(r.reason)} |")
+        lines += self._pictures_markdown()
         for r in self.results:
             if r.details or r.log:
                 lines += ["", f"<details><summary><code>{r.name}</code></summary>", "", "```"]
@@ -133,10 +140,40 @@ class Protocol:
                 lines += ["```", "", "</details>"]
         return "\n".join(lines) + "\n"
 
+    def _pictures_markdown(self) -> list[str]:
+        """The visual diff: per view the release, the new model and both overlaid."""
+        p = self.pictures
+        if p is None:
+            return []
+        tree = [] if not p.tree else [
+            "", f"The kinematic tree, changed links in orange: [{p.tree}]({p.tree})"]
+        if p.problem:
+            return ["", f"No pictures: {_cell(p.problem)}", *tree]
+        changed = ", ".join(f"`{link}` ({why})" for link, why in p.changed.items()) or "none"
+        lines = ["", "### Pictures", "", "Links changed beyond the tolerances are coloured (blue in the "
+                 "release, orange in the new model); the others are grey. The overlay shows both.",
+                 "", f"Changed links: {_cell(changed)}.", "", "| view | release | new | overlay |",
+                 "|---|---|---|---|"]
+        for view in p.views:
+            cells = " | ".join(f"![{view}, {side}]({p.path(view, side)})" for side in _SIDES)
+            lines.append(f"| {view} | {cells} |")
+        return lines + tree
+
+    def picture_files(self) -> list[str]:
+        """The pictures' paths, relative to the protocol."""
+        p = self.pictures
+        if p is None:
+            return []
+        return [p.path(v, s) for v in p.views for s in _SIDES if p.drawn] + ([p.tree] if p.tree else [])
+
     def to_json(self) -> dict[str, object]:
+        p = self.pictures
+        pictures = None if p is None else {
+            "views": {v: {s: p.path(v, s) for s in _SIDES} for v in p.views} if p.drawn else {},
+            "kinematic_tree": p.tree or None, "changed_links": p.changed, "problem": p.problem}
         return {
             "model": self.model, "failed": self.failed, "counts": self.counts(),
-            "compare": self.compare, "waiver": self.waiver,
+            "compare": self.compare, "waiver": self.waiver, "pictures": pictures,
             "tests": [{"name": r.name, "status": r.status, "reason": r.reason, "figure": r.figure,
                        "unit": r.unit, "tolerances": [{"name": t.name, "value": t.value, "unit": t.unit,
                                                        "kind": "absolute"} for t in r.tolerances],
@@ -149,6 +186,11 @@ class Protocol:
                f'<testsuites name="mpc test" tests="{len(self.results)}" failures="{c["failed"]}">',
                f'  <testsuite name={_xml_attribute(self.model)} tests="{len(self.results)}" '
                f'failures="{c["failed"]}" skipped="{c["skipped"] + c["waived"]}" errors="0">']
+        files = self.picture_files()
+        if files:
+            out.append("    <properties>")
+            out += [f'      <property name="picture" value={_xml_attribute(f)}/>' for f in files]
+            out.append("    </properties>")
         for r in self.results:
             head = f'    <testcase classname={_xml_attribute(self.model)} name={_xml_attribute(r.name)}'
             measured = [] if r.figure is None else [f"{_figure(r)} (tolerance {_tolerance(r) or 'none'})"]
@@ -164,6 +206,9 @@ class Protocol:
             if r.log:
                 out.append(f"      <system-out>{_xml_text(r.log)}</system-out>")
             out.append("    </testcase>")
+        if files:  # GitLab's and Jenkins's way of attaching files to a report
+            out.append(f"    <system-out>{_xml_text(chr(10).join(f'[[ATTACHMENT|{f}]]' for f in files))}"
+                       "</system-out>")
         out += ["  </testsuite>", "</testsuites>"]
         return "\n".join(out) + "\n"
 
@@ -175,6 +220,23 @@ class Protocol:
         write_atomic(folder / "test_protocol.md", self.markdown())
         write_atomic(folder / "test_protocol.json", json.dumps(self.to_json(), indent=2) + "\n")
         write_atomic(folder / "test_protocol.junit.xml", self.junit())
+        self._write_pictures(folder)
+
+    def _write_pictures(self, folder: Path) -> None:
+        """The pictures into `folder/test_pictures/`, replacing those of an earlier run (a
+        symbolic link there is removed, not followed)."""
+        from mpc.checks.pictures import FOLDER
+
+        target = folder / FOLDER
+        if target.is_symlink() or target.is_file():
+            target.unlink()
+        elif target.exists():
+            shutil.rmtree(target)
+        if self.pictures is None or not self.pictures.files:  # pictures, or the tree alone
+            return
+        target.mkdir()
+        for name, data in sorted(self.pictures.files.items()):
+            (target / name).write_bytes(data)
 
 
 def first_of(problems: list[str]) -> str:

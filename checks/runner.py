@@ -11,12 +11,13 @@ import traceback
 from collections.abc import Callable
 from pathlib import Path
 
-from mpc.checks import bullet, dynamics, masses, process, topology, validity  # noqa: F401  (registration)
+from mpc.checks import bullet, dynamics, masses, pictures, process, topology, validity  # noqa: F401  (registration)
 from mpc.checks.models import Model, load_built, load_compare
+from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
 from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
 from mpc.compiler.diagnostics import Sink
-from mpc.ir.program import ModelTest, Program, TestPlan
+from mpc.ir.program import ModelTest, PdfExport, Program, TestPlan
 from mpc.ir.robot import Robot
 
 ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity")
@@ -65,7 +66,19 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     tests += [ModelTest(name=name, span=plan.span) for name in ALWAYS if name not in listed]
     for test in tests:
         protocol.add(_run(ctx, test))
+    if ctx.old is not None and ctx.new is not None:
+        protocol.pictures = _pictures(ctx)
     return protocol
+
+
+def _pictures(ctx: Context) -> VisualDiff:
+    """The visual diff against the release (checks/pictures.py); a bug in it is its reason."""
+    try:
+        tree = any(isinstance(e, PdfExport) and not e.submodel for e in ctx.program.exports)
+        return pictures.draw(ctx.compare.robot, ctx.built.robot, ctx.tol,
+                             pictures.render_export(ctx.program.exports), ctx.sink, tree=tree)
+    except Exception as e:
+        return VisualDiff(problem=_bug(e))
 
 
 def _load(loader: Callable[..., tuple[Model | None, str]], *args: object) -> tuple[Model | None, str]:

@@ -99,7 +99,13 @@ def _parser() -> argparse.ArgumentParser:
     ci.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container)")
     ci.add_argument("--setup", default="pip install model-pipeline-compiler",
                     help="command that installs mpc in a job (default: %(default)s)")
-    for p in (comp, check, test, run):
+    view = sub.add_parser("view", help="show a model in the browser (a local web viewer)")
+    view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
+    view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
+                      "or a git repository at a branch or commit")
+    view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
+    view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
+    for p in (comp, check, test, run, view):
         _diagnostic_options(p)
     return parser
 
@@ -242,6 +248,12 @@ def _test(args: argparse.Namespace) -> int:
     return 1 if protocol.failed else 0
 
 
+def _view(args: argparse.Namespace) -> int:
+    from mpc.compiler.view import run
+
+    return run(args)
+
+
 def _pipeline(args: argparse.Namespace) -> int:
     """`mpc run` and `mpc ci` (compiler/pipeline/command.py)."""
     from mpc.compiler.pipeline import command
@@ -259,7 +271,7 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     command = {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
-               "deploy": _deploy, "run": _pipeline, "ci": _pipeline}[args.command]
+               "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command]
     try:
         if _json_on_stdout(args):
             from mpc.compiler.render import json_document

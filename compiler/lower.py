@@ -362,6 +362,20 @@ class Lowering:
                 return [] if self.sink.has_errors() else lowered
             finally:
                 self.sink = sink
+        if entry.type == "render":
+            from mpc.compiler.lower_render import lower_render
+
+            target = f"{'submodels/' + submodel + '/' if submodel else ''}render/"
+            if target in written:
+                if not inherited:
+                    self.sink.error(entry.span, "E0576", f"two render exports would write {target}",
+                                    notes=((written[target].span, "the other export"),))
+                return []
+            render = lower_render(entry, self.sink if not inherited else Sink(), submodel)
+            if render is None:
+                return []
+            written[target] = render
+            return [render]
         if entry.type in ("pdf", "joint_limits"):
             export = self.simple_export(entry, inherited)
             return [] if export is None else [replace(export, submodel=submodel)]

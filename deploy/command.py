@@ -56,8 +56,9 @@ def run(args: argparse.Namespace) -> int:
     protocol = None if args.protocol is None else _read_protocol(args.protocol, sink)
     result = None
     if program is not None and settings is not None and not sink.has_errors():
+        pictures = None if args.protocol is None else args.protocol.parent / "test_pictures"
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
-                              tests_failed=args.tests_failed)
+                              tests_failed=args.tests_failed, pictures=pictures)
     print_diagnostics(sink.diagnostics, args.format)
     if result is None or not result.ok:
         print(f"error: could not deploy '{args.definition}'", file=sys.stderr)

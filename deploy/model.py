@@ -18,6 +18,7 @@ from mpc.deploy import content, lfs, names, submodules
 from mpc.deploy.forges import adapter
 from mpc.deploy.gitcmd import DeployError, scrub
 from mpc.deploy.merge_request import merge_request
+from mpc.deploy.pictures import FOLDER, copy_pictures
 from mpc.deploy.plan import Plan, check_plan_branches, do_not_deploy, make_plan
 from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
 from mpc.deploy.repository import Clone, locked, open_clone, publish
@@ -27,8 +28,12 @@ from mpc.ir.program import Program
 
 
 def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: Sink, *,
-                 protocol_markdown: str | None = None, tests_failed: bool = False) -> DeployResult:
+                 protocol_markdown: str | None = None, tests_failed: bool = False,
+                 pictures: Path | None = None) -> DeployResult:
     """Deploy the build of `program` in `built` (what `mpc compile` wrote).
+
+    pictures: the folder of the protocol's pictures (`test_pictures/` beside it), committed
+    with the model when it is not the build's own; the merge request links them.
 
     Models deployed at the same time (a pipeline's workers, or two CI jobs) may share the
     workdir: each holds the lock of its own clone, and the shared caches have locks of their own.
@@ -47,7 +52,7 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
         workdir = _workdir(settings.workdir)
         with locked(workdir / program.modelname):
             _deploy(program, built.resolve(), remote, workdir, settings, result, protocol_markdown,
-                    tests_failed)
+                    tests_failed, pictures)
     except DeployError as e:
         sink.error(span, e.code, e.message)
         result.ok = False
@@ -92,7 +97,8 @@ def _workdir(folder: Path) -> Path:
 
 
 def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings: DeploySettings,
-            result: DeployResult, protocol: str | None, tests_failed: bool) -> None:
+            result: DeployResult, protocol: str | None, tests_failed: bool,
+            pictures: Path | None = None) -> None:
     clone = open_clone(remote, workdir / program.modelname, settings.remote_name)
     plan = make_plan(program, settings, clone.url, clone.default_branch, tests_failed)
     check_plan_branches(plan)
@@ -116,6 +122,9 @@ def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings:
 
     def fill(c: Clone) -> None:
         fill_model(c, built, program, plan, prov, pinned)
+        if pictures is not None and pictures.is_dir() and pictures.resolve() != built / FOLDER:
+            copy_pictures(pictures, c.folder)
+            c.git("add", "-A")
 
     published = publish(clone, plan.branch, plan.base, fill, message, settings.dry_run, forge, request)
     record_push(result, published, forge, request)

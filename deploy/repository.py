@@ -19,6 +19,7 @@ from pathlib import Path
 from mpc.deploy.forges import ForgeAdapter
 from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git, without_credentials
 from mpc.deploy.merge_request import MergeRequest
+from mpc.deploy.pictures import link_pictures
 
 ATTEMPTS = 3
 
@@ -144,6 +145,7 @@ class Published:
     diffstat: str = ""
     output: str = ""
     attempts: int = 1
+    request: MergeRequest | None = None  # as pushed: its pictures linked to the commit
 
 
 Fill = Callable[[Clone], None]
@@ -160,6 +162,7 @@ def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: st
     files the other commit added that neither names are removed, as on every update.
     """
     options = forge.push_options(request) if forge is not None and request is not None else []
+    original = request
     for attempt in range(1, ATTEMPTS + 1):
         start = start_branch(clone, branch, base)
         fill(clone)
@@ -168,6 +171,10 @@ def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: st
         if dry_run:
             return Published(None, False, diff_stat(clone.git, start), attempts=attempt)
         sha = commit(clone.git, message)
+        if forge is not None and request is not None:
+            # the description's pictures link to this commit (deploy/pictures.py)
+            request = link_pictures(original, forge.name, sha)  # type: ignore[arg-type]
+            options = forge.push_options(request)
         if forge is not None and request is not None and attempt == 1:
             forge.before_push(request)
         args = ["push", "--porcelain"]
@@ -175,7 +182,7 @@ def publish(clone: Clone, branch: str, base: str | None, fill: Fill, message: st
             args += ["-o", option]
         status, out, err = clone.git.result(*args, "--", clone.remote, f"HEAD:refs/heads/{branch}")
         if status == 0:
-            return Published(sha, True, output=f"{out}\n{err}", attempts=attempt)
+            return Published(sha, True, output=f"{out}\n{err}", attempts=attempt, request=request)
         before = clone.remote_sha(branch)
         clone.fetch()
         if clone.remote_sha(branch) == before:

@@ -42,6 +42,7 @@ def record_push(result: DeployResult, published: Published, forge: ForgeAdapter,
                 request: MergeRequest | None) -> None:
     """What `publish` did, into `result`; the merge request is made once the push went through."""
     result.commit, result.pushed, result.diffstat = published.sha, published.pushed, published.diffstat
+    request = published.request or request
     if published.pushed and request is not None:
         result.push_options = tuple(forge.push_options(request))
         result.merge_request = request

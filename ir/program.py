@@ -158,6 +158,35 @@ class PdfExport(ExportEntry):
 # The joint selections a `joint_limits` export may name instead of joints.
 JOINT_SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
 
+# The render export's camera directions: (azimuth, elevation) in degrees of MuJoCo's free
+# camera (the camera looks along azimuth, tilted by elevation); robots face +x (REP 103).
+RENDER_VIEWS: dict[str, tuple[float, float]] = {
+    "iso": (225.0, -25.0), "front": (180.0, 0.0), "side": (270.0, 0.0), "back": (0.0, 0.0),
+    "top": (180.0, -89.0)}
+RENDER_BACKGROUNDS: dict[str, tuple[float, float, float]] = {
+    "white": (1.0, 1.0, 1.0), "black": (0.0, 0.0, 0.0), "grey": (0.5, 0.5, 0.5), "gray": (0.5, 0.5, 0.5)}
+
+
+@record(slots=True, kw_only=True)
+class RenderExport(ExportEntry):
+    """A `type: render` entry: PNG pictures in `render/<pose>_<view>.png`, drawn headless by
+    MuJoCo (backends/render.py).
+
+    views: camera directions (backends/scene.py VIEWS). geometry: visual, collision or both.
+    poses: pose names; `zero` is every joint at 0, ("all",) the zero pose and every named one.
+    size: (width, height) in pixels. background: rgb in 0..1.
+    """
+
+    span: Span
+    views: tuple[str, ...] = ("iso", "front", "side")
+    geometry: Literal["visual", "collision", "both"] = "visual"
+    poses: tuple[str, ...] = ("all",)
+    size: tuple[int, int] = (640, 480)
+    background: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    add_floating_base: bool = False
+    submodel: str = ""
+    type: Literal["render"] = "render"
+
 
 @record(slots=True, kw_only=True)
 class JointLimitsExport(ExportEntry):
@@ -307,7 +336,7 @@ class KccdExport(ExportEntry):
 
 # The exports that write a robot (the whole one or a submodel's), optionally floating.
 RobotExport = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SmurfExport
-               | KccdExport)
+               | KccdExport | RenderExport)
 Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Set up mpc on a fresh Debian machine, as root or not:
 #  1. Debian's tools that exports and tests call: check_urdf (liburdfdom-tools), sdformat 12's
-#     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, and python3-venv when the
-#     interpreter cannot make virtual environments (Debian's own python3);
+#     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, EGL and Mesa (pictures),
+#     Chromium (the viewer's test), and python3-venv when the interpreter cannot make virtual
+#     environments (Debian's own python3);
 #  2. uv, in a virtual environment of its own under the user's cache (PEP 668: nothing is
 #     installed into the system's Python);
 #  3. the project's virtual environment `.venv`, exactly as `uv.lock` pins it, with the dev extra,
@@ -22,6 +23,9 @@ command -v ign >/dev/null || packages+=(ignition-tools libsdformat12-12 sdformat
 command -v dot >/dev/null || packages+=(graphviz)
 command -v pdftoppm >/dev/null || packages+=(poppler-utils)
 command -v git-lfs >/dev/null || packages+=(git-lfs)
+# the render export and mpc test's pictures: MuJoCo draws headless through EGL on Mesa (llvmpipe)
+/sbin/ldconfig -p 2>/dev/null | grep -q "libEGL_mesa.so.0" || packages+=(libegl1 libegl-mesa0 libgl1-mesa-dri)
+command -v chromium >/dev/null || packages+=(chromium)  # the test of `mpc view` loads its page
 "$PYTHON" -c "import ensurepip, venv" 2>/dev/null || packages+=(python3-venv)
 if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
   echo "setup: apt-get install ${packages[*]}" >&2

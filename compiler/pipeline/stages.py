@@ -184,7 +184,8 @@ def deploy_stage(job: StageJob) -> StageOutcome:
     tested = job.results.get("test")
     tests = tested.details if tested is not None else {}
     result = deploy_model(job.program, job.built, settings, job.sink,
-                          protocol_markdown=tests.get("markdown"), tests_failed=bool(tests.get("failed")))
+                          protocol_markdown=tests.get("markdown"), tests_failed=bool(tests.get("failed")),
+                          pictures=job.workdir / "test_pictures" if tested is not None else None)
     if not result.ok:
         return StageOutcome("failed", first_error(job.sink.diagnostics))
     if result.skipped:

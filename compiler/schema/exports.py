@@ -62,6 +62,16 @@ class PdfExport(_Export):
     type: Literal["pdf"]
 
 
+class RenderExport(_Export):
+    SECTION: ClassVar[str] = "a render export"
+    type: Literal["render"]
+    views: OneOrMore = ["iso", "front", "side"]
+    geometry: Literal["visual", "collision", "both"] = "visual"
+    poses: OneOrMore = ["all"]
+    size: list[int] = [640, 480]
+    background: str | list[Expr] = "white"
+
+
 class JointLimitsExport(_Export):
     SECTION: ClassVar[str] = "a joint_limits export"
     type: Literal["joint_limits"]
@@ -119,5 +129,5 @@ class SubmodelExport(_Export):
 
 
 # Told apart by `type` (compiler/schema/base.py: TaggedType).
-ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | JointLimitsExport
-               | KccdExport | SubmodelExport)
+ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | RenderExport
+               | JointLimitsExport | KccdExport | SubmodelExport)

@@ -1,0 +1,90 @@
+"""ir.Robot → `render/<pose>_<view>.png`: pictures of the robot drawn headless by MuJoCo.
+
+For each pose (the zero pose `zero` and the named poses, or those the entry lists) and each
+view, the camera frames every drawn shape at that pose. The PNGs carry no date: the same
+model gives the same bytes. No EGL is E0570 naming what to install; it draws nothing else
+(no animation, no textures: the MJCF holds colours only).
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+
+from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
+from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.ir.program import RenderExport
+from mpc.ir.robot import Robot
+
+ZERO = "zero"  # the pose with every joint at 0
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]")
+
+
+def file_stem(name: str) -> str:
+    """A pose or view name as part of a file name: only letters, digits, `_`, `.` and `-`
+    (a pose name is free text; it must not reach outside `render/`)."""
+    stem = _UNSAFE.sub("_", name).lstrip(".")
+    return stem or "_"
+
+
+def pose_values(robot: Robot, pose: str) -> dict[str, float]:
+    """The joint values of a pose (`zero`: none), with mimic joints following their joint."""
+    values = dict(robot.poses.get(pose, {})) if pose != ZERO or ZERO in robot.poses else {}
+    for joint in robot.joints.values():
+        m = joint.mimic
+        if m is not None and m.joint in values and joint.name not in values:
+            values[joint.name] = (m.offset or 0.0) + (1.0 if m.multiplier is None else m.multiplier) \
+                * values[m.joint]
+    return values
+
+
+def poses_of(robot: Robot, export: RenderExport, sink: Sink) -> list[str] | None:
+    """The poses to draw, or None after E0575 (a name the robot has no pose of)."""
+    if export.poses == ("all",):
+        return [ZERO, *sorted(p for p in robot.poses if p != ZERO)]
+    known = {ZERO, *robot.poses}
+    unknown = [p for p in export.poses if p not in known]
+    for name in unknown:
+        sink.error(export.span, "E0575", f"render pose '{name}' is neither '{ZERO}' nor a pose of "
+                   f"robot '{robot.name}'{did_you_mean(name, known)}",
+                   hint="poses are named in the `poses` section")
+    return None if unknown else list(dict.fromkeys(export.poses))
+
+
+def draw_all(robot: Robot, export: RenderExport, sink: Sink) -> Mapping[str, bytes] | None:
+    """{file name: PNG bytes} of every pose and view, or None after an error."""
+    poses = poses_of(robot, export, sink)
+    if poses is None:
+        return None
+    out: dict[str, bytes] = {}
+    with tempfile.TemporaryDirectory(prefix="mpc-render-") as work:
+        scene = Scene.build(robot, Path(work), sink, export.span, export.geometry, export.background)
+        if scene is None:
+            return None
+        try:
+            for pose in poses:
+                scene.pose(pose_values(robot, pose))
+                points = scene.points()
+                for view in export.views:
+                    picture = scene.draw(frame(points, view, export.size), export.size)
+                    out[f"{file_stem(pose)}_{view}.png"] = png(picture)
+        except GLMissing as e:
+            sink.error(export.span, "E0570", f"cannot draw robot '{robot.name}' without a display: "
+                       f"MuJoCo found no EGL ({e})", hint=missing_gl_hint())
+            return None
+        finally:
+            scene.close()
+    return out
+
+
+def emit(robot: Robot, export: RenderExport, out: Path, sink: Sink) -> None:
+    """Write `out/render/<pose>_<view>.png` for every pose and view of the entry."""
+    pictures = draw_all(robot, export, sink)
+    if pictures is None:
+        return
+    folder = out / "render"
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, data in sorted(pictures.items()):
+        (folder / name).write_bytes(data)
