@@ -90,15 +90,31 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--log-format", choices=("text", "json"), default="text",
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
     ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
-    ci.add_argument("system", choices=("gitlab", "github"),
-                    help="gitlab: a child pipeline; github: a workflow")
-    ci.add_argument("pipeline", type=Path, help="the pipeline file")
-    ci.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
-    ci.add_argument("--stages", default="compile", metavar="STAGE,…", help="stages each job runs")
-    ci.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container)")
-    ci.add_argument("--setup", default="pip install model-pipeline-compiler",
-                    help="command that installs mpc in a job (default: %(default)s)")
-    for p in (comp, check, test, run):
+    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary")
+    for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
+        gen = systems.add_parser(system, help=f"write {what}")
+        gen.add_argument("pipeline", type=Path, help="the pipeline file")
+        gen.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
+        gen.add_argument("--stages", default="compile", metavar="STAGE,…",
+                         help="stages to run, each in jobs of its own (default: compile)")
+        gen.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container); "
+                         "without --install, the jobs use the mpc the image has")
+        gen.add_argument("--install", "--setup", dest="install", metavar="CMD",
+                         help="shell command that installs mpc in a job and puts it on PATH (default: "
+                         "the install of this mpc, from the project's requirements.txt or how it was "
+                         "installed)")
+    job = systems.add_parser("job", help="what a generated job runs: one model and stages, with the "
+                             "artifacts of earlier jobs")
+    job.add_argument("pipeline", type=Path, help="the pipeline file")
+    job.add_argument("model", help="the modelname")
+    job.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
+    job.add_argument("--stages", default="compile", metavar="STAGE,…", help="stages to run")
+    summary = systems.add_parser("summary", help="what the last job runs: every job's status merged")
+    summary.add_argument("pipeline", type=Path, help="the pipeline file")
+    summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
+    summary.add_argument("--markdown", type=Path, metavar="FILE",
+                         help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
+    for p in (comp, check, test, run, job):
         _diagnostic_options(p)
     return parser
 
