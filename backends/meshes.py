@@ -10,6 +10,7 @@ another format, is computed with trimesh (DAE through pycollada, with its unit).
 
 from __future__ import annotations
 
+import contextlib
 import filecmp
 import hashlib
 import os
@@ -172,6 +173,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         cached = _cached_path(src, ops, dest.suffix)
         if not cached.is_file():
             todo[cached] = (src, ops, cached)
+        else:
+            _touch(cached)
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
     users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
@@ -198,6 +201,12 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(source, dest)
     return ok
+
+
+def _touch(entry: Path) -> None:
+    """Mark a cache entry as used (a CI job passes on the entries its build used: `mpc ci job`)."""
+    with contextlib.suppress(OSError):  # a read-only cache still serves
+        os.utime(entry)
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:

@@ -84,9 +84,10 @@ def renders(plan: Plan) -> set[str]:
     """The models with a `render` export (their pictures go to artifacts of their own)."""
     out = set()
     for name, model in plan.models.items():
-        exports = (model.data or {}).get("model", {}).get("export_config") if isinstance(model.data, dict) \
-            else None
-        if isinstance(exports, list) and any(isinstance(e, dict) and e.get("type") == "render" for e in exports):
+        data = model.data if isinstance(model.data, dict) else {}
+        exports = data.get("model", {}).get("export_config")
+        if isinstance(exports, list) and any(isinstance(e, dict) and e.get("type") == "render"
+                                             for e in exports):
             out.add(name)
     return out
 
@@ -113,6 +114,18 @@ def _content(path: Path) -> bytes:
         return b"-"
 
 
+def _install_digest(s: Setup) -> str:
+    """The install's commands and the files they read (the uv cache's key)."""
+    h = hashlib.sha256("\n".join(s.install.lines if s.install else ()).encode())
+    for rel in s.install.files if s.install else ():
+        h.update(_content(s.project / rel))
+    return h.hexdigest()[:16]
+
+
+def _status_files(s: Setup) -> list[str]:
+    return [f"{s.build}/.mpc/status.json", f"{s.build}/.mpc/summary.md"]
+
+
 def _header(s: Setup) -> str:
     source = s.install.source if s.install else f"the image {s.image}"
     return HEADER.format(version=s.version, command=s.command, source=source.replace("\n", " "))
@@ -137,9 +150,7 @@ def gitlab(plan: Plan, s: Setup) -> str:
     ids = {stage: job_ids(plan, f"{'build' if stage == 'compile' else stage}:", r"[^A-Za-z0-9_.:-]")
            for stage in s.stages}
     key = mesh_key(plan, s)
-    uv_key = "mpc-uv-" + hashlib.sha256("\n".join(s.install.lines if s.install else ()).encode()
-                                          + b"".join(_content(s.project / f) for f in
-                                                     (s.install.files if s.install else ()))).hexdigest()[:16]
+    uv_key = "mpc-uv-" + _install_digest(s)
     doc: dict[str, Any] = {"stages": [*s.stages, "summary"], "variables": {
         "MPC_VERSION": s.version, "MPC_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/mpc",
         "UV_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/uv", "PIP_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/pip"}}
@@ -178,7 +189,7 @@ def gitlab(plan: Plan, s: Setup) -> str:
                   {"key": key, "paths": [f"{CACHE}/mpc/"], "policy": "push", "when": "always"},
                   {"key": f"mpc-meshes-{s.version}", "paths": [f"{CACHE}/mpc/"], "policy": "push",
                    "when": "always"}],
-        "artifacts": {"when": "always", "paths": [f"{s.build}/.mpc/status.json", f"{s.build}/.mpc/summary.md"]},
+        "artifacts": {"when": "always", "paths": _status_files(s)},
     }
     return _header(s) + _dump(doc)
 
@@ -194,8 +205,7 @@ def github(plan: Plan, s: Setup) -> str:
     meshes = f"mpc-meshes-{s.version}-"
     install_files = s.install.files if s.install else ()
     uv_key = "mpc-uv-${{ runner.os }}-" + (f"${{{{ hashFiles('{install_files[0]}') }}}}" if install_files
-                                          else hashlib.sha256("\n".join(
-                                              s.install.lines if s.install else ()).encode()).hexdigest()[:16])
+                                          else _install_digest(s))
     # A saved key never changes: the summary saves under the inputs' hash and the run; a job
     # restores the newest save of the same inputs, else the newest of this mpc version.
     mesh_key_gh = meshes + f"${{{{ hashFiles({', '.join(inputs)}) }}}}"
@@ -233,7 +243,8 @@ def github(plan: Plan, s: Setup) -> str:
                               "uses": "mikepenz/action-junit-report@v5",
                               "with": {"report_paths": _junit(s, name), "check_name": f"tests of {name}"}})
             if stage == "compile" and name in pictures:
-                steps.append({"name": "pictures", "if": "${{ !cancelled() }}", "uses": "actions/upload-artifact@v4",
+                steps.append({"name": "pictures", "if": "${{ !cancelled() }}",
+                              "uses": "actions/upload-artifact@v4",
                               "with": {"name": f"pictures-{job_id}", "path": f"{s.build}/{name}/render/"}})
             job: dict[str, Any] = {"name": name if stage == "compile" else f"{stage} {name}",
                                    "runs-on": "ubuntu-latest"}
@@ -245,6 +256,7 @@ def github(plan: Plan, s: Setup) -> str:
             job["steps"] = steps
             jobs[job_id] = job
     everything = [j for stage in s.stages for j in ids[stage].values()]
+    summary = shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build])
     jobs["summary"] = {
         "name": "summary", "runs-on": "ubuntu-latest", **({"container": s.image} if s.image else {}),
         "needs": everything, "if": "${{ !cancelled() }}",
@@ -252,15 +264,14 @@ def github(plan: Plan, s: Setup) -> str:
                   {"name": "the artifacts of every job", "uses": "actions/download-artifact@v4",
                    "with": {"pattern": "model-*", "merge-multiple": True, "path": s.build}},
                   restore[0], *setup,
-                  {"name": "the status table", "run": shlex.join(
-                      ["mpc", "ci", "summary", s.pipeline, "-o", s.build, "--markdown"]) + ' "$GITHUB_STEP_SUMMARY"'},
+                  {"name": "the status table", "run": summary + ' --markdown "$GITHUB_STEP_SUMMARY"'},
                   {"name": "save the mesh cache", "uses": "actions/cache/save@v4",
                    "with": {"path": f"{CACHE}/mpc",
                             "key": mesh_key_gh + "-${{ github.run_id }}"}},
                   {"name": "save the uv cache", "uses": "actions/cache/save@v4", "if": "${{ always() }}",
                    "with": {"path": f"{CACHE}/uv", "key": uv_key + "-${{ github.run_id }}"}},
                   {"name": "keep the status", "uses": "actions/upload-artifact@v4",
-                   "with": {"name": "mpc-status", "path": f"{s.build}/.mpc/status.json\n{s.build}/.mpc/summary.md",
+                   "with": {"name": "mpc-status", "path": "\n".join(_status_files(s)),
                             "include-hidden-files": True}}]}
     doc = {"name": "mpc models", "on": {"workflow_dispatch": {}, "workflow_call": {}},
            "env": {"MPC_VERSION": s.version, "MPC_CACHE_DIR": f"${{{{ github.workspace }}}}/{CACHE}/mpc",

@@ -112,10 +112,15 @@ def _running(project: Path, sink: Sink) -> str | None:
         raw = metadata.distribution(DIST).read_text("direct_url.json")
     except metadata.PackageNotFoundError:
         raw = None
-    version = mpc_version()
-    if not raw:
-        return f"{DIST}=={version}"  # from a package index: the team's index serves it again
-    info = json.loads(raw)
+    return requirement(raw, project, sink)
+
+
+def requirement(direct_url: str | None, project: Path, sink: Sink) -> str | None:
+    """A requirement for the mpc that PEP 610's `direct_url.json` describes (None: it came
+    from a package index), for jobs that check out `project`."""
+    if not direct_url:
+        return f"{DIST}=={mpc_version()}"  # from a package index: the team's index serves it again
+    info = json.loads(direct_url)
     url: str = info["url"]
     vcs = info.get("vcs_info")
     if vcs:
