@@ -147,7 +147,8 @@ def test_github_workflow(fleet: Path, tmp_path: Path) -> None:
     _validate(path, "vendor.github-workflows")
     assert _actionlint(path) == []
     broken = tmp_path / "broken.yml"
-    broken.write_text(done.stdout.replace("needs:\n    - build-quad_front", "needs:\n    - build-quad_fronts", 1))
+    broken.write_text(done.stdout.replace("needs:\n    - build-quad_front",
+                                          "needs:\n    - build-quad_fronts", 1))
     assert any("build-quad_fronts" in finding for finding in _actionlint(broken))
     doc = yaml.safe_load(done.stdout)
     jobs = doc["jobs"]
