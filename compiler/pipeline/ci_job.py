@@ -57,9 +57,9 @@ def latest(build: Path, model: str) -> dict[str, Any] | None:
     return None
 
 
-def blocked(plan: Plan, build: Path, model: str) -> str | None:
-    """Why the model cannot be built in this job (a parent's or its own compile did not
-    succeed in an earlier job), as `mpc run` says it; None when it can."""
+def blocked(plan: Plan, build: Path, model: str, stages: tuple[str, ...]) -> str | None:
+    """Why the model cannot be built in this job (a parent's compile, or the model's own in
+    the job of its earlier stage, did not succeed), as `mpc run` says it; None when it can."""
     for parent in plan.models[model].parents:
         record = latest(build, parent)
         if record is None:
@@ -67,11 +67,24 @@ def blocked(plan: Plan, build: Path, model: str) -> str | None:
         state = record["record"]["stages"].get("compile", {}).get("state", "skipped")
         if state not in GOOD:
             return f"derived_base '{parent}' {past(state)}"
-    own = latest(build, model)
-    state = own["record"]["stages"].get("compile", {}).get("state") if own else None
-    if state is not None and state not in GOOD:
-        return f"compile {past(state)}"
-    return None
+    if len(stages) < 2:
+        return None
+    earlier = _earlier(build, model, stages)
+    if earlier is None:
+        return f"its {stages[-2]} job did not finish in this pipeline"
+    state = earlier["stages"].get("compile", {}).get("state", "skipped")
+    return None if state in GOOD else f"compile {past(state)}"
+
+
+def _earlier(build: Path, model: str, stages: tuple[str, ...]) -> dict[str, Any] | None:
+    """The model's status record from its job of the stage before this job's, if any."""
+    if len(stages) < 2:
+        return None
+    try:
+        data = json.loads((records(build) / model / f"{stages[-2]}.json").read_text(encoding="utf-8"))
+        return data["record"]
+    except (OSError, ValueError, KeyError):
+        return None
 
 
 def inventory() -> dict[Path, int]:
@@ -102,12 +115,13 @@ def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...
     from mpc.compiler.pipeline.command import run
 
     merge_caches(build)
-    reason = blocked(plan, build, model)
+    reason = blocked(plan, build, model, stages)
     if reason is not None:
-        record = ModelRecord(model, plan.models[model].written, plan.models[model].parents)
-        record.stages[stages[0]] = StageRecord("skipped", reason, blocked=True)
-        for stage in stages[1:]:
-            record.stages[stage] = StageRecord("skipped", reason, blocked=True)
+        earlier = _earlier(build, model, stages)  # what the model's earlier jobs did stays
+        record = model_from_json(model, earlier) if earlier else \
+            ModelRecord(model, plan.models[model].written, plan.models[model].parents)
+        for stage in stages:
+            record.stages.setdefault(stage, StageRecord("skipped", reason, blocked=True))
         status = RunStatus(str(plan.file), stages, 1, {model: record})
         _save(build, model, stages, status.to_json()["models"][model], 0, 0)
         print(plain_table(status))

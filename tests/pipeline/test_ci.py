@@ -305,6 +305,12 @@ def test_a_job_whose_parent_failed_reports_it_as_mpc_run_does(fleet: Path, tmp_p
     assert done.returncode == 1
     assert done.stderr == "mpc ci: broken_child is not built: derived_base 'broken' failed\n"
     assert not (top / "build/broken_child").exists()
+    # the test job of a model whose build job failed
+    done = mpc("ci", "job", "pipeline.yml", "broken", "--stages", "test", cwd=top, cache=tmp_path / "cache")
+    assert (done.returncode, done.stderr) == (1, "mpc ci: broken is not built: compile failed\n")
+    tested = json.loads((top / "build/.mpc/ci/broken/test.json").read_text())["record"]["stages"]
+    assert (tested["compile"]["state"], tested["test"]) == (
+        "failed", {"state": "skipped", "seconds": 0.0, "reason": "compile failed"})
     done = mpc("ci", "summary", "pipeline.yml", "--markdown", "summary.md", cwd=top)
     assert done.returncode == 0, done.stderr
     status = json.loads((top / "build/.mpc/status.json").read_text())
