@@ -179,7 +179,7 @@ def ci(args: argparse.Namespace) -> int:
     else:
         found = Sink()
         install = ci_install.derive(here, found)
-        _print_diagnostics(found.diagnostics, "human")
+        render.print_diagnostics(found.diagnostics, "human")
         if install is None:
             print("mpc ci: error: no CI file was written", file=sys.stderr)
             return 1
