@@ -118,10 +118,11 @@ def _running(project: Path, sink: Sink) -> str | None:
 def requirement(direct_url: str | None, project: Path, sink: Sink) -> str | None:
     """A requirement for the mpc that PEP 610's `direct_url.json` describes (None: it came
     from a package index), for jobs that check out `project`."""
-    if not direct_url:
+    try:
+        info = json.loads(direct_url) if direct_url else {}
+        url: str = info["url"]
+    except (ValueError, TypeError, KeyError):  # none, or not PEP 610's: as from an index
         return f"{DIST}=={mpc_version()}"  # from a package index: the team's index serves it again
-    info = json.loads(direct_url)
-    url: str = info["url"]
     vcs = info.get("vcs_info")
     if vcs:
         return f"{DIST} @ {vcs['vcs']}+{url}@{vcs['commit_id']}"
