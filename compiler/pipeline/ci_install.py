@@ -64,9 +64,10 @@ def given(command: str) -> Install:
 
 
 def version_check(version: str) -> str:
-    """A shell line that stops a job whose mpc is not the one that wrote the pipeline."""
+    """A shell line that stops a job whose mpc is not the one that wrote the pipeline (E0682)."""
+    code = "E0682"
     return ('v="$(mpc --version 2>/dev/null || true)"; [ "$v" = "mpc $MPC_VERSION" ] || '
-            '{ echo "error[E0682]: this pipeline was written by mpc $MPC_VERSION, but this job runs '
+            f'{{ echo "error[{code}]: this pipeline was written by mpc $MPC_VERSION, but this job runs '
             '${v:-no mpc}: install mpc $MPC_VERSION (see the install step), or regenerate the '
             'pipeline with the mpc that the job installs" >&2; exit 1; }')
 
