@@ -158,7 +158,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     when several are missing; a later build with the same inputs only copies them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
-    from mpc.compiler.cache import load_entry, remove_entry
+    from mpc.compiler.cache import load_entry, remove_entry, touch_entry
     from mpc.compiler.files import describe
 
     ok = True
@@ -196,6 +196,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             todo[cached] = (src, ops, cached)
         else:
             entries[cached] = data
+            touch_entry(cached, _ignored_path(cached))
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
     for source, dest, rel in plan_:

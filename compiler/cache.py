@@ -4,6 +4,7 @@ the hash of their bytes, so that a damaged one is never returned."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
@@ -52,6 +53,14 @@ def load_entry(entry: Path) -> tuple[bytes | None, str | None]:
     if hashlib.sha256(data).hexdigest() != expected:
         return None, "its bytes do not match their hash"
     return data, None
+
+
+def touch_entry(entry: Path, *beside: Path) -> None:
+    """Mark an entry (with its hash and the files `beside` it) as used: a CI job passes on the
+    entries its build used (`mpc ci job`). A read-only cache still serves."""
+    for path in (entry, _hash_file(entry), *beside):
+        with contextlib.suppress(OSError):
+            os.utime(path)
 
 
 def remove_entry(entry: Path) -> None:

@@ -91,21 +91,37 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--log-format", choices=("text", "json"), default="text",
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
     ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
-    ci.add_argument("system", choices=("gitlab", "github"),
-                    help="gitlab: a child pipeline; github: a workflow")
-    ci.add_argument("pipeline", type=Path, help="the pipeline file")
-    ci.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
-    ci.add_argument("--stages", default="compile", metavar="STAGE,…", help="stages each job runs")
-    ci.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container)")
-    ci.add_argument("--setup", default="pip install model-pipeline-compiler",
-                    help="command that installs mpc in a job (default: %(default)s)")
+    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary")
+    for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
+        gen = systems.add_parser(system, help=f"write {what}")
+        gen.add_argument("pipeline", type=Path, help="the pipeline file")
+        gen.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
+        gen.add_argument("--stages", default="compile", metavar="STAGE,…",
+                         help="stages to run, each in jobs of its own (default: compile)")
+        gen.add_argument("--image", help="container image of the jobs (GitLab image, GitHub container); "
+                         "without --install, the jobs use the mpc the image has")
+        gen.add_argument("--install", "--setup", dest="install", metavar="CMD",
+                         help="shell command that installs mpc in a job and puts it on PATH (default: "
+                         "the install of this mpc, from the project's requirements.txt or how it was "
+                         "installed)")
+    job = systems.add_parser("job", help="what a generated job runs: one model and stages, with the "
+                             "artifacts of earlier jobs")
+    job.add_argument("pipeline", type=Path, help="the pipeline file")
+    job.add_argument("model", help="the modelname")
+    job.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
+    job.add_argument("--stages", default="compile", metavar="STAGE,…", help="stages to run")
+    summary = systems.add_parser("summary", help="what the last job runs: every job's status merged")
+    summary.add_argument("pipeline", type=Path, help="the pipeline file")
+    summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
+    summary.add_argument("--markdown", type=Path, metavar="FILE",
+                         help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
     view = sub.add_parser("view", help="show a model in the browser (a local web viewer)")
     view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
     view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
-    for p in (comp, check, test, run, view):
+    for p in (comp, check, test, run, view, job):
         _diagnostic_options(p)
     return parser
 

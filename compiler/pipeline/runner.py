@@ -40,6 +40,7 @@ from mpc.compiler.pipeline.status import (
     StageRecord,
     diagnostics_from_json,
     diagnostics_json,
+    past,
 )
 from mpc.compiler.pipeline.store import Store
 from mpc.ir.span import Span
@@ -171,7 +172,7 @@ class Runner:
         for parent in model.parents:
             if parent in self.selected and self.fingerprints.get(parent) is None:
                 state = self.status.models[parent].stages[self.opts.stages[0]].state
-                self._finish_all(name, "skipped", f"derived_base '{parent}' {_past(state)}", blocked=True)
+                self._finish_all(name, "skipped", f"derived_base '{parent}' {past(state)}", blocked=True)
                 return None
         pre = self.freshness.before_build(model, self.fingerprints)
         failure = self.freshness.last_failure(name, pre)
@@ -386,7 +387,7 @@ class Runner:
                                            details=details or {})
         for stage in rest:
             record.stages[stage] = StageRecord("skipped", summary if state == "skipped" else
-                                               f"{first} {_past(state)}", blocked=True)
+                                               f"{first} {past(state)}", blocked=True)
         self.fingerprints[name] = None
         self._done(name)
 
@@ -410,10 +411,6 @@ def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
     return Diagnostic(Severity.ERROR, "E0642", f"cannot write the build of model '{name}' "
                       f"({describe(error)}); its previous output is unchanged",
                       model.span)
-
-
-def _past(state: str) -> str:
-    return {"failed": "failed", "skipped": "was skipped", "interrupted": "was interrupted"}.get(state, state)
 
 
 def _preload() -> None:

@@ -143,6 +143,21 @@ def diagnostics_from_json(items: list[Any]) -> list[Diagnostic]:
                        tuple((span(n["span"]), n["message"]) for n in d["notes"]), d["hint"]) for d in items]
 
 
+def past(state: str) -> str:
+    """A stage's state as the reason its dependants give: "derived_base 'x' failed"."""
+    return {"failed": "failed", "skipped": "was skipped", "interrupted": "was interrupted"}.get(state, state)
+
+
+def model_from_json(name: str, data: dict[str, Any]) -> ModelRecord:
+    """A model's record as `RunStatus.to_json` wrote it (a CI job's record, for the summary)."""
+    stages = {stage: StageRecord(r["state"], r.get("summary") or r.get("reason", ""),
+                                 diagnostics_from_json(r.get("diagnostics", [])), r.get("seconds", 0.0),
+                                 r.get("fingerprint"), r.get("details", {}))
+              for stage, r in data["stages"].items()}
+    return ModelRecord(name, data["definition"], tuple(data["parents"]), stages,
+                       diagnostics_from_json(data.get("warnings", [])))
+
+
 def table_rows(status: RunStatus) -> list[list[str]]:
     """Header and one row per model: name, each stage's state, time, what to know."""
     rows = [["model", *status.stages, "time", "note"]]
@@ -172,6 +187,14 @@ def summary_line(status: RunStatus) -> str:
     parts = [f"{n} {state}" for state, n in sorted(counts.items(), key=lambda kv: _ORDER.index(kv[0]))]
     total = sum(counts.values())
     return f"{total} model{'s' * (total != 1)}: {', '.join(parts)} in {status.seconds:.1f} s"
+
+
+def markdown_table(status: RunStatus) -> str:
+    """The table as Markdown (a GitHub job summary, a merge request)."""
+    rows = table_rows(status)
+    lines = ["| " + " | ".join(rows[0]) + " |", "|" + "---|" * len(rows[0])]
+    lines += ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in rows[1:]]
+    return "\n".join(lines) + "\n\n" + summary_line(status) + "\n"
 
 
 _ORDER = ["ok", "cached", "failed", "skipped", "interrupted"]
