@@ -87,6 +87,11 @@ def _earlier(build: Path, model: str, stages: tuple[str, ...]) -> dict[str, Any]
         return None
 
 
+# What an entry keeps beside it: its hash (compiler/cache.py) and, for a mesh, what reading
+# its source ignored (backends/meshes.py). They travel with the entry.
+SIDECARS = (".sha256", ".ignored")
+
+
 def inventory() -> dict[Path, int]:
     """Every cache entry a job passes on, with its modification time (a hit touches it)."""
     out: dict[Path, int] = {}
@@ -94,7 +99,7 @@ def inventory() -> dict[Path, int]:
         folder = cache_dir(kind)
         if folder.is_dir():
             for path in folder.rglob("*"):
-                if path.is_file() and not path.name.startswith("."):
+                if path.is_file() and not path.name.startswith(".") and not path.name.endswith(SIDECARS):
                     out[path] = path.stat().st_mtime_ns
     return out
 
@@ -139,7 +144,9 @@ def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...
         kind = next(k for k in KINDS if path.is_relative_to(cache_dir(k)))
         target = records(build) / model / "cache" / kind / path.relative_to(cache_dir(kind))
         target.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(path, target)
+        for file in (path, *(path.with_name(path.name + s) for s in SIDECARS)):
+            if file.is_file():
+                shutil.copy2(file, target.with_name(file.name))
     try:
         status = json.loads((build / ".mpc" / "status.json").read_text(encoding="utf-8"))
         record = status["models"][model]
