@@ -52,6 +52,12 @@ class PackageResolver:
             ros = [Path(p) for p in _path_list("ROS_PACKAGE_PATH")]
             ament = [Path(p) / "share" for p in _path_list("AMENT_PREFIX_PATH")]
             self.search_path = ros + ament + _environment_share_dirs()
+            # colcon's --symlink-install links a workspace's install/ into its src/ and build/:
+            # inputs may link anywhere inside the workspace of a sourced prefix.
+            for prefix in map(Path, _path_list("AMENT_PREFIX_PATH")):
+                install = next((p for p in (prefix, *prefix.parents) if p.name == "install"), None)
+                if install is not None:
+                    self.add_root(install.parent)
 
     def find(self, package: str, near: Path | None = None) -> Path | None:
         """The folder of `package`, or None."""

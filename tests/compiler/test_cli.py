@@ -159,3 +159,32 @@ def test_package_paths_are_found_in_a_sourced_ros2_workspace(tmp_path: Path) -> 
     assert found.returncode == 0, found.stderr
     assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (
         tmp_path / "ws/install/arm_description/share/arm_description/meshes/tetra.stl").read_bytes()
+
+
+def test_a_colcon_symlink_install_workspace_is_read_through_its_links(tmp_path: Path) -> None:
+    """`colcon build --symlink-install` links install/<pkg>/share/<pkg>/meshes/… into src/:
+    links inside the workspace of a sourced prefix are read; one out of it is still refused."""
+    import os
+
+    from tests.fixtures import ARM_URDF, tetra_stl
+
+    ws = tmp_path / "ws"
+    tetra_stl(ws / "src/arm_description/meshes/tetra.stl")
+    share = ws / "install/arm_description/share/arm_description"
+    share.mkdir(parents=True)
+    (share / "meshes").symlink_to(ws / "src/arm_description/meshes")
+    write(tmp_path / "models/arm.urdf",
+          ARM_URDF.replace("meshes/tetra.stl", "package://arm_description/meshes/tetra.stl"))
+    spec = write(tmp_path / "models/model.yml", definition("arm.urdf", "stl", "arm"))
+    env = {**os.environ, "AMENT_PREFIX_PATH": str(ws / "install/arm_description")}
+    run = [sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o", str(tmp_path / "out")]
+    done = subprocess.run(run, capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (
+        ws / "src/arm_description/meshes/tetra.stl").read_bytes()
+    tetra_stl(tmp_path / "elsewhere/tetra.stl")
+    (ws / "src/arm_description/meshes/tetra.stl").unlink()
+    (ws / "src/arm_description/meshes/tetra.stl").symlink_to(tmp_path / "elsewhere/tetra.stl")
+    refused = subprocess.run([*run, "--format", "gcc"], capture_output=True, text=True, env=env)
+    assert refused.returncode == 1
+    assert "[E0650]" in refused.stderr
