@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import signal
 import sys
 import tempfile
 import threading
@@ -168,8 +169,14 @@ def run(args: argparse.Namespace) -> int:
             print(f"error: cannot show '{args.model}'", file=sys.stderr)
             return 1
         print(f"mpc view: http://{args.host}:{server.get_port()}/  (Ctrl-C ends it)", flush=True)
+        # Ctrl-C and SIGTERM end it, also where the shell that started it ignores SIGINT
+        # (a background job of a script).
+        stop = threading.Event()
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, lambda *_: stop.set())
         try:
-            threading.Event().wait()
+            while not stop.wait(0.5):
+                pass
         finally:
             server.stop()
     return 0
