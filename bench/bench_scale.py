@@ -57,12 +57,12 @@ def main(sizes: list[int]) -> None:
                 for exports in cases:
                     times[n, exports] = compile_seconds(Path(tmp), urdf, exports)
         print(f"{shape}: seconds per compile (a process each, cold)")
-        print("  exports          " + "".join(f"{n:>10}" for n in sizes)
+        print("  exports                " + "".join(f"{n:>10}" for n in sizes)
               + (f"   growth {sizes[0]}→{sizes[-1]}" if len(sizes) > 1 else ""))
         for exports in cases:
             row = "".join(f"{times[n, exports]:10.2f}" for n in sizes)
             growth = times[sizes[-1], exports] / times[sizes[0], exports] if len(sizes) > 1 else 0
-            print(f"  {'+'.join(exports):<17}{row}" + (f"   {growth:6.1f}×" if len(sizes) > 1 else ""))
+            print(f"  {'+'.join(exports):<23}{row}" + (f"   {growth:6.1f}×" if len(sizes) > 1 else ""))
 
 
 if __name__ == "__main__":
