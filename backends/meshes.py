@@ -158,7 +158,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     when several are missing; a later build with the same inputs only copies them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
-    from mpc.compiler.cache import load_entry, remove_entry, touch_entry
+    from mpc.compiler.cache import load_entry, notes_file, remove_entry, touch_entry
     from mpc.compiler.files import describe
 
     ok = True
@@ -187,7 +187,6 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 sink.warning(where(src, ops)[0], "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
                              f"is unusable ({bad}); it is removed and computed again")
                 remove_entry(cached)
-                _ignored_path(cached).unlink(missing_ok=True)
         except OSError as e:
             sink.error(where(src, ops)[0], "E0652", f"mesh '{rel}': {describe(e, 'use the mesh cache')}")
             ok = False
@@ -196,7 +195,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             todo[cached] = (src, ops, cached)
         else:
             entries[cached] = data
-            touch_entry(cached, _ignored_path(cached))
+            touch_entry(cached)
         plan_.append((cached, dest, rel))
     problems = _compute(list(todo.values()))
     for source, dest, rel in plan_:
@@ -215,8 +214,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 ok = False
                 continue
             entries[source] = data
-        ignored = _ignored_path(source)
-        if ignored.is_file():  # the cache entry records what its computation ignored
+        ignored = notes_file(source)
+        if source in entries and ignored.is_file():  # the entry records what computing it ignored
             src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
             span, of = where(src, ops)
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
@@ -257,7 +256,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
     """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
     or None."""
-    from mpc.compiler.cache import store_entry
+    from mpc.compiler.cache import notes_file, store_entry
     from mpc.compiler.files import describe, write_atomic
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
@@ -278,16 +277,11 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, s
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
     try:
         if ignored:  # written before the entry, so that an entry never lacks its record
-            write_atomic(_ignored_path(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
+            write_atomic(notes_file(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
         store_entry(dest, data if isinstance(data, bytes) else data.encode())
     except OSError as e:
         return "E0652", describe(e, "write the mesh cache entry")
     return None
-
-
-def _ignored_path(entry: Path) -> Path:
-    """Where a cache entry records the broken references its computation ignored (W0605)."""
-    return entry.with_name(entry.name + ".ignored")
 
 
 def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,

@@ -24,8 +24,22 @@ def cache_dir(kind: str) -> Path:
 # and one whose bytes do not match it was damaged (a full disk, an edit, a flipped bit) and
 # is never returned.
 
+# The files an entry keeps beside it: its hash, and the notes its computation left (a mesh's
+# broken DAE references, W0605). They are touched, removed and passed on with the entry.
+SIDECARS = (".sha256", ".ignored")
+
+
 def _hash_file(entry: Path) -> Path:
     return entry.with_name(entry.name + ".sha256")
+
+
+def notes_file(entry: Path) -> Path:
+    """Where an entry keeps what its computation ignored, one line each."""
+    return entry.with_name(entry.name + ".ignored")
+
+
+def sidecars(entry: Path) -> list[Path]:
+    return [entry.with_name(entry.name + suffix) for suffix in SIDECARS]
 
 
 def store_entry(entry: Path, data: bytes) -> None:
@@ -55,17 +69,17 @@ def load_entry(entry: Path) -> tuple[bytes | None, str | None]:
     return data, None
 
 
-def touch_entry(entry: Path, *beside: Path) -> None:
-    """Mark an entry (with its hash and the files `beside` it) as used: a CI job passes on the
-    entries its build used (`mpc ci job`). A read-only cache still serves."""
-    for path in (entry, _hash_file(entry), *beside):
+def touch_entry(entry: Path) -> None:
+    """Mark an entry (with its sidecars) as used: a CI job passes on the entries its build used
+    (`mpc ci job`). A read-only cache still serves."""
+    for path in (entry, *sidecars(entry)):
         with contextlib.suppress(OSError):
             os.utime(path)
 
 
 def remove_entry(entry: Path) -> None:
-    """Remove a bad entry and its hash; raises OSError when the cache cannot be changed."""
-    for path in (entry, _hash_file(entry)):
+    """Remove a bad entry and its sidecars; raises OSError when the cache cannot be changed."""
+    for path in (entry, *sidecars(entry)):
         if path.is_dir() and not path.is_symlink():
             shutil.rmtree(path)
         elif path.exists() or path.is_symlink():

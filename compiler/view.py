@@ -152,7 +152,7 @@ def serve(robot: Robot, ghost: Robot | None, host: str, port: int, workdir: Path
 
 def run(args: argparse.Namespace) -> int:
     """Serve the viewer until interrupted; 1 when the model (or the compare model) cannot be shown."""
-    from mpc.compiler.cli import print_diagnostics
+    from mpc.compiler.render import print_diagnostics
 
     sink = Sink()
     with tempfile.TemporaryDirectory(prefix="mpc-view-") as work:
@@ -164,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
         server = None
         if robot is not None and not sink.has_errors():
             server = serve(robot, ghost, args.host, args.port, Path(work), sink)
-        print_diagnostics(sink, args.format)
+        print_diagnostics(sink.diagnostics, args.format)
         if server is None:
             print(f"error: cannot show '{args.model}'", file=sys.stderr)
             return 1

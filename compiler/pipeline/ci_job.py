@@ -26,7 +26,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.cache import cache_dir
+from mpc.compiler.cache import SIDECARS, cache_dir, sidecars
 from mpc.compiler.pipeline import dag
 from mpc.compiler.pipeline.plan import Plan
 from mpc.compiler.pipeline.status import (
@@ -87,11 +87,6 @@ def _earlier(build: Path, model: str, stages: tuple[str, ...]) -> dict[str, Any]
         return None
 
 
-# What an entry keeps beside it: its hash (compiler/cache.py) and, for a mesh, what reading
-# its source ignored (backends/meshes.py). They travel with the entry.
-SIDECARS = (".sha256", ".ignored")
-
-
 def inventory() -> dict[Path, int]:
     """Every cache entry a job passes on, with its modification time (a hit touches it)."""
     out: dict[Path, int] = {}
@@ -144,7 +139,7 @@ def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...
         kind = next(k for k in KINDS if path.is_relative_to(cache_dir(k)))
         target = records(build) / model / "cache" / kind / path.relative_to(cache_dir(kind))
         target.parent.mkdir(parents=True, exist_ok=True)
-        for file in (path, *(path.with_name(path.name + s) for s in SIDECARS)):
+        for file in (path, *sidecars(path)):
             if file.is_file():
                 shutil.copy2(file, target.with_name(file.name))
     try:
