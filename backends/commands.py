@@ -14,7 +14,7 @@ import shlex
 import subprocess
 from pathlib import Path
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import CommandExport
 
 _OUTPUT_LINES = 20  # the end of a failing command's output shown in the diagnostic

@@ -14,8 +14,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.files import confined
+from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
 from mpc.ir.program import JOINT_SELECTIONS, JointLimitsExport
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first

@@ -27,7 +27,7 @@ import numpy as np
 
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.geometry import Mesh, MeshSource
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.program import KccdExport

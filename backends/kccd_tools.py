@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import KccdExport
 
 

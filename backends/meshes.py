@@ -19,7 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.numbers import zero_small
+from mpc.core.span import Span
 from mpc.ir.geometry import (
     ConvexHull,
     ConvexPart,
@@ -30,9 +32,7 @@ from mpc.ir.geometry import (
     ReflectMesh,
     ScaleMesh,
 )
-from mpc.ir.numbers import zero_small
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ def mesh_uses(robot: Robot) -> Iterator[MeshUse]:
 
 
 # Extensions of the formats the language names; `mars_obj` is OBJ content (Phobos's intended
-# axis change was never written), `bobj` is MARS's binary OBJ (backends/bobj.py).
+# axis change was never written), `bobj` is MARS's binary OBJ (core/bobj.py).
 EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply", "bobj": "bobj"}
 
 
@@ -153,13 +153,13 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
          robot: Robot | None = None) -> bool:
     """Write each planned mesh into `out`: a copy of the file, or the result of its ops.
 
-    Results are kept in a content-addressed cache (compiler/cache.py: `meshes/`), keyed by
+    Results are kept in a content-addressed cache (core/cache.py: `meshes/`), keyed by
     the source's bytes, the ops and the format, and computed in parallel (a process pool)
     when several are missing; a later build with the same inputs only copies them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
-    from mpc.compiler.cache import load_entry, notes_file, remove_entry, touch_entry
-    from mpc.compiler.files import describe
+    from mpc.core.cache import load_entry, notes_file, remove_entry, touch_entry
+    from mpc.core.files import describe
 
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
@@ -230,7 +230,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
-    from mpc.compiler.cache import cache_dir
+    from mpc.core.cache import cache_dir
 
     h = hashlib.sha256(src.read_bytes())
     h.update(f"{ENGINE}|{ops!r}|{suffix}".encode())
@@ -256,8 +256,8 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
     """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
     or None."""
-    from mpc.compiler.cache import notes_file, store_entry
-    from mpc.compiler.files import describe, write_atomic
+    from mpc.core.cache import notes_file, store_entry
+    from mpc.core.files import describe, write_atomic
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
@@ -270,7 +270,7 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, s
     if len(mesh.faces) == 0:
         return "E0603", "it has no triangles after reading"
     if dest.suffix == ".bobj":
-        from mpc.backends import bobj
+        from mpc.core import bobj
 
         data: bytes | str = bobj.dumps(mesh)
     else:

@@ -42,16 +42,16 @@ from scipy.spatial.transform import Rotation
 from mpc.backends import meshes, xml_escape
 from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.files import confined
+from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
+from mpc.core.numbers import EPSILON
+from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import matrix_pose, pose_matrix
-from mpc.ir.numbers import EPSILON
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
-from mpc.ir.span import Span
 from mpc.ir.tree import child_joints, depth_first
 
 __all__ = ["check", "cut_sites", "emit", "left_out", "to_string"]

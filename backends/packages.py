@@ -88,9 +88,9 @@ class PackageResolver:
     def refusal(self, path: Path, base_dir: Path | None = None) -> str | None:
         """Why the input file `path` (a mesh, a model) must not be read, or None: a link out
         of the package roots (and `base_dir`, the folder of the file naming it), a special
-        file (compiler/files.py: input_problem). A missing file is no refusal: whoever reads
+        file (core/files.py: input_problem). A missing file is no refusal: whoever reads
         it reports that."""
-        from mpc.compiler.files import input_problem, package_roots
+        from mpc.core.files import input_problem, package_roots
 
         if not path.exists():
             return None

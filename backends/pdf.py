@@ -17,7 +17,7 @@ from collections.abc import Collection, Iterable
 from pathlib import Path
 
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import PdfExport
 from mpc.ir.robot import Joint, Robot
 from mpc.ir.tree import depth_first

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.program import RenderExport
 from mpc.ir.robot import Robot
 

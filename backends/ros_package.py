@@ -18,7 +18,7 @@ import yaml
 
 from mpc.backends import xml_escape
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import RosPackageExport
 from mpc.ir.robot import Robot
 

@@ -24,10 +24,10 @@ from typing import Any, Literal
 import numpy as np
 
 from mpc.backends import meshes
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import RENDER_VIEWS
 from mpc.ir.robot import Inertia, Inertial, Robot
-from mpc.ir.span import Span
 
 Geometry = Literal["visual", "collision", "both"]
 RGBA = tuple[float, float, float, float]

@@ -19,14 +19,14 @@ from mpc.backends.float_formats import SDF_KEYS, Formats
 from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.files import confined
+from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
+from mpc.core.span import Span
 from mpc.ir.extras import CutJoint, Sensor
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import links_in_root, matrix_pose
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Material, Pose, Robot, Visual
-from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 __all__ = ["emit", "read", "sdf_names", "to_string"]

@@ -23,7 +23,7 @@ from lxml import etree
 
 from mpc.backends.packages import PackageResolver
 from mpc.backends.xml import XmlSource, load, parse_floats
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.fragments import Fragment, FragmentRef

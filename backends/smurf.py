@@ -39,7 +39,7 @@ from mpc.backends.smurf_forms import (
 )
 from mpc.backends.smurf_reader import read
 from mpc.backends.xml import fmt_float, write_path
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.extras import CutJoint, Motor, Sensor
 from mpc.ir.program import SmurfExport, SubmodelExport
 from mpc.ir.robot import Material, Robot
@@ -192,7 +192,7 @@ def _submechanisms(robot: Robot, sink: Sink, span: Any) -> dict[str, Any]:
     """`{submechanisms: [...], exoskeletons: [...]}`: the submechanisms file as it is, else
     the definitions in the robot, in their order."""
     if robot.submechanisms_file:
-        from mpc.compiler import source
+        from mpc.core import yaml_source as source
 
         doc = source.load(Path(robot.submechanisms_file), sink, origin=span)
         if doc is None:

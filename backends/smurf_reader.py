@@ -34,8 +34,8 @@ from mpc.backends.smurf_forms import (
     position_in,
     shape_names,
 )
-from mpc.compiler import source
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.robot import Material, Pose, Robot
 

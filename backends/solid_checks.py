@@ -6,7 +6,7 @@ triangles, their winding reversed where the mesh is reflected (tests/backends/
 test_solid_meshes.py measures it on TALOS's meshes). They are not read again for it, which
 would double the cost of a cold mirrored build. Each mesh value that needs it is checked
 once per content (its file's bytes and its ops): the answer is kept in the cache
-(compiler/cache.py: `solids/`), so a rebuild does not compute it again.
+(core/cache.py: `solids/`), so a rebuild does not compute it again.
 """
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ import hashlib
 import json
 import os
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.geometry import ConvexPart, JoinShapes, Mesh, MeshOp, ReduceMesh, ScaleMesh
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 VERSION = "1"  # changes when the test for closed changes, so old answers go unused
 WATCHED = {ScaleMesh: "apply_scale", ReduceMesh: "reduce_meshes", ConvexPart: "convex_decomposition"}
@@ -55,7 +55,7 @@ def opened_by(mesh: Mesh) -> str | None:
     assert mesh.source.path is not None
     h = hashlib.sha256(mesh.source.path.read_bytes())
     h.update(f"{VERSION}|{mesh.ops!r}".encode())
-    from mpc.compiler.cache import cache_dir
+    from mpc.core.cache import cache_dir
 
     path = cache_dir("solids") / f"{h.hexdigest()}.json"
     try:

@@ -13,8 +13,8 @@ from mpc.backends.float_formats import URDF_KEYS, Formats
 from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.files import confined
+from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
 from mpc.ir.program import UrdfExport
 from mpc.ir.robot import Robot
 

@@ -14,7 +14,8 @@ from lxml import etree
 
 from mpc.backends.packages import PackageResolver
 from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.span import Span
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.robot import (
@@ -34,7 +35,6 @@ from mpc.ir.robot import (
     SafetyController,
     Visual,
 )
-from mpc.ir.span import Span
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")

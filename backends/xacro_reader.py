@@ -23,9 +23,9 @@ from pathlib import Path
 from typing import Any
 
 from mpc.backends.packages import PackageResolver
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 SUFFIX = ".xacro"
 # xacro keeps its state (file stack, macros, arguments) in module globals: one expansion at a time.

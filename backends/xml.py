@@ -15,8 +15,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from mpc.compiler.diagnostics import Sink
-from mpc.ir.span import Span, hardened_parser
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span, hardened_parser
 
 # Start tags outside comments, CDATA, processing instructions and doctype, in document order.
 _TOKENS = re.compile(
@@ -136,7 +136,7 @@ def parse_floats(text: str | None) -> list[float] | None:
 
 
 def write_path(path: Path, data: str) -> None:
-    """Write a text output file (compiler/files.py: all or nothing)."""
-    from mpc.compiler.files import write_atomic
+    """Write a text output file (core/files.py: all or nothing)."""
+    from mpc.core.files import write_atomic
 
     write_atomic(path, data)

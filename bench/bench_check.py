@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("pinocchio", "pybullet", "trimesh", "numpy", "lark")
 PROBE = (
     "import sys\n"
-    "from mpc.compiler.cli import main\n"
+    "from mpc.cli.main import main\n"
     f"code = main(['check', {str(ROOT / 'examples/talos.yml')!r}])\n"
     f"print(','.join(m for m in {HEAVY!r} if m in sys.modules))\n"
     "sys.exit(code)\n"

@@ -35,7 +35,7 @@ def main() -> None:
         for label in ("cold", "warm"):
             out = Path(tmp) / label
             t0 = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o", str(out)],
+            subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o", str(out)],
                            check=True, env=env, capture_output=True)
             print(f"{label:5s} build: {time.perf_counter() - t0:6.2f} s")
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024

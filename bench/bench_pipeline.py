@@ -51,7 +51,7 @@ def run(pipeline: Path, *args: str, env: dict[str, str]) -> tuple[float, float, 
     peak = 0
     done = threading.Event()
     t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", "mpc.compiler.cli", "run", str(pipeline), *args],
+    proc = subprocess.Popen([sys.executable, "-m", "mpc.cli.main", "run", str(pipeline), *args],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
 
     def sample() -> None:

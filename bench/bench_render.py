@@ -14,9 +14,9 @@ from mpc.backends.packages import PackageResolver
 from mpc.backends.render import draw_all
 from mpc.backends.urdf_reader import read
 from mpc.checks import pictures
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import RenderExport, Tolerances
-from mpc.ir.span import Span
 
 ERD = PackageResolver().find("example-robot-data") / "robots"  # type: ignore[operator]
 ROBOTS = {"talos": ERD / "talos_data/robots/talos_full_v2.urdf",

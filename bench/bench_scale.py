@@ -38,7 +38,7 @@ def compile_seconds(folder: Path, urdf: Path, exports: tuple[str, ...]) -> float
                     f"  input_models: {{r: {{basefile: '{urdf}'}}}}\n  assemble: {{model: r}}\n"
                     f"  export_config: [{', '.join(f'{{type: {e}}}' for e in exports)}]\n")
     t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o",
+    done = subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o",
                            str(folder / f"out-{spec.stem}")], capture_output=True, text=True)
     seconds = time.perf_counter() - t0
     if done.returncode != 0:

@@ -14,7 +14,7 @@ import time
 from mpc.backends.packages import PackageResolver
 from mpc.backends.urdf_reader import read
 from mpc.checks.validity import _validity, findings
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.solids import solid, union
 

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from mpc.backends.packages import PackageResolver
 from mpc.checks import run_model_tests
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.driver import Options, compile_model
+from mpc.core.diagnostics import Sink
 
 TESTS = """\
       - process_double_check

@@ -13,7 +13,7 @@ import time
 
 from mpc.backends import urdf
 from mpc.backends.packages import PackageResolver
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.geometry import Mesh
 
 

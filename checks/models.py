@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
@@ -148,7 +148,7 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
 def _clone(target: CompareTarget, workdir: Path) -> tuple[Path | None, str, str]:
     """Clone the repository into `workdir` and check out the branch or commit; the work
     tree, the commit checked out, and the reason when it failed."""
-    from mpc.compiler.gitrun import GitFailed, git, scrub, without_credentials
+    from mpc.core.gitrun import GitFailed, git, scrub, without_credentials
 
     key = hashlib.sha256(f"{without_credentials(target.git)}\0{target.branch}\0{target.commit}"
                          .encode()).hexdigest()[:12]

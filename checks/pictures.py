@@ -20,12 +20,12 @@ from pathlib import Path
 
 import numpy as np
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.program import RenderExport, Tolerances
 from mpc.ir.robot import Joint, Link, Pose, Robot
-from mpc.ir.span import Span
 
 # The reference palette: changed links in the release and in the new model; the others grey.
 CHANGED_RELEASE = (0.15, 0.45, 0.95, 1.0)  # blue

@@ -214,7 +214,7 @@ class Protocol:
 
     def write(self, folder: Path) -> None:
         """Write test_protocol.md, test_protocol.json and test_protocol.junit.xml into `folder`."""
-        from mpc.compiler.files import write_atomic
+        from mpc.core.files import write_atomic
 
         folder.mkdir(parents=True, exist_ok=True)  # its error names the folder as the user gave it
         write_atomic(folder / "test_protocol.md", self.markdown())

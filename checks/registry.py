@@ -14,7 +14,7 @@ from typing import Literal
 
 from mpc.checks.models import Model
 from mpc.checks.protocol import Result, Tolerance, failed, skipped
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import ModelTest, Program, TestPlan, Tolerances
 from mpc.ir.robot import Robot
 

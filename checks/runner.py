@@ -16,7 +16,7 @@ from mpc.checks.models import Model, load_built, load_compare
 from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
 from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import ModelTest, PdfExport, Program, TestPlan
 from mpc.ir.robot import Robot
 

@@ -23,11 +23,11 @@ import numpy as np
 from mpc.checks.protocol import Result, failed, first_of, passed, vector_text
 from mpc.checks.registry import Context, register
 from mpc.checks.topology import MOVABLE
+from mpc.core.span import Span
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.program import DENSITY, FACTOR, ModelTest
 from mpc.ir.robot import Inertia, Robot
-from mpc.ir.span import Span
 from mpc.ir.tree import child_joints
 
 RELATIVE = 1e-6

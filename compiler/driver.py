@@ -15,19 +15,20 @@ import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from mpc.compiler import inherit, schema, source
-from mpc.compiler.diagnostics import Severity, Sink
-from mpc.compiler.files import OutsideOutput, confined, describe
+from mpc.compiler import inherit, schema
 from mpc.compiler.inputs import InputLoader, Options
 from mpc.compiler.lower import lower
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Severity, Sink
+from mpc.core.files import OutsideOutput, confined, describe
+from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
 from mpc.ir.ops.assembly import r2r_origin
 from mpc.ir.program import CommandExport, Export, JointLimitsExport, Program, RobotExport, SubmodelExport
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 
 @dataclass
@@ -93,7 +94,7 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
 def check_output_names(program: Program, sink: Sink) -> bool:
     """The names of an IR program that become file names, checked as the schema checks
     them in YAML (E0250): IR text comes without a schema."""
-    from mpc.compiler.files import name_problem
+    from mpc.core.files import name_problem
 
     named = [("robotname", program.robotname, program.span, False),
              ("modelname", program.modelname, program.span, False)]
@@ -163,32 +164,21 @@ def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> 
     return apply(program, sink, loader) if program else None
 
 
-def check_file(path: Path, sink: Sink, options: Options) -> None:
-    """Everything `mpc check` does for one file; nothing is written.
+def check_file(path: Path, sink: Sink, options: Options, doc: source.Document | None = None) -> None:
+    """Everything `mpc check` does for one model definition (or IR file); nothing is written.
 
-    A model definition goes through the front end with names checked; a pipeline file
-    is validated and each of its model definitions checked.
+    `doc` is the file already loaded, when the caller had to read it to know what it is
+    (pipeline/plan.py's check_file, which also takes pipeline files).
     """
     try:
-        _check(path, sink, options)
+        if path.suffix == ".ir":
+            load_program(path, sink, options, Severity.WARNING)
+            return
+        doc = doc or source.load(path, sink)
+        if doc is not None:
+            front_end(path, sink, options, Severity.WARNING, doc=doc)
     except OSError as e:
         sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
-
-
-def _check(path: Path, sink: Sink, options: Options) -> None:
-    if path.suffix == ".ir":
-        load_program(path, sink, options, Severity.WARNING)
-        return
-    doc = source.load(path, sink)
-    if doc is None:
-        return
-    if isinstance(doc.data, dict) and "pipeline" in doc.data:
-        from mpc.compiler.pipeline.plan import check_pipeline
-
-        check_pipeline(path, sink, lambda model, defaults: front_end(
-            model, sink, replace(options, defaults=defaults), Severity.WARNING))
-        return
-    front_end(path, sink, options, Severity.WARNING, doc=doc)
 
 
 def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | None = None) -> bool:

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
-from mpc.compiler.source import source_line
-from mpc.ir.record import record
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.record import record
+from mpc.core.span import Span
+from mpc.core.yaml_source import source_line
 
 if TYPE_CHECKING:
     from lark import Lark

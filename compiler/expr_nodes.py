@@ -4,7 +4,7 @@ builds it from lark's parse tree). Only the nodes: no parsing, no evaluation.
 
 from __future__ import annotations
 
-from mpc.ir.record import record
+from mpc.core.record import record
 
 # Nodes. `start`/`end` are 0-based offsets into the expression text (end exclusive);
 # the evaluator turns them into file spans, since the parser never sees the file.

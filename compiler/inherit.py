@@ -31,10 +31,10 @@ import re
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler import source
-from mpc.compiler.diagnostics import Sink, did_you_mean
-from mpc.compiler.source import Document, Path_
-from mpc.ir.span import Span
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.span import Span
+from mpc.core.yaml_source import Document, Path_
 
 _DEFAULTS_KEYS = ("defaults", "default_model")
 _SUBST = re.compile(r"@([A-Za-z_][A-Za-z0-9_]*)@")

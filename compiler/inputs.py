@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mpc.backends.packages import PackageResolver
-from mpc.compiler import source
-from mpc.compiler.diagnostics import Sink
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Sink
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 from mpc.ir.robot import Robot
@@ -25,7 +25,7 @@ class Options:
 
     out: Path | None = None
     resolver: PackageResolver = field(default_factory=PackageResolver)
-    # Pipeline runs (compiler/pipeline/): the pipeline's defaults, applied to each definition
+    # Pipeline runs (pipeline/): the pipeline's defaults, applied to each definition
     # after its own defaults chain; and where the output goes once the runner moves it from
     # `out` (a staging folder) into place, which post_processing commands see as their target.
     defaults: Callable[[source.Document], source.Document] | None = None

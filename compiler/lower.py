@@ -16,7 +16,6 @@ from pathlib import Path
 from typing import Any
 
 from mpc.backends.packages import PackageResolver
-from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
 from mpc.compiler.expr import evaluate
 from mpc.compiler.lower_deploy import lower_model_deployment
 from mpc.compiler.lower_edits import EditLowering
@@ -24,6 +23,8 @@ from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import Definition
 from mpc.compiler.schema.assembly import AssembleChild, AssemblyEntry, AttachJoint, NameEditing
 from mpc.compiler.schema.base import Node
+from mpc.core.diagnostics import Severity, Sink, did_you_mean
+from mpc.core.span import Span
 from mpc.ir.naming import LINK_SUFFIX, SCOPES, NameRule, bad_pattern, edit_name, takes_link_suffix
 from mpc.ir.ops import (
     ROOT,
@@ -51,7 +52,6 @@ from mpc.ir.program import (
     UrdfExport,
 )
 from mpc.ir.robot import Limit, Pose
-from mpc.ir.span import Span
 
 # Sections of the model that later versions lower; named here so that nothing is ignored.
 LATER_SECTIONS = ("swing_my_robot",)

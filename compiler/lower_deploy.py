@@ -10,11 +10,11 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import PurePosixPath
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.schema.definition import ModelSection
 from mpc.compiler.schema.release import DeploymentSection
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import Deployment, DeployMirror, DeploySubmodule
-from mpc.ir.span import Span
 
 
 def inside_repository(path: str) -> bool:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.program import RENDER_BACKGROUNDS, RENDER_VIEWS, RenderExport
 
 MAX_SIDE = 4096  # pixels: MuJoCo's offscreen buffer, and what a review page can show

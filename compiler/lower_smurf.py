@@ -11,9 +11,9 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import Export, SdfExport, SmurfExport, SubmodelExport, UrdfExport
-from mpc.ir.span import Span
 
 
 class SmurfLowering:

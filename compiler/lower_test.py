@@ -10,11 +10,11 @@ import re
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.expr import evaluate
 from mpc.compiler.schema.release import TestSection
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import DENSITY, FACTOR, CompareTarget, ModelTest, TestPlan, Tolerances
-from mpc.ir.span import Span
 
 # Tests that take a pair of links [left, right] (and optionally a mirror plane).
 PAIR_TESTS = frozenset({"symmetry_check_masses", "symmetry_check", "symmetry_check_torques"})
@@ -105,7 +105,7 @@ class _TestLowering:
         if written is None and not path.is_file():
             return None
         span = self.span("test_data_file") if written else self.section.span
-        from mpc.compiler import source
+        from mpc.core import yaml_source as source
 
         doc = source.load(path, self.sink) if path.is_file() else None
         if doc is None:

@@ -15,12 +15,12 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from mpc.compiler.cache import cache_dir
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.files import describe
-from mpc.compiler.gitrun import GitFailed, git, scrub, without_credentials
+from mpc.core.cache import cache_dir
+from mpc.core.diagnostics import Sink
+from mpc.core.files import describe
+from mpc.core.gitrun import GitFailed, git, scrub, without_credentials
+from mpc.core.span import Span
 from mpc.ir.program import RepoRef
-from mpc.ir.span import Span
 
 
 def _slot(url: str) -> Path:

@@ -3,7 +3,7 @@
 The entry point is `deploy_model(program, built, settings, sink, *, protocol_markdown,
 tests_failed) -> DeployResult`; `DeploySettings` holds the pipeline-level settings.
 Its names are imported when first used, so that `mpc`'s argument parser (which reads
-deploy/command.py) does not load git and the schema on every start.
+cli/deploy.py) does not load git and the schema on every start.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Running git in one repository, with credentials kept out of messages.
 
-`Git(folder)` runs `git <args>` there through mpc's one git runner (compiler/gitrun.py:
+`Git(folder)` runs `git <args>` there through mpc's one git runner (core/gitrun.py:
 never prompting, credentials scrubbed) and returns its output; a failure raises
 `DeployError` with git's own message.
 """
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.compiler import gitrun
-from mpc.compiler.gitrun import SECRET_VARIABLES, git_environment, scrub, without_credentials
+from mpc.core import gitrun
+from mpc.core.gitrun import SECRET_VARIABLES, git_environment, scrub, without_credentials
 
 __all__ = ["EMPTY_TREE", "SECRET_VARIABLES", "DeployError", "Git", "git_environment", "scrub",
            "without_credentials"]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.deploy import content, lfs, names, submodules
 from mpc.deploy.forges import adapter
 from mpc.deploy.gitcmd import DeployError, scrub

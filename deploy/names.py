@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import re
 
-from mpc.compiler import gitrun
+from mpc.core import gitrun
 from mpc.deploy.gitcmd import DeployError
 
 

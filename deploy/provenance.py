@@ -12,14 +12,14 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from mpc.compiler.version import mpc_version
+from mpc.core.version import mpc_version
 from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.ir.program import Program
 
 
 def _repository_state(path: Path) -> tuple[str, bool, str] | None:
     """(commit, dirty, path in the repository) of the git working copy holding `path`, or None."""
-    from mpc.compiler.gitrun import GitFailed, git
+    from mpc.core.gitrun import GitFailed, git
 
     try:
         folder = path if path.is_dir() else path.parent

@@ -13,8 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.schema.definition import PipelineSection
+from mpc.core.diagnostics import Sink
 from mpc.ir.program import Deployment
 
 DEFAULT_FAILURE_BRANCH = "tests-failed"

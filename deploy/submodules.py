@@ -96,7 +96,7 @@ def write_files(p: Pinned, folder: Path) -> None:
     the files instead of the submodule)."""
     import tempfile
 
-    from mpc.compiler.gitrun import GitFailed, git
+    from mpc.core.gitrun import GitFailed, git
 
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="mpc-archive-") as work:

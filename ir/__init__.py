@@ -1,5 +1,6 @@
 """The robot IR: immutable robot values, transforms, fragments, ops and programs."""
 
+from mpc.core.span import Span
 from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, MeshSource, Sphere
 from mpc.ir.robot import (
@@ -18,7 +19,6 @@ from mpc.ir.robot import (
     SafetyController,
     Visual,
 )
-from mpc.ir.span import Span
 
 __all__ = [
     "Box", "Calibration", "Collision", "Cylinder", "Dynamics", "Fragment", "FragmentRef",

@@ -15,7 +15,7 @@ import io
 import numpy as np
 import trimesh
 
-from mpc.compiler.cache import cache_dir, load_entry, remove_entry, store_entry, touch_entry
+from mpc.core.cache import cache_dir, load_entry, remove_entry, store_entry, touch_entry
 from mpc.ir.geometry import Mesh
 from mpc.ir.mesh_props import as_trimesh
 
@@ -32,7 +32,7 @@ def _key(mesh: Mesh) -> str:
 def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
     """The convex parts of `mesh` (scaled, with its ops), computed once.
 
-    A damaged cache entry (compiler/cache.py checks its hash) is removed and computed
+    A damaged cache entry (core/cache.py checks its hash) is removed and computed
     again; a cache that cannot be written only costs the time of computing again.
     """
     entry = cache_dir("decompositions") / f"{_key(mesh)}.npz"

@@ -9,10 +9,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import field
 
-from mpc.ir.record import record
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.refs import JointRef, LinkOrJointRef, LinkRef, MotorName, SensorName, SubmechanismName
 from mpc.ir.robot import Pose
-from mpc.ir.span import Span
 
 Vec3 = tuple[float, float, float]
 Annotations = Mapping[str, object]

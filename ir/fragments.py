@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from typing import Literal
 
-from mpc.ir.record import record
-from mpc.ir.span import Span
+from mpc.core.record import record
+from mpc.core.span import Span
 
 RefKind = Literal["link", "joint"]
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.ir.record import record
-from mpc.ir.span import Span
+from mpc.core.record import record
+from mpc.core.span import Span
 
 Vec3 = tuple[float, float, float]
 Attrs = tuple[tuple[str, str], ...]

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mpc.core.record import record
 from mpc.ir.kinematics import pose_matrix
-from mpc.ir.record import record
 from mpc.ir.robot import Inertia, Inertial, Pose
 
 

@@ -16,12 +16,12 @@ from typing import Any
 
 import numpy as np
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.kinematics import links_in_root, matrix_pose, pose_matrix
 from mpc.ir.ops import Effects
 from mpc.ir.ops.joints import RemoveJoint
 from mpc.ir.robot import Pose, Robot
-from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 

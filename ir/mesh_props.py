@@ -47,11 +47,11 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
             raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
         try:
             if path.suffix.lower() == ".bobj":
-                from mpc.backends import bobj
+                from mpc.core import bobj
 
                 mesh = bobj.loads(path.read_bytes())
             elif path.suffix.lower() == ".dae":
-                from mpc.backends import collada
+                from mpc.core import collada
 
                 mesh, broken = collada.read(path)
                 if ignored is not None:

@@ -11,7 +11,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import field, replace
 from typing import Literal
 
-from mpc.ir.record import record
+from mpc.core.record import record
 from mpc.ir.robot import Robot
 
 Kind = Literal["link", "joint", "collision", "visual", "material", "motor", "sensor", "pose",

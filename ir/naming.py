@@ -11,7 +11,7 @@ import re
 from functools import lru_cache
 from typing import Literal
 
-from mpc.ir.record import record
+from mpc.core.record import record
 
 Scope = Literal["all", "link", "joint", "collision", "visual", "submechanism"]
 SCOPES: tuple[Scope, ...] = ("all", "link", "joint", "collision", "visual", "submechanism")

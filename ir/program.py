@@ -11,9 +11,9 @@ from dataclasses import field
 from pathlib import Path
 from typing import Literal
 
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.ops import Op
-from mpc.ir.record import record
-from mpc.ir.span import Span
 
 
 @record(slots=True, kw_only=True)

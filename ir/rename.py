@@ -14,10 +14,10 @@ from dataclasses import replace
 
 from lxml import etree
 
+from mpc.core.span import hardened_parser
 from mpc.ir import refs as declared
 from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.robot import Joint, Link, Robot
-from mpc.ir.span import hardened_parser
 
 Rename = Callable[[str], str]
 

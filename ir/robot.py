@@ -19,9 +19,10 @@ from collections.abc import Mapping
 from dataclasses import field
 from typing import Any, Literal
 
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Geometry, Vec3
-from mpc.ir.record import record
 from mpc.ir.refs import (
     CollisionName,
     JointName,
@@ -33,7 +34,6 @@ from mpc.ir.refs import (
     PoseName,
     VisualName,
 )
-from mpc.ir.span import Span
 
 JointType = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar"]
 JOINT_TYPES: tuple[str, ...] = JointType.__args__  # type: ignore[attr-defined]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.ops import CompleteSubmechanisms, Effects
 from mpc.ir.ops.assembly import keep_links

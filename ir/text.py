@@ -29,10 +29,10 @@ from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 from lark.tree import Meta
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.program import Program
-from mpc.ir.record import record
-from mpc.ir.span import Span
 from mpc.ir.text_types import (
     BAD,
     Call,

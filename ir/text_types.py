@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePath
 from typing import Any, Literal, Union, get_args, get_origin
 
-from mpc.compiler.diagnostics import did_you_mean
+from mpc.core.diagnostics import did_you_mean
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.ops import OPS, import_all
-from mpc.ir.record import record
-from mpc.ir.span import Span
 
 import_all()  # the IR text names every op: import the op modules `mpc check` does not need
 

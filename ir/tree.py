@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.span import Span
 from mpc.ir.robot import Joint, Link, Robot
-from mpc.ir.span import Span
 
 
 def child_joints(robot: Robot) -> dict[str, list[Joint]]:

@@ -15,8 +15,8 @@ import pytest
 from hypothesis import settings
 
 from mpc.backends.packages import PackageResolver
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
 from mpc.compiler.driver import Options, Result, compile_model
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
 
 # Property tests are bounded: a fixed number of examples and no per-example deadline (the
 # machines are shared; a slow example is not a failure). `HYPOTHESIS_PROFILE=long` digs deeper.

@@ -98,7 +98,7 @@ class Seeds:
 
     @classmethod
     def make(cls, work: Path) -> Seeds:
-        from mpc.compiler.cli import main
+        from mpc.cli.main import main
 
         folder = work / "seed"
         arm(folder)
@@ -127,7 +127,7 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
     """Write the seeds into a fresh folder under `base` with the one file mutated, run mpc
     (`compile`, `check`, or `run` for a pipeline), check the invariants (AssertionError when
     one fails) and return the exit status."""
-    from mpc.compiler.cli import main
+    from mpc.cli.main import main
 
     case = Path(os.path.realpath(base)) / f"case{next(_COUNTER)}"
     target, run = seeds.seed(kind)

@@ -24,9 +24,10 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler import render
-from mpc.compiler.diagnostics import Severity, Sink
-from mpc.compiler.driver import Options, check_file, compile_model, load_program
+from mpc.cli.check import check_file
+from mpc.compiler.driver import Options, compile_model, load_program
+from mpc.core import render
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.text import dump
 from tests.conftest import ERD_PACKAGE
 from tests.fixtures import ARM_URDF, tetra_stl
@@ -184,7 +185,7 @@ def test_example(example: Example, tmp_path: Path) -> None:
 
 def test_every_code_is_documented() -> None:
     used = set()
-    for folder in ("compiler", "backends", "ir", "checks", "deploy"):
+    for folder in ("core", "ir", "backends", "compiler", "checks", "deploy", "pipeline", "cli"):
         for path in (ROOT / folder).rglob("*.py"):
             used |= set(re.findall(r'"([EW]\d{4})"', path.read_text()))
     documented = set(re.findall(r"^\| ([EW]\d{4}) \|", (SPECS / "diagnostics.md").read_text(), re.M))

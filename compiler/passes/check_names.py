@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from mpc.compiler.diagnostics import Severity, did_you_mean
 from mpc.compiler.passes.context import PassContext
+from mpc.core.diagnostics import Severity, did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.ops import Attach, Effects, LoadModel, Op
 from mpc.ir.program import Program

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.passes.check_names import symbolic
 from mpc.compiler.passes.context import PassContext
+from mpc.core.diagnostics import Sink
 from mpc.ir.names import Names
 from mpc.ir.ops import Effects, Op, Phase
 from mpc.ir.program import Program

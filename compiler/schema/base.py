@@ -36,9 +36,9 @@ import typing
 from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.diagnostics import Sink, did_you_mean
-from mpc.compiler.source import Document, Path_
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.span import Span
+from mpc.core.yaml_source import Document, Path_
 
 _REQUIRED: Any = object()
 
@@ -101,7 +101,7 @@ NAME_BYTES = 200
 
 
 def _path_name(value: str, folders: bool) -> None:
-    from mpc.compiler.files import name_problem
+    from mpc.core.files import name_problem
 
     longest = max(len(part.encode("utf-8", "surrogatepass")) for part in value.split("/"))
     if longest > NAME_BYTES:

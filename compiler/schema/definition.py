@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.schema.annotations import (
     AnnotationsSection,
     Exoskeleton,
@@ -24,7 +23,8 @@ from mpc.compiler.schema.editing import (
 )
 from mpc.compiler.schema.exports import ExportEntry
 from mpc.compiler.schema.release import DeploymentSection, Forge, TestSection
-from mpc.compiler.source import Document
+from mpc.core.diagnostics import Sink
+from mpc.core.yaml_source import Document
 
 
 class ModelSection(Node):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.diagnostics import did_you_mean
 from mpc.compiler.schema.base import After, Expr, Node, OneOrMore
+from mpc.core.diagnostics import did_you_mean
 
 TESTS = frozenset({
     "topological_self_consistency", "process_double_check", "file_consistency", "load_in_pybullet",

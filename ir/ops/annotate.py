@@ -9,11 +9,11 @@ import re
 from collections.abc import Mapping
 from dataclasses import field, replace
 
-from mpc.compiler.diagnostics import did_you_mean
+from mpc.core.diagnostics import did_you_mean
+from mpc.core.record import record
 from mpc.ir.extras import Sensor, Submechanism
 from mpc.ir.names import Names
 from mpc.ir.ops.base import Effects, Op, Phase, Ref
-from mpc.ir.record import record
 from mpc.ir.refs import JointRef, LinkRef, MaterialName, MaterialRef, PoseName, SensorName, SubmechanismName
 from mpc.ir.robot import Collision, Material, Pose, Robot
 

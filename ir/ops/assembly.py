@@ -10,11 +10,11 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Literal
 
-from mpc.compiler.diagnostics import did_you_mean
+from mpc.core.diagnostics import did_you_mean
+from mpc.core.record import record
 from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
 from mpc.ir.ops.base import Effects, Op, Phase, Ref
-from mpc.ir.record import record
 from mpc.ir.refs import JointName, LinkRef
 from mpc.ir.rename import rename_robot, rename_with
 from mpc.ir.robot import IDENTITY, Joint, Limit, Pose, Robot

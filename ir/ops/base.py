@@ -12,12 +12,12 @@ from dataclasses import field
 from enum import IntEnum
 from typing import ClassVar
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.names import Kind, Names
-from mpc.ir.record import record
 from mpc.ir.refs import refs as declared_refs
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 
 OPS: dict[str, type[Op]] = {}
 ROOT = "root"

@@ -11,9 +11,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import field, replace
 from typing import TYPE_CHECKING
 
+from mpc.core.record import record
 from mpc.ir.names import Names
 from mpc.ir.ops.base import Effects, Op, Phase
-from mpc.ir.record import record
 from mpc.ir.refs import JointName, LinkName, LinkRef, MaterialRef
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Link, Pose, Robot
 from mpc.ir.tree import parent_joint

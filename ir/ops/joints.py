@@ -8,10 +8,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import field, replace
 
+from mpc.core.record import record
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.names import Names
 from mpc.ir.ops.base import Effects, Op, Phase, Ref
-from mpc.ir.record import record
 from mpc.ir.refs import JointName, JointRef, LinkRef, MotorName
 from mpc.ir.robot import Dynamics, Joint, Limit, Mimic, Pose, Robot
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from mpc.core.record import record
 from mpc.ir.geometry import Mesh, ReduceMesh, ScaleMesh
 from mpc.ir.ops.base import Effects, Op, Phase
-from mpc.ir.record import record
 from mpc.ir.robot import Robot
 
 

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 import trimesh
 
-from mpc.backends import collada
-from mpc.compiler.diagnostics import Severity
+from mpc.core import collada
+from mpc.core.diagnostics import Severity
 from tests.conftest import Diags, compile_file, definition, write
 
 # A tetrahedron in centimetres whose only material has an effect with a texture sampler that

@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 import trimesh
 
-from mpc.compiler.diagnostics import Severity
+from mpc.core.diagnostics import Severity
 from tests.conftest import ERD, Diags, compile_file, write
 from tests.fixtures import arm
 
@@ -249,8 +249,8 @@ def test_the_settings_go_into_urdf2kccds_cfg(tmp_path: Path, diags: Diags) -> No
     DONTCHECK lines for the pairs (named by urdf2kccd's body names). The `.cfg` here is
     shaped as Phobos's reading of it expects; kccdcoveriv is not installed (W0520)."""
     from mpc.backends.kccd_tools import _configured
+    from mpc.core.span import Span
     from mpc.ir.program import KccdExport
-    from mpc.ir.span import Span
 
     cfg = ("TITLE arm\n\n# BRAKINGMODEL <linearFactor> <invDeceleration> UNCERTAINTY <uncertainty> "
            "LATENCY <latency>\n\n# OVERWRITE\n\n"

@@ -17,14 +17,14 @@ import pytest
 from lxml import etree
 
 from mpc.backends import meshes, mjcf, urdf
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.bitmask import assign, never_colliding
 from mpc.ir.extras import CutJoint, Motor
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertia, Inertial, Joint, Limit, Link, Mimic, Pose, Robot
-from mpc.ir.span import Span
 from tests.backends.test_urdf_real_models import GOOD
 from tests.conftest import ERD, Diags
 

@@ -15,7 +15,7 @@ import pytest
 
 from mpc.backends import mjcf, sdf_reader
 from mpc.checks.dynamics_model import Dynamics, build
-from mpc.compiler.diagnostics import Severity
+from mpc.core.diagnostics import Severity
 from mpc.ir.extras import Motor
 from mpc.ir.robot import Pose, Robot
 from tests.checks.fourbar import FOURBAR_DEFINITION, FOURBAR_URDF

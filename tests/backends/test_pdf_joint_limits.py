@@ -67,7 +67,7 @@ def test_kinematic_tree_pdf(tmp_path: Path) -> None:
     assert out is not None
     gv = (out / "arm.pdf.gv").read_text()
     from mpc.backends import urdf
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
     robot = urdf.read(source, Sink())
     assert robot is not None

@@ -12,10 +12,10 @@ import pytest
 from PIL import Image
 
 from mpc.backends.render import draw_all
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.driver import Options, compile_model
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.program import RenderExport
-from mpc.ir.span import Span
 from tests.conftest import ERD, Diags, definition, write
 
 UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"

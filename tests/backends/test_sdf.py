@@ -15,13 +15,13 @@ import pytest
 from lxml import etree
 
 from mpc.backends import sdf, sdf_reader, urdf
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
+from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.geometry import Mesh
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.program import SdfExport
 from mpc.ir.robot import Robot
-from mpc.ir.span import Span
 from tests.backends.test_urdf_real_models import GOOD
 from tests.conftest import ERD, Diags, write
 

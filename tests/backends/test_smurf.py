@@ -15,12 +15,12 @@ import pytest
 import yaml
 
 from mpc.backends import smurf, urdf
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
+from mpc.core.span import Span
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.kinematics import link_in_root
 from mpc.ir.program import SmurfExport, UrdfExport
 from mpc.ir.robot import Material, Pose, Robot
-from mpc.ir.span import Span
 from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, Diags, write
 from tests.fixtures import arm

@@ -10,8 +10,8 @@ from pathlib import Path
 import yaml
 
 from mpc.backends import smurf, urdf
+from mpc.core.span import Span
 from mpc.ir.program import SmurfExport, UrdfExport
-from mpc.ir.span import Span
 from tests.compiler.test_cli import mpc
 from tests.conftest import Diags, write
 from tests.phobos_release import ANNOTATIONS, SUBMECHANISMS, write_release

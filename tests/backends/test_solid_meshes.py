@@ -14,7 +14,7 @@ import trimesh
 from lxml import etree
 
 from mpc.backends.urdf_reader import read
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.solids import closed, solid, union
 from tests.conftest import ERD, Diags, compile_file, write

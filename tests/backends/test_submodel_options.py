@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import yaml
 
-from mpc.compiler.diagnostics import Severity
+from mpc.core.diagnostics import Severity
 from tests.backends.test_submodel import HEAD
 from tests.conftest import Diags, compile_file, write
 

@@ -13,7 +13,7 @@ from lxml import etree
 
 from mpc.backends import urdf
 from mpc.backends.xml import fmt_float
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.geometry import Mesh
 from tests.backends.test_urdf_real_models import GOOD
 from tests.conftest import ERD, Diags, compile_file, definition, write

@@ -8,8 +8,8 @@ from pathlib import Path
 from lxml import etree
 
 from mpc.checks import Protocol, run_model_tests
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.driver import Options, Result, compile_model
+from mpc.core.diagnostics import Sink
 from tests.conftest import definition as model_definition
 from tests.conftest import write
 

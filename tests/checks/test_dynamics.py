@@ -9,7 +9,7 @@ import pytest
 
 from mpc.backends.urdf_reader import read
 from mpc.checks.dynamics_model import build
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from tests.backends.pin_compare import load
 from tests.conftest import ERD
 

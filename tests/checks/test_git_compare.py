@@ -9,7 +9,7 @@ from pathlib import Path
 import git
 import pytest
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from tests.checks.helpers import (
     compile_ok,
     definition,

@@ -94,7 +94,7 @@ def test_moved_forearm_is_coloured_in_the_pictures(tmp_path: Path) -> None:
     from mpc.backends.pdf import UNCHANGED as TREE_GREY
     from mpc.backends.pdf import to_gv
     from mpc.backends.urdf_reader import read
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
     gv = to_gv(read(moved, Sink()), changed={"forearm_link"})
     assert gv.count(f'fillcolor="{TREE_CHANGED}"') == 1
@@ -140,7 +140,7 @@ def test_an_unchanged_model_is_all_grey(tmp_path: Path) -> None:
 
 def test_without_egl_the_protocol_says_so_and_the_tests_still_count(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
     from tests.fixtures import arm
 
     urdf = arm(tmp_path)

@@ -12,7 +12,7 @@ import pytest
 from mpc.checks import Protocol, run_model_tests
 from mpc.checks.protocol import Result, Tolerance, failed, passed, skipped
 from mpc.checks.registry import TESTS
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from tests.checks.helpers import compile_ok, definition, result, run, statuses, write
 from tests.conftest import ERD
 

@@ -9,7 +9,7 @@ import pytest
 
 from mpc.backends.urdf_reader import read
 from mpc.checks.validity import findings, inertia_problem
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.robot import Inertia
 from tests.checks.helpers import definition, result, run, write
 from tests.conftest import ERD

@@ -11,7 +11,7 @@ import pinocchio as pin
 from lxml import etree
 
 from mpc.backends import urdf
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.kinematics import link_in_root
 from tests.backends.pin_compare import load, random_configurations
 from tests.conftest import ERD, Diags, compile_file, definition, write

@@ -254,7 +254,7 @@ def test_mesh_format_that_cannot_be_written(tmp_path: Path, diags: Diags) -> Non
 
 
 def test_bobj_meshes_read_back(tmp_path: Path) -> None:
-    from mpc.backends import bobj
+    from mpc.core import bobj
 
     arm(tmp_path)
     spec = write(tmp_path / "model.yml", definition("arm.urdf", "bobj"))

@@ -23,8 +23,9 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
-from mpc.compiler.driver import Options, check_file
+from mpc.cli.check import check_file
+from mpc.compiler.inputs import Options
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
 
 BROKEN = (Path(__file__).parent / "broken").resolve()
 FIXTURES = sorted(BROKEN.glob("*__invalid.yml"))
@@ -35,11 +36,6 @@ _EXPECT = re.compile(r"# expect: (?P<code>[EW]\d{4}) (?:(?P<file>[^\s:]+):)?(?P<
 _HINT = re.compile(r"# hint: (?P<hint>.+)")
 
 Key = tuple[str, str, str]  # code, where ("line:col" or "file:line:col"), message
-
-# Fixtures whose diagnostics are reported twice today: `check_file` loads the YAML once to
-# tell a pipeline file from a model definition and `front_end` loads it again, so every
-# diagnostic of `source.load` that does not stop loading (E0103, E0105) appears twice.
-
 
 @dataclass
 class Expected:

@@ -16,7 +16,7 @@ UNUSED = ("mpc.ir.ops.annotate", "mpc.ir.ops.frames", "mpc.ir.ops.joints", "mpc.
 
 
 def _check_and_list(path: Path, modules: tuple[str, ...]) -> str:
-    code = ("import sys\nfrom mpc.compiler.cli import main\nstatus = main(['check', sys.argv[1]])\n"
+    code = ("import sys\nfrom mpc.cli.main import main\nstatus = main(['check', sys.argv[1]])\n"
             f"print(status, sorted(m for m in {modules!r} if m in sys.modules))")
     done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, check=True)
     return done.stdout

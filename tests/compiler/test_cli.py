@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def mpc(*args: str | Path, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "mpc.compiler.cli", *map(str, args)],
+    return subprocess.run([sys.executable, "-m", "mpc.cli.main", *map(str, args)],
                           capture_output=True, text=True, cwd=cwd)
 
 
@@ -94,7 +94,7 @@ def test_json_is_one_document_on_stdout_and_the_rest_goes_to_stderr(tmp_path: Pa
 
 def test_version_and_schema_go_to_stdout(tmp_path: Path) -> None:
     from mpc.compiler.jsonschema import render
-    from mpc.compiler.version import mpc_version
+    from mpc.core.version import mpc_version
 
     version = mpc("--version")
     assert (version.returncode, version.stdout) == (0, f"mpc {mpc_version()}\n")
@@ -130,7 +130,7 @@ def test_usage_errors_exit_2() -> None:
 def test_check_imports_no_heavy_library() -> None:
     """`mpc check` runs on every save in editors: YAML, the schema and URDF names, nothing more."""
     heavy = ("pinocchio", "pybullet", "trimesh", "numpy", "scipy", "lark", "pydantic", "git")
-    probe = ("import sys\nfrom mpc.compiler.cli import main\n"
+    probe = ("import sys\nfrom mpc.cli.main import main\n"
              f"code = main(['check', {str(ROOT / 'examples/talos.yml')!r}])\n"
              f"print(code, [m for m in {heavy!r} if m in sys.modules])\n")
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
@@ -154,7 +154,7 @@ def test_package_paths_are_found_in_a_sourced_ros2_workspace(tmp_path: Path) -> 
            "AMENT_PREFIX_PATH, the Python environment and the folders above the model)" in missing.stderr
     env = {**os.environ, "AMENT_PREFIX_PATH": f"{tmp_path}/ws/install/other{os.pathsep}"
                                               f"{tmp_path}/ws/install/arm_description"}
-    found = subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o",
+    found = subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o",
                             str(tmp_path / "out")], capture_output=True, text=True, env=env)
     assert found.returncode == 0, found.stderr
     assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (
@@ -177,7 +177,7 @@ def test_a_colcon_symlink_install_workspace_is_read_through_its_links(tmp_path: 
           ARM_URDF.replace("meshes/tetra.stl", "package://arm_description/meshes/tetra.stl"))
     spec = write(tmp_path / "models/model.yml", definition("arm.urdf", "stl", "arm"))
     env = {**os.environ, "AMENT_PREFIX_PATH": str(ws / "install/arm_description")}
-    run = [sys.executable, "-m", "mpc.compiler.cli", "compile", str(spec), "-o", str(tmp_path / "out")]
+    run = [sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o", str(tmp_path / "out")]
     done = subprocess.run(run, capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (

@@ -181,7 +181,7 @@ def test_auto_bitmask(tmp_path: Path, model: str) -> None:
     """Pairs the rules keep apart share no bit, pairs that may collide share one, and links
     touching at the zero pose (checked independently with Pinocchio's geometry) never collide."""
     from mpc.backends import urdf as urdf_backend
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
     from mpc.ir.bitmask import never_colliding
 
     source = ERD / model
@@ -194,8 +194,8 @@ def test_auto_bitmask(tmp_path: Path, model: str) -> None:
     mpc_robot = urdf_backend.read(source, Sink())
     assert mpc_robot is not None
     # Re-run the op on the IR to read the masks it sets.
+    from mpc.core.span import Span
     from mpc.ir.ops import AutoBitmask, Effects
-    from mpc.ir.span import Span
 
     op = AutoBitmask(span=Span("x"))
     sink = Sink()
@@ -233,7 +233,7 @@ def test_make_root_keeps_the_multibody(tmp_path: Path) -> None:
     """With the left foot as root, every link keeps its pose relative to every other link,
     for any configuration: X_new(F) = X_old(L)⁻¹ · X_old(P) · A_P, A_P the frame move."""
     from mpc.backends import urdf as urdf_backend
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
     out = _compile(tmp_path, TALOS, """
           frames:
@@ -289,7 +289,7 @@ def test_join_and_convex_collisions_are_convex_hulls(tmp_path: Path) -> None:
         assert mesh.volume > 0 and _convex(mesh) < 1e-9
     # The joined hull contains each part (scaled, placed), within the float32 precision of STL.
     from mpc.backends import urdf as urdf_backend
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
     from mpc.ir.kinematics import pose_matrix
     from mpc.ir.mesh_props import as_trimesh
 

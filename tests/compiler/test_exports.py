@@ -214,7 +214,7 @@ def test_sdf_loop_closures_with_include_cut_joints(tmp_path: Path) -> None:
     import subprocess
 
     from mpc.backends import sdf
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
     arm(tmp_path)
     spec = write(tmp_path / "m.yml", HEAD.replace("  export_config:\n", """  joints:

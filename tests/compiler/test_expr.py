@@ -12,10 +12,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import mpc.compiler.expr
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.expr import Binary, Call, Name, Num, Unary, evaluate, parse, parser
-from mpc.compiler.source import load
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
+from mpc.core.yaml_source import load
 from tests.conftest import Diags, write
 
 WHAT = "joint 'j1' max"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.cli import main
+from mpc.cli.main import main
 from tests.conftest import definition, write
 from tests.fixtures import arm
 
@@ -200,7 +200,7 @@ def test_an_alias_bomb_stops_under_a_memory_limit(tmp_path: Path) -> None:
 
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
-    run = subprocess.run([sys.executable, "-c", "import sys; from mpc.compiler.cli import main; "
+    run = subprocess.run([sys.executable, "-c", "import sys; from mpc.cli.main import main; "
                           "sys.exit(main(['check', sys.argv[1]]))", str(spec)],
                          capture_output=True, text=True, preexec_fn=cap, timeout=300)
     assert run.returncode == 1, run.stderr
@@ -273,7 +273,8 @@ def test_staging_folders_of_killed_builds_are_removed(tmp_path: Path,
 
 def test_git_runs_never_prompt_and_scrub_credentials(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                      monkeypatch: pytest.MonkeyPatch) -> None:
-    from mpc.compiler import gitrun, repos
+    from mpc.compiler import repos
+    from mpc.core import gitrun
 
     monkeypatch.delenv("GIT_TERMINAL_PROMPT", raising=False)
     assert gitrun.git("-c", "alias.p=!echo $GIT_TERMINAL_PROMPT", "p") == "0"

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.compiler import source
 from mpc.compiler.inherit import resolve
-from mpc.compiler.source import Document
-from mpc.ir.span import Span
+from mpc.core import yaml_source as source
+from mpc.core.span import Span
+from mpc.core.yaml_source import Document
 from tests.conftest import Diags, write
 
 

@@ -10,7 +10,7 @@ import pytest
 import trimesh
 
 from mpc.backends import urdf
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.mirror import axis_flip, reflection
 from tests.backends.pin_compare import random_configurations

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.diagnostics import Severity, Sink
 from mpc.compiler.passes import PASSES, PassContext, order_ops
 from mpc.compiler.passes.check_names import symbolic
 from mpc.compiler.passes.order_ops import language_order
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, LoadModel, import_all
 from mpc.ir.program import Program
@@ -199,7 +199,8 @@ def _arm_definition(folder: Path, assemble: str) -> Path:
 
 def test_one_clash_of_many_names_is_one_report(tmp_path: Path) -> None:
     """Attaching a model to itself unrenamed: one E0304 per kind of name, not one per name."""
-    from mpc.compiler.driver import Options, check_file
+    from mpc.cli.check import check_file
+    from mpc.compiler.inputs import Options
 
     definition = _arm_definition(tmp_path, "  assemble:\n    model: arm\n    children:\n"
                                  "      - model: arm\n        joint: {parent: lower, name: wrist}\n")
@@ -215,7 +216,7 @@ def test_one_clash_of_many_names_is_one_report(tmp_path: Path) -> None:
 
 def test_emit_ir_lowered_is_before_the_passes(tmp_path: Path) -> None:
     """`--emit ir-lowered` keeps the dead remove_beyond that `--emit ir` drops."""
-    from mpc.compiler.cli import main
+    from mpc.cli.main import main
 
     definition = _arm_definition(
         tmp_path, "  assemble: {model: arm, remove_beyond: lower, take_leaf: upper}\n")

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler import inherit, schema, source
+from mpc.compiler import inherit, schema
+from mpc.core import yaml_source as source
 from mpc.ir.robot import Robot
 from tests.conftest import Diags
 

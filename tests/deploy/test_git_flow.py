@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.version import mpc_version
+from mpc.core.diagnostics import Sink
+from mpc.core.version import mpc_version
 from mpc.deploy import deploy_model
 from tests.conftest import Diags
 from tests.deploy.conftest import SMURF_FILES, Model, Server, git, heavier

@@ -8,13 +8,13 @@ from pathlib import Path
 import pytest
 
 from mpc.compiler.driver import Options, load_program
+from mpc.core.span import Span
 from mpc.deploy.gitcmd import scrub
 from mpc.deploy.github import repository_slug
 from mpc.deploy.plan import lfs_patterns, make_plan, merged
 from mpc.deploy.settings import DeploySettings, join_remote
 from mpc.deploy.submodules import absolute_url
 from mpc.ir.program import Deployment, DeployMirror, Program
-from mpc.ir.span import Span
 from tests.conftest import Diags
 from tests.deploy.conftest import definition_text
 from tests.fixtures import arm

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.deploy import deploy_model
 from mpc.deploy.pictures import raw_base, web_address
 from tests.conftest import Diags

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.deploy import deploy_model
 from tests.conftest import Diags
 from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git, heavier, make_server

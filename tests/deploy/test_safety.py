@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.deploy import DeploySettings, deploy_model
 from tests.compiler.test_cli import mpc
 from tests.conftest import Diags
@@ -207,7 +207,7 @@ def test_deployments_at_the_same_time_share_the_workdir(model: Model, server: Se
     for definition, remote in ((model.definition, server), (_second_model(model, "arm-two"), other),
                                (model.definition, server), (model.definition, server)):
         jobs.append(subprocess.Popen(
-            [sys.executable, "-m", "mpc.compiler.cli", "deploy", str(definition), "--built", str(model.built),
+            [sys.executable, "-m", "mpc.cli.main", "deploy", str(definition), "--built", str(model.built),
              "--remote", remote.url, "--workdir", str(work)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
             text=True))
     outcomes = [(job.wait(), *job.communicate()) for job in jobs]

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 
 from mpc.backends.urdf_reader import read
-from mpc.compiler.diagnostics import Severity
+from mpc.core.diagnostics import Severity
+from mpc.core.span import Span
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.merge import merge_joints
 from mpc.ir.robot import Pose, Robot
-from mpc.ir.span import Span
 from tests.conftest import Diags
 from tests.fixtures import arm
 

@@ -6,9 +6,9 @@ import dataclasses
 
 import pytest
 
+from mpc.core.record import record
+from mpc.core.span import Span
 from mpc.ir.geometry import Box
-from mpc.ir.record import record
-from mpc.ir.span import Span
 
 
 @record(slots=True, kw_only=True)

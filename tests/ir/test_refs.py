@@ -110,8 +110,8 @@ def test_renamed_follows_every_declaration_and_keeps_what_did_not_change() -> No
 
 
 def test_an_op_reads_its_declared_references_in_field_order() -> None:
+    from mpc.core.span import Span
     from mpc.ir.ops import AnnotateLinks
-    from mpc.ir.span import Span
 
     op = AnnotateLinks(span=Span("d.yml", 1, 1, 1, 2), links=("a", "b"), material="steel")
     assert [(r.kind, r.name, r.field) for r in op.reads()] == [

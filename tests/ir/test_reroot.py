@@ -15,7 +15,7 @@ from lxml import etree
 
 from mpc.backends.urdf_reader import read
 from mpc.backends.urdf_writer import to_string
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.reroot import RerootError, reroot
 from mpc.ir.robot import Pose

@@ -13,7 +13,7 @@ import trimesh
 from lxml import etree
 
 from mpc.backends.urdf_reader import read
-from mpc.compiler.diagnostics import Severity, Sink
+from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.geometry import Box, Mesh, MeshSource, ReflectMesh
 from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.mesh_props import as_trimesh

@@ -20,12 +20,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mpc.compiler.diagnostics import Sink
 from mpc.compiler.driver import Options, front_end
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.ops import OPS, Op
 from mpc.ir.program import Program
 from mpc.ir.robot import Pose
-from mpc.ir.span import Span
 from mpc.ir.text import dump, parse
 from mpc.ir.text_types import field_hints, registry, unwrap
 from tests.conftest import Diags

@@ -40,7 +40,7 @@ def env(cache: Path) -> dict[str, str]:
 
 def mpc(*args: str | Path, cwd: Path | None = None,
         cache: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "mpc.compiler.cli", *map(str, args)], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "mpc.cli.main", *map(str, args)], capture_output=True,
                           text=True, cwd=cwd, env=env(cache) if cache else None, timeout=600)
 
 

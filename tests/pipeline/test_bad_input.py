@@ -270,10 +270,10 @@ def test_a_derived_base_cycle_across_three_files_fails_them_and_their_dependant(
 def test_a_definition_that_changes_between_plan_and_build(built: Path, tmp_path: Path, change: str,
                                                            monkeypatch: pytest.MonkeyPatch) -> None:
     """The runner plans from the file as it was; the worker builds the file as it is."""
-    from mpc.compiler.diagnostics import Sink
-    from mpc.compiler.pipeline.plan import load_plan
-    from mpc.compiler.pipeline.progress import Quiet
-    from mpc.compiler.pipeline.runner import Runner, RunOptions
+    from mpc.core.diagnostics import Sink
+    from mpc.pipeline.plan import load_plan
+    from mpc.pipeline.progress import Quiet
+    from mpc.pipeline.runner import Runner, RunOptions
 
     folder = _copy(built, tmp_path / "p")
     monkeypatch.setenv("MPC_CACHE_DIR", str(folder / "cache"))

@@ -163,10 +163,10 @@ def test_a_checkout_at_another_path_keeps_its_cache_and_sees_its_own_files(proje
 
 
 def test_a_new_mpc_version_rebuilds_everything(project: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from mpc.compiler.diagnostics import Sink
-    from mpc.compiler.pipeline import freshness, runner
-    from mpc.compiler.pipeline.plan import load_plan
-    from mpc.compiler.pipeline.progress import Quiet
+    from mpc.core.diagnostics import Sink
+    from mpc.pipeline import freshness, runner
+    from mpc.pipeline.plan import load_plan
+    from mpc.pipeline.progress import Quiet
 
     monkeypatch.setenv("MPC_CACHE_DIR", str(project.parent / "cache"))
     options = runner.RunOptions(jobs=1, package_map={"example-robot-data": project / "erd"})
@@ -195,10 +195,11 @@ def test_the_installed_package_is_named_absolutely(project: Path) -> None:
 
 def test_mpc_version_hashes_the_sources_of_mpc_and_nothing_else() -> None:
     """In a checkout, tests/ lies next to compiler/: editing a test must not rebuild models."""
-    from mpc.compiler.pipeline.fingerprint import source_files
+    from mpc.pipeline.fingerprint import source_files
 
     names = {name for name, _ in source_files()}
-    assert {"compiler/driver.py", "compiler/pipeline/runner.py", "grammar/expr.lark", "ir/robot.py",
+    assert {"compiler/driver.py", "pipeline/runner.py", "grammar/expr.lark", "ir/robot.py",
             "backends/urdf.py"} <= names
     packages = {name.split("/")[0] for name in names}
-    assert packages == {"backends", "checks", "compiler", "deploy", "grammar", "ir"}
+    assert packages == {"backends", "checks", "cli", "compiler", "core", "deploy", "grammar", "ir",
+                        "pipeline"}

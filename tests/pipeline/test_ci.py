@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mpc.compiler.version import mpc_version
+from mpc.core.version import mpc_version
 from tests.pipeline.helpers import copy_fleet, mpc
 
 VERSION = mpc_version()
@@ -218,7 +218,7 @@ def test_a_requirement_of_another_mpc_version_is_an_error(fleet: Path) -> None:
 ])
 def test_a_job_stops_when_its_mpc_is_another_version(tmp_path: Path, installed: str | None,
                                                      expected: str) -> None:
-    from mpc.compiler.pipeline.ci_install import version_check
+    from mpc.pipeline.ci_install import version_check
 
     bin_ = tmp_path / "bin"
     bin_.mkdir()
@@ -232,8 +232,8 @@ def test_a_job_stops_when_its_mpc_is_another_version(tmp_path: Path, installed: 
 
 def test_where_ci_installs_this_mpc_from(tmp_path: Path) -> None:
     """From PEP 610's direct_url.json of the running mpc."""
-    from mpc.compiler.diagnostics import Sink
-    from mpc.compiler.pipeline.ci_install import requirement
+    from mpc.core.diagnostics import Sink
+    from mpc.pipeline.ci_install import requirement
 
     project = tmp_path / "project"
     (project / "wheels").mkdir(parents=True)

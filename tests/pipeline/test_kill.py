@@ -76,7 +76,7 @@ def test_sigterm_to_a_worker_keeps_the_previous_output_and_the_next_run_complete
     urdf = folder / "slow.urdf"
     urdf.write_text(urdf.read_text().replace('value="0.10159"', 'value="0.2"', 1))
     (folder / "hold").write_text("")
-    argv = [sys.executable, "-m", "mpc.compiler.cli", "run", str(pipeline), "--log-format", "json"]
+    argv = [sys.executable, "-m", "mpc.cli.main", "run", str(pipeline), "--log-format", "json"]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env(cache))
     try:
         assert proc.stdout is not None
@@ -129,7 +129,7 @@ def test_sigterm_to_the_run_stops_its_workers_and_keeps_every_output(tmp_path: P
     build = folder / "build"
     previous = (build / "slow/urdf/slow.urdf").read_bytes()
     (folder / "hold").write_text("")
-    argv = [sys.executable, "-m", "mpc.compiler.cli", "run", str(pipeline), "--force", "--log-format", "json"]
+    argv = [sys.executable, "-m", "mpc.cli.main", "run", str(pipeline), "--force", "--log-format", "json"]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env(cache))
     try:
         deadline = time.monotonic() + 120

@@ -6,11 +6,12 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
-from mpc.compiler import inherit, source
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.defaults import PipelineDefaults
-from mpc.compiler.pipeline.plan import load_plan
+from mpc.compiler import inherit
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Sink
+from mpc.pipeline import dag
+from mpc.pipeline.defaults import PipelineDefaults
+from mpc.pipeline.plan import load_plan
 from tests.conftest import ERD, write
 from tests.pipeline.helpers import mpc, run_json
 
@@ -185,8 +186,8 @@ def test_check_of_a_definition_imports_nothing_of_the_pipeline(tmp_path: Path) -
     import sys
 
     write(tmp_path / "m.yml", _model("m"))
-    code = ("import sys\nfrom mpc.compiler.cli import main\nstatus = main(['check', sys.argv[1]])\n"
-            "print(status, sorted(m for m in sys.modules if m.startswith('mpc.compiler.pipeline') "
+    code = ("import sys\nfrom mpc.cli.main import main\nstatus = main(['check', sys.argv[1]])\n"
+            "print(status, sorted(m for m in sys.modules if m.startswith('mpc.pipeline') "
             "or m in ('multiprocessing', 'rich')))")
     done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "m.yml")], capture_output=True,
                           text=True, check=True)

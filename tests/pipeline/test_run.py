@@ -220,7 +220,7 @@ def test_on_a_terminal_a_live_display_then_the_table(fleet: Fleet) -> None:
     """stdout and stderr on a pseudo-terminal: rich's progress display (finished models
     printed above it), then the coloured table."""
     main, side = pty.openpty()
-    argv = [sys.executable, "-m", "mpc.compiler.cli", "run", str(fleet.pipeline), "--only", "pendulum",
+    argv = [sys.executable, "-m", "mpc.cli.main", "run", str(fleet.pipeline), "--only", "pendulum",
             "finger", "--force", "-j", "2"]
     proc = subprocess.Popen(argv, stdin=side, stdout=side, stderr=side, close_fds=True,
                             env={**os.environ, "MPC_CACHE_DIR": str(fleet.cache), "COLUMNS": "100"})

@@ -10,12 +10,12 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.pipeline.plan import load_plan
-from mpc.compiler.pipeline.progress import Quiet
-from mpc.compiler.pipeline.runner import Runner, RunOptions
-from mpc.compiler.pipeline.stages import STAGES, Stage, StageJob, StageOutcome
-from mpc.compiler.pipeline.status import RunStatus
+from mpc.core.diagnostics import Sink
+from mpc.pipeline.plan import load_plan
+from mpc.pipeline.progress import Quiet
+from mpc.pipeline.runner import Runner, RunOptions
+from mpc.pipeline.stages import STAGES, Stage, StageJob, StageOutcome
+from mpc.pipeline.status import RunStatus
 
 BASE = "package://example-robot-data/robots/double_pendulum_description/urdf/double_pendulum_simple.urdf"
 

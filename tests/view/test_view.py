@@ -25,7 +25,7 @@ UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"
 def start_view(tmp_path: Path, *args: str) -> tuple[subprocess.Popen, str]:
     """`mpc view …` in a process of its own; it and the URL it printed."""
     env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
-    process = subprocess.Popen([sys.executable, "-m", "mpc.compiler.cli", "view", *args, "--port", "0"],
+    process = subprocess.Popen([sys.executable, "-m", "mpc.cli.main", "view", *args, "--port", "0"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     assert process.stdout is not None
     for line in process.stdout:  # ends when the process does

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 import viser
 
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.view import compare_target, load_model, serve
-from mpc.compiler.view_scene import joint_range, link_poses, movable
+from mpc.cli.view import compare_target, load_model, serve
+from mpc.cli.view_scene import joint_range, link_poses, movable
+from mpc.core.diagnostics import Sink
 from tests.conftest import definition, write
 from tests.fixtures import arm
 
@@ -40,7 +40,7 @@ def test_a_definition_and_its_build_show_the_same_robot(tmp_path: Path) -> None:
     sink = Sink()
     robot = load_model(path, sink)
     assert robot is not None and not sink.has_errors()
-    subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(path), "-o",
+    subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(path), "-o",
                     str(tmp_path / "out")], check=True, capture_output=True)
     built = load_model(tmp_path / "out", sink)
     assert built is not None and set(built.links) == set(robot.links)
@@ -54,7 +54,7 @@ def test_a_definition_and_its_build_show_the_same_robot(tmp_path: Path) -> None:
 def test_the_compare_model_is_drawn_as_a_ghost(tmp_path: Path) -> None:
     arm(tmp_path)
     path = write(tmp_path / "arm.yml", definition(tmp_path / "arm.urdf", robotname="arm"))
-    subprocess.run([sys.executable, "-m", "mpc.compiler.cli", "compile", str(path), "-o",
+    subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(path), "-o",
                     str(tmp_path / "release")], check=True, capture_output=True)
     sink = Sink()
     robot = load_model(path, sink)
@@ -69,7 +69,7 @@ def test_the_compare_model_is_drawn_as_a_ghost(tmp_path: Path) -> None:
 
 
 def test_what_cannot_be_shown(tmp_path: Path) -> None:
-    view = [sys.executable, "-m", "mpc.compiler.cli", "view"]
+    view = [sys.executable, "-m", "mpc.cli.main", "view"]
     run = subprocess.run([*view, str(tmp_path / "nothing.yml")], capture_output=True, text=True)
     assert run.returncode == 1
     assert f"error[E0690]: '{tmp_path / 'nothing.yml'}' is neither a model definition nor a built folder" \

@@ -16,10 +16,10 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
-from mpc.compiler.pipeline.fingerprint import ReadRecorder, dep_entry
-from mpc.compiler.pipeline.stages import STAGES, StageJob, StageOutcome, ensure_program, first_error
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.span import Span
+from mpc.pipeline.fingerprint import ReadRecorder, dep_entry
+from mpc.pipeline.stages import STAGES, StageJob, StageOutcome, ensure_program, first_error
 
 
 def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ignore: list[Path],

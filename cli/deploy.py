@@ -1,4 +1,4 @@
-"""`mpc deploy`: deploy an existing build of one model definition (compiler/cli.py parses
+"""`mpc deploy`: deploy an existing build of one model definition (cli/main.py parses
 the arguments and calls `run`). Exit status: 0 deployed (or nothing to do), 1 failed."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from mpc.deploy import FORGES
 
 if TYPE_CHECKING:  # the rest is imported by `run`: building the parser of `mpc` stays light
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
     from mpc.deploy.result import DeployResult
     from mpc.deploy.settings import DeploySettings
 
@@ -44,9 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from mpc.compiler.diagnostics import Severity, Sink
     from mpc.compiler.driver import Options, load_program
-    from mpc.compiler.render import print_diagnostics
+    from mpc.core.diagnostics import Severity, Sink
+    from mpc.core.render import print_diagnostics
     from mpc.deploy.model import deploy_model
 
     sink = Sink()
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _read_protocol(path: Path, sink: Sink) -> str | None:
     """The test protocol's text; E0802 when it cannot be read or is not UTF-8."""
-    from mpc.ir.span import Span
+    from mpc.core.span import Span
 
     try:
         return path.read_text(encoding="utf-8")
@@ -91,7 +91,8 @@ def _settings(args: argparse.Namespace, sink: Sink) -> DeploySettings | None:
         return DeploySettings.from_environment(
             definition_repo=args.definition.resolve().parent,
             **{**values, "forge": args.forge or "none"})
-    from mpc.compiler import schema, source
+    from mpc.compiler import schema
+    from mpc.core import yaml_source as source
 
     doc = source.load(args.pipeline, sink)
     pipeline = schema.validate_pipeline(doc, sink) if doc is not None else None

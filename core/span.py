@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mpc.ir.record import record
+from mpc.core.record import record
 
 
 @record(slots=True)

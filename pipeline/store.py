@@ -20,7 +20,7 @@ import shutil
 from pathlib import Path
 from typing import IO, Any
 
-from mpc.compiler.files import describe, write_atomic
+from mpc.core.files import describe, write_atomic
 
 
 class BuildFolderBusy(Exception):
@@ -84,8 +84,8 @@ class Store:
         return self._read_state(model)[1]
 
     def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
-        from mpc.compiler import source
-        from mpc.compiler.diagnostics import Sink
+        from mpc.core import yaml_source as source
+        from mpc.core.diagnostics import Sink
 
         path = self.state_file(model)
         if not path.exists() and not path.is_symlink():
@@ -117,7 +117,7 @@ def write_json(path: Path, data: Any) -> None:
 
 def well_formed(state: Any) -> bool:
     """Whether `state` has the shape `save_state` gives it, so the runner can trust its types."""
-    from mpc.compiler.pipeline.status import diagnostics_from_json
+    from mpc.pipeline.status import diagnostics_from_json
 
     if not isinstance(state, dict):
         return False

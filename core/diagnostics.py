@@ -11,8 +11,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from enum import Enum
 
-from mpc.ir.record import record
-from mpc.ir.span import Span
+from mpc.core.record import record
+from mpc.core.span import Span
 
 
 class Severity(Enum):

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import trimesh
 
-from mpc.ir.span import hardened_parser
+from mpc.core.span import hardened_parser
 
 
 def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:

@@ -17,8 +17,8 @@ import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from mpc.compiler.diagnostics import Sink
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 
 if TYPE_CHECKING:
     from mpc.ir.robot import Robot
@@ -80,7 +80,7 @@ def serve(robot: Robot, ghost: Robot | None, host: str, port: int, workdir: Path
     import numpy as np
     import viser
 
-    from mpc.compiler.view_scene import add_robot, joint_range, movable
+    from mpc.cli.view_scene import add_robot, joint_range, movable
 
     try:
         server = viser.ViserServer(host=host, port=port, label=f"mpc view: {robot.name}", verbose=False)
@@ -152,7 +152,7 @@ def serve(robot: Robot, ghost: Robot | None, host: str, port: int, workdir: Path
 
 def run(args: argparse.Namespace) -> int:
     """Serve the viewer until interrupted; 1 when the model (or the compare model) cannot be shown."""
-    from mpc.compiler.render import print_diagnostics
+    from mpc.core.render import print_diagnostics
 
     sink = Sink()
     with tempfile.TemporaryDirectory(prefix="mpc-view-") as work:

@@ -16,12 +16,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from mpc.compiler import inherit, source
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
-from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.defaults import PipelineDefaults
-from mpc.compiler.source import Document
-from mpc.ir.span import Span
+from mpc.compiler import inherit
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.span import Span
+from mpc.core.yaml_source import Document
+from mpc.pipeline import dag
+from mpc.pipeline.defaults import PipelineDefaults
 
 if TYPE_CHECKING:
     from mpc.compiler.schema.definition import PipelineSection

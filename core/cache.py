@@ -44,7 +44,7 @@ def sidecars(entry: Path) -> list[Path]:
 
 def store_entry(entry: Path, data: bytes) -> None:
     """Keep `data` as `entry`, atomically; raises OSError (a read-only cache, a file in the way)."""
-    from mpc.compiler.files import write_atomic
+    from mpc.core.files import write_atomic
 
     write_atomic(entry, data)
     write_atomic(_hash_file(entry), hashlib.sha256(data).hexdigest() + "\n")

@@ -1,6 +1,6 @@
 """ir.Robot → a viser scene: one frame per link (posed by forward kinematics), its visuals,
 collisions and axes under it; `pose(q)` moves the frames. No GUI and no server of its own
-(compiler/view.py makes them). Meshes go through the mesh cache as OBJ, their recorded ops
+(cli/view.py makes them). Meshes go through the mesh cache as OBJ, their recorded ops
 applied, as every export does.
 """
 
@@ -16,11 +16,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from mpc.backends import meshes
-from mpc.compiler.diagnostics import Sink
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.robot import Collision, Joint, Material, Robot, Visual
-from mpc.ir.span import Span
 from mpc.ir.tree import depth_first
 
 RGBA = tuple[float, float, float, float]

@@ -12,7 +12,7 @@ import sys
 import time
 from typing import IO, Any
 
-from mpc.compiler.pipeline.status import ModelRecord, RunStatus, model_state, record_json
+from mpc.pipeline.status import ModelRecord, RunStatus, model_state, record_json
 
 
 class Quiet:
@@ -120,7 +120,7 @@ def rich_table(status: RunStatus) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    from mpc.compiler.pipeline.status import summary_line, table_rows
+    from mpc.pipeline.status import summary_line, table_rows
 
     header, *rows = table_rows(status)
     table = Table(*header, box=None, pad_edge=False)

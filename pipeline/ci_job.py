@@ -1,4 +1,4 @@
-"""`mpc ci job` and `mpc ci summary`: what a generated CI job runs (compiler/pipeline/ci.py).
+"""`mpc ci job` and `mpc ci summary`: what a generated CI job runs (pipeline/ci.py).
 
 `mpc ci job PIPELINE MODEL --stages S`: `mpc run PIPELINE --only MODEL --stages S`, with
 what earlier jobs left as artifacts in `<build>/.mpc/ci/<model>/`:
@@ -23,13 +23,14 @@ import argparse
 import json
 import shutil
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.cache import SIDECARS, cache_dir, sidecars
-from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.plan import Plan
-from mpc.compiler.pipeline.status import (
+from mpc.core.cache import SIDECARS, cache_dir, sidecars
+from mpc.pipeline import dag
+from mpc.pipeline.plan import Plan
+from mpc.pipeline.status import (
     GOOD,
     ModelRecord,
     RunStatus,
@@ -110,10 +111,9 @@ def merge_caches(build: Path) -> None:
                     shutil.copy2(entry, target)
 
 
-def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...], build: Path) -> int:
-    """`mpc ci job` (see the module docstring)."""
-    from mpc.compiler.pipeline.command import run
-
+def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...], build: Path,
+        run: Callable[[argparse.Namespace], int]) -> int:
+    """`mpc ci job` (see the module docstring); `run` is `mpc run`'s command."""
     merge_caches(build)
     reason = blocked(plan, build, model, stages)
     if reason is not None:

@@ -52,7 +52,7 @@ def file_digest(path: Path) -> str:
 @cache
 def mpc_version() -> str:
     """mpc's version and a digest of its source files (compiler, ir, backends, grammar, …)."""
-    from mpc.compiler.version import mpc_version as installed_version
+    from mpc.core.version import mpc_version as installed_version
 
     ver = installed_version()
     h = hashlib.sha256(ver.encode())

@@ -12,9 +12,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from mpc.compiler.pipeline.fingerprint import data_digest, dep_name, deps_current, digest, mpc_version
-from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.store import Store
+from mpc.pipeline.fingerprint import data_digest, dep_name, deps_current, digest, mpc_version
+from mpc.pipeline.plan import Plan, PlannedModel
+from mpc.pipeline.store import Store
 
 
 class Freshness:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from mpc.compiler.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
 
 if TYPE_CHECKING:
     from mpc.compiler.driver import Options

@@ -21,7 +21,7 @@ from typing import Any
 
 # The merge of defaults files, reused so both layers follow one rule.
 from mpc.compiler.inherit import copy_value, forget_spans, merge_value
-from mpc.compiler.source import Document
+from mpc.core.yaml_source import Document
 
 _MERGED = (("test", "default_test"), ("deployment", "default_deployment"))
 

@@ -11,12 +11,12 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mpc.compiler import render
-from mpc.compiler.diagnostics import Severity, Sink, did_you_mean
-from mpc.compiler.pipeline.plan import Plan, load_plan
+from mpc.core import render
+from mpc.core.diagnostics import Severity, Sink, did_you_mean
+from mpc.pipeline.plan import Plan, load_plan
 
 if TYPE_CHECKING:
-    from mpc.compiler.pipeline.status import RunStatus
+    from mpc.pipeline.status import RunStatus
 
 
 class UsageError(Exception):
@@ -27,7 +27,7 @@ class UsageError(Exception):
 
 def parse_stages(text: str) -> tuple[str, ...]:
     """The stages named on the command line, with the stages they need, in run order."""
-    from mpc.compiler.pipeline.stages import KNOWN, STAGES, stages_with_needs
+    from mpc.pipeline.stages import KNOWN, STAGES, stages_with_needs
 
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:
@@ -67,10 +67,10 @@ def _load(args: argparse.Namespace, sink: Sink) -> Plan | None:
 
 def run(args: argparse.Namespace) -> int:
     """`mpc run PIPELINE`."""
-    from mpc.compiler.pipeline import progress
-    from mpc.compiler.pipeline.runner import Runner, RunOptions
-    from mpc.compiler.pipeline.status import plain_table
-    from mpc.compiler.pipeline.store import BuildFolderBusy, BuildFolderUnusable
+    from mpc.pipeline import progress
+    from mpc.pipeline.runner import Runner, RunOptions
+    from mpc.pipeline.status import plain_table
+    from mpc.pipeline.store import BuildFolderBusy, BuildFolderUnusable
 
     sink = Sink(werror=args.werror)
     plan = _load(args, sink)
@@ -144,9 +144,9 @@ def _interrupt(signum: int, frame: object) -> None:
 
 def ci(args: argparse.Namespace) -> int:
     """`mpc ci gitlab|github PIPELINE`, and `mpc ci job|summary` (what the generated jobs run)."""
-    from mpc.compiler.pipeline import ci as generate
-    from mpc.compiler.pipeline import ci_install
-    from mpc.compiler.version import mpc_version
+    from mpc.core.version import mpc_version
+    from mpc.pipeline import ci as generate
+    from mpc.pipeline import ci_install
 
     if args.system in ("job", "summary"):
         return _ci_step(args)
@@ -189,7 +189,7 @@ def ci(args: argparse.Namespace) -> int:
     if args.output is None:
         sys.stdout.write(text)
     else:
-        from mpc.compiler.files import describe, write_atomic
+        from mpc.core.files import describe, write_atomic
 
         try:
             write_atomic(args.output, text)
@@ -201,8 +201,8 @@ def ci(args: argparse.Namespace) -> int:
 
 
 def _ci_step(args: argparse.Namespace) -> int:
-    """`mpc ci job PIPELINE MODEL` and `mpc ci summary PIPELINE` (compiler/pipeline/ci_job.py)."""
-    from mpc.compiler.pipeline import ci_job
+    """`mpc ci job PIPELINE MODEL` and `mpc ci summary PIPELINE` (pipeline/ci_job.py)."""
+    from mpc.pipeline import ci_job
 
     plan = _load(args, Sink())
     if plan is None:
@@ -216,4 +216,4 @@ def _ci_step(args: argparse.Namespace) -> int:
     except UsageError as e:
         print(f"mpc ci job: error: {e}", file=sys.stderr)
         return 2
-    return ci_job.job(args, plan, model, stages, build)
+    return ci_job.job(args, plan, model, stages, build, run)

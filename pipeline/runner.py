@@ -27,14 +27,15 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-from mpc.compiler.diagnostics import Diagnostic, Severity
-from mpc.compiler.files import describe
-from mpc.compiler.pipeline import dag
-from mpc.compiler.pipeline.fingerprint import mpc_version, with_deps
-from mpc.compiler.pipeline.freshness import Freshness
-from mpc.compiler.pipeline.plan import Plan, PlannedModel
-from mpc.compiler.pipeline.stages import StageJob, StageOutcome, first_error
-from mpc.compiler.pipeline.status import (
+from mpc.core.diagnostics import Diagnostic, Severity
+from mpc.core.files import describe
+from mpc.core.span import Span
+from mpc.pipeline import dag
+from mpc.pipeline.fingerprint import mpc_version, with_deps
+from mpc.pipeline.freshness import Freshness
+from mpc.pipeline.plan import Plan, PlannedModel
+from mpc.pipeline.stages import StageJob, StageOutcome, first_error
+from mpc.pipeline.status import (
     ModelRecord,
     RunStatus,
     StageRecord,
@@ -42,8 +43,7 @@ from mpc.compiler.pipeline.status import (
     diagnostics_json,
     past,
 )
-from mpc.compiler.pipeline.store import Store
-from mpc.ir.span import Span
+from mpc.pipeline.store import Store
 
 if TYPE_CHECKING:
     from mpc.compiler.driver import Options
@@ -68,7 +68,7 @@ class RunOptions:
 
 
 class Reporter(Protocol):
-    """Progress of a run (compiler/pipeline/progress.py)."""
+    """Progress of a run (pipeline/progress.py)."""
 
     def planned(self, status: RunStatus, models: list[str]) -> None: ...
     def started(self, model: str, pid: int) -> None: ...
@@ -204,8 +204,8 @@ class Runner:
                        defaults=self.plan.defaults)
 
     def _start(self, name: str, pre: str, cached: list[str]) -> None:
-        from mpc.compiler.cache import cache_dir
-        from mpc.compiler.pipeline import worker
+        from mpc.core.cache import cache_dir
+        from mpc.pipeline import worker
 
         _preload()
         model = self.plan.models[name]

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 # The rest of mpc is imported by the command that needs it: `mpc check` turns off the cyclic
 # garbage collector first (see _check), and no command pays for another's imports.
 if TYPE_CHECKING:
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
 
 def _package(text: str) -> tuple[str, Path]:
@@ -42,7 +42,7 @@ class _Version(argparse.Action):
         super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)  # type: ignore[arg-type]
 
     def __call__(self, parser: argparse.ArgumentParser, *_: object) -> None:
-        from mpc.compiler.version import mpc_version
+        from mpc.core.version import mpc_version
 
         print(f"mpc {mpc_version()}")
         parser.exit()
@@ -63,8 +63,8 @@ def _parser() -> argparse.ArgumentParser:
                        help="model definitions, IR files or pipeline.yml files")
     schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
     schema.add_argument("-o", "--out", type=Path, help="the file to write it to (default: stdout)")
-    # mpc deploy (deploy/command.py)
-    from mpc.deploy.command import add_arguments as deploy_arguments
+    # mpc deploy (cli/deploy.py)
+    from mpc.cli.deploy import add_arguments as deploy_arguments
 
     deploy_arguments(sub.add_parser("deploy", help="deploy a built model to its git repository"))
     # -- mpc test (checks/) --
@@ -73,7 +73,7 @@ def _parser() -> argparse.ArgumentParser:
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
                       "--built: where the protocol goes (default: the --built folder)")
-    # -- pipeline runs and CI generation (compiler/pipeline/) --
+    # -- pipeline runs and CI generation (pipeline/) --
     run = sub.add_parser("run", help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
     run.add_argument("pipeline", type=Path, help="the pipeline file")
     run.add_argument("--only", nargs="+", action="extend", default=[], metavar="MODEL",
@@ -127,20 +127,20 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _sink(args: argparse.Namespace) -> Sink:
-    from mpc.compiler.diagnostics import Sink
+    from mpc.core.diagnostics import Sink
 
     return Sink(werror=args.werror)
 
 
 def _summary(sink: Sink) -> str:
     """"2 errors, 1 warning"."""
-    from mpc.compiler import render
+    from mpc.core import render
 
     return render.summary(sink.diagnostics)
 
 
 def print_diagnostics(sink: Sink, fmt: str) -> None:
-    from mpc.compiler import render
+    from mpc.core import render
 
     render.print_diagnostics(sink.diagnostics, fmt)
 
@@ -189,7 +189,8 @@ def _check(args: argparse.Namespace) -> int:
 
 def _check_files(args: argparse.Namespace) -> int:
     from mpc.backends.packages import PackageResolver
-    from mpc.compiler.driver import Options, check_file
+    from mpc.cli.check import check_file
+    from mpc.compiler.inputs import Options
 
     sink = _sink(args)
     options = Options(resolver=PackageResolver(package_map=dict(args.package)))
@@ -209,7 +210,7 @@ def _schema(args: argparse.Namespace) -> int:
     if args.out is None or str(args.out) == "-":
         sys.stdout.write(text)
     else:
-        from mpc.compiler.files import write_atomic
+        from mpc.core.files import write_atomic
 
         write_atomic(args.out, text)
         print(f"wrote {args.out}")
@@ -217,7 +218,7 @@ def _schema(args: argparse.Namespace) -> int:
 
 
 def _deploy(args: argparse.Namespace) -> int:
-    from mpc.deploy.command import run
+    from mpc.cli.deploy import run
 
     return run(args)
 
@@ -265,14 +266,14 @@ def _test(args: argparse.Namespace) -> int:
 
 
 def _view(args: argparse.Namespace) -> int:
-    from mpc.compiler.view import run
+    from mpc.cli.view import run
 
     return run(args)
 
 
 def _pipeline(args: argparse.Namespace) -> int:
-    """`mpc run` and `mpc ci` (compiler/pipeline/command.py)."""
-    from mpc.compiler.pipeline import command
+    """`mpc run` and `mpc ci` (cli/run.py)."""
+    from mpc.cli import run as command
 
     return command.run(args) if args.command == "run" else command.ci(args)
 
@@ -290,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
                "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command]
     try:
         if _json_on_stdout(args):
-            from mpc.compiler.render import json_document
+            from mpc.core.render import json_document
 
             with json_document():
                 return command(args)
@@ -300,7 +301,7 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as e:  # the disk, not mpc: what no phase reported with its own code
         if os.environ.get("MPC_DEBUG"):
             raise
-        from mpc.compiler.files import describe
+        from mpc.core.files import describe
 
         code = "E0669"
         print(f"error[{code}]: {describe(e, f'finish mpc {args.command}')}", file=sys.stderr)

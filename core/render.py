@@ -10,9 +10,9 @@ import sys
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager, redirect_stdout
 
-from mpc.compiler.diagnostics import Diagnostic, Severity
-from mpc.compiler.source import source_line
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Diagnostic, Severity
+from mpc.core.span import Span
+from mpc.core.yaml_source import source_line
 
 MAX_SHOWN = 50
 

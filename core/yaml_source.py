@@ -23,8 +23,8 @@ from typing import Any
 import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from mpc.compiler.diagnostics import Sink
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 
 Path_ = tuple[str | int, ...]
 

@@ -11,7 +11,7 @@ import json
 from dataclasses import dataclass, field
 from typing import Any
 
-from mpc.compiler.diagnostics import Diagnostic, Severity
+from mpc.core.diagnostics import Diagnostic, Severity
 
 GOOD = ("ok", "cached")
 
@@ -127,14 +127,14 @@ def record_json(r: StageRecord) -> dict[str, Any]:
 
 
 def diagnostics_json(diagnostics: list[Diagnostic]) -> list[Any]:
-    from mpc.compiler import render
+    from mpc.core import render
 
     return json.loads(render.as_json(diagnostics)) if diagnostics else []
 
 
 def diagnostics_from_json(items: list[Any]) -> list[Diagnostic]:
     """Diagnostics as `diagnostics_json` wrote them (a failure replayed from the state)."""
-    from mpc.ir.span import Span
+    from mpc.core.span import Span
 
     def span(d: dict[str, Any] | None) -> Span | None:
         return None if d is None else Span(d["file"], d["line"], d["col"], d["end_line"], d["end_col"])

@@ -22,9 +22,9 @@ from importlib import metadata
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
-from mpc.compiler.diagnostics import Sink
-from mpc.compiler.version import mpc_version
-from mpc.ir.span import Span
+from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
+from mpc.core.version import mpc_version
 
 DIST = "model-pipeline-compiler"
 VENV = ".mpc-venv"  # where a job installs mpc, inside its checkout

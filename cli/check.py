@@ -1,0 +1,39 @@
+"""`mpc check FILE…`: a model definition, an IR file or a pipeline file, checked; nothing written.
+
+The command tells a pipeline file from a model definition by reading it once; a definition
+then goes through the driver's front end without the pipeline's modules being imported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+from mpc.compiler import driver
+from mpc.compiler.inputs import Options
+from mpc.core import yaml_source as source
+from mpc.core.diagnostics import Sink
+from mpc.core.files import describe
+from mpc.core.span import Span
+
+
+def check_file(path: Path, sink: Sink, options: Options) -> None:
+    """Everything `mpc check` does for one file: a pipeline file through check_pipeline, with
+    each of its definitions under the pipeline's defaults; anything else through the driver."""
+    if path.suffix == ".ir":
+        driver.check_file(path, sink, options)
+        return
+    try:
+        doc = source.load(path, sink)
+    except OSError as e:
+        sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
+        return
+    if doc is None:
+        return
+    if isinstance(doc.data, dict) and "pipeline" in doc.data:
+        from mpc.pipeline.plan import check_pipeline
+
+        check_pipeline(path, sink, lambda model, defaults: driver.check_file(
+            model, sink, replace(options, defaults=defaults)))
+        return
+    driver.check_file(path, sink, options, doc)
