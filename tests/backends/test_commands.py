@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, write
+from tests.mpc_command import mpc
 
 SOURCE = ERD / "talos_data/robots/talos_left_arm.urdf"
 HEAD = f"""

@@ -388,7 +388,7 @@ def test_sdf_additional_meshes_and_enforce_zero(tmp_path: Path, diags: Diags) ->
 def test_from_the_command_line(tmp_path: Path) -> None:
     """pr2: `mpc check` is clean, `mpc compile` writes both files of each export and names
     the corrected links in gcc format."""
-    from tests.compiler.test_cli import mpc
+    from tests.mpc_command import mpc
 
     spec = _spec(tmp_path, ERD / "pr2_description/urdf/pr2.urdf", """
             - type: urdf

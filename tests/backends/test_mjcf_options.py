@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, write
+from tests.mpc_command import mpc
 
 ARM = ERD / "talos_data/robots/talos_left_arm.urdf"
 

@@ -21,9 +21,9 @@ from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.kinematics import link_in_root
 from mpc.ir.program import SmurfExport, UrdfExport
 from mpc.ir.robot import Material, Pose, Robot
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, Diags, write
 from tests.fixtures import arm
+from tests.mpc_command import mpc
 
 SPAN = Span("test.yml", 1, 1)
 MODELS = {

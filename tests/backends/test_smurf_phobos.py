@@ -12,8 +12,8 @@ import yaml
 from mpc.backends import smurf, urdf
 from mpc.core.span import Span
 from mpc.ir.program import SmurfExport, UrdfExport
-from tests.compiler.test_cli import mpc
 from tests.conftest import Diags, write
+from tests.mpc_command import mpc
 from tests.phobos_release import ANNOTATIONS, SUBMECHANISMS, write_release
 
 DEFINITION = """\

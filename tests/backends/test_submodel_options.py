@@ -239,7 +239,7 @@ def test_move_joint_axis_to_intersection(tmp_path: Path, diags: Diags) -> None:
 def test_from_the_command_line(tmp_path: Path) -> None:
     """`mpc compile` on TALOS: the legs without fixed joints (sole links merged into the
     ankles), their joint limits, and the KCCD model of the legs; the one warning is W0520."""
-    from tests.compiler.test_cli import mpc
+    from tests.mpc_command import mpc
 
     spec = write(tmp_path / "m.yml", HEAD + """
   export_config:

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import git
 
-from tests.compiler.test_cli import mpc
 from tests.conftest import write
+from tests.mpc_command import mpc
 from tests.pipeline.helpers import run_json
 
 MAIN = """\

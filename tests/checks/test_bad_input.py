@@ -15,8 +15,8 @@ from lxml import etree
 
 from tests.checks.fourbar import FOURBAR_DEFINITION, FOURBAR_URDF
 from tests.checks.helpers import EVERY_TEST, definition, edited_urdf, link_el, write
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD
+from tests.mpc_command import mpc
 
 SOLO = ERD / "solo_description/robots/solo12.urdf"
 EVERY = (EVERY_TEST + "          - move_hyrodyn_model: 0.3\n          - compare_torques\n"

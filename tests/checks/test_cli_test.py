@@ -7,8 +7,8 @@ import json
 from pathlib import Path
 
 from tests.checks.helpers import definition, edited_urdf, link_el, write
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD
+from tests.mpc_command import mpc, mpc_process
 
 SOLO = ERD / "solo_description/robots/solo12.urdf"
 TESTS = "      - load_in_pybullet\n      - compare_link_masses\n      - hyrodynChecks: [compare_masses]\n"
@@ -17,7 +17,7 @@ TESTS = "      - load_in_pybullet\n      - compare_link_masses\n      - hyrodynC
 def test_a_model_against_its_release_passes_and_writes_the_protocol(tmp_path: Path) -> None:
     write(tmp_path / "m.yml", definition(SOLO, "solo", TESTS, compare="      path: ref\n"))
     assert mpc("compile", tmp_path / "m.yml", "-o", tmp_path / "ref").returncode == 0
-    run = mpc("test", tmp_path / "m.yml", "-o", tmp_path / "out")
+    run = mpc_process("test", tmp_path / "m.yml", "-o", tmp_path / "out")
     assert run.returncode == 0, run.stdout + run.stderr
     assert run.stdout.startswith("## Model tests of `solo-model`: **passed** (6 passed, 0 failed)\n")
     assert "| `load_in_pybullet` | ✅ passed | 17 links |" in run.stdout

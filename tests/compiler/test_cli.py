@@ -11,17 +11,13 @@ from lxml import etree
 
 from tests.conftest import definition, write
 from tests.fixtures import arm
+from tests.mpc_command import mpc, mpc_process
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def mpc(*args: str | Path, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "mpc.cli.main", *map(str, args)],
-                          capture_output=True, text=True, cwd=cwd)
-
-
 def test_bundled_example_compiles(tmp_path: Path) -> None:
-    run = mpc("compile", ROOT / "examples/talos.yml", "-o", tmp_path / "talos")
+    run = mpc_process("compile", ROOT / "examples/talos.yml", "-o", tmp_path / "talos")
     assert run.returncode == 0, run.stderr
     assert run.stderr == ""
     assert run.stdout == (f"compiled '{ROOT}/examples/talos.yml' into '{tmp_path}/talos': "

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, write
+from tests.mpc_command import mpc
 
 UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"
 ARM = ERD / "talos_data/robots/talos_left_arm.urdf"

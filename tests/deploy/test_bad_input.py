@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.compiler.test_cli import mpc
 from tests.deploy.conftest import Model, Server, definition_text, git, make_server
+from tests.mpc_command import mpc
 
 
 def _deploy(model: Model, *extra: str | Path) -> subprocess.CompletedProcess[str]:

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tests.compiler.test_cli import mpc
 from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git
+from tests.mpc_command import mpc
 
 PIPELINE = """\
 pipeline:

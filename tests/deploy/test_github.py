@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.compiler.test_cli import mpc
 from tests.deploy.conftest import Model, Server, git, heavier
+from tests.mpc_command import mpc
 
 TOKEN = "ghp_SECRETtoken1234567890"
 

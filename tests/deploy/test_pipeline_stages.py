@@ -7,8 +7,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from tests.compiler.test_cli import mpc
 from tests.deploy.conftest import Model, Server, definition_text, git, heavier
+from tests.mpc_command import mpc
 
 PIPELINE = """\
 pipeline:

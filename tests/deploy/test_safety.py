@@ -15,9 +15,9 @@ import pytest
 
 from mpc.core.diagnostics import Sink
 from mpc.deploy import DeploySettings, deploy_model
-from tests.compiler.test_cli import mpc
 from tests.conftest import Diags
 from tests.deploy.conftest import SMURF_FILES, Model, Server, definition_text, git, heavier, make_server
+from tests.mpc_command import mpc
 
 
 def _plain(model: Model, server: Server) -> DeploySettings:

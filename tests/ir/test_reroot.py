@@ -20,8 +20,8 @@ from mpc.ir.kinematics import link_in_root, pose_matrix
 from mpc.ir.reroot import RerootError, reroot
 from mpc.ir.robot import Pose
 from mpc.ir.tree import joints_up
-from tests.compiler.test_cli import mpc
 from tests.conftest import ERD, write
+from tests.mpc_command import mpc
 
 ARM = ERD / "talos_data/robots/talos_left_arm.urdf"
 UR5 = ERD / "ur_description/urdf/ur5_robot.urdf"
