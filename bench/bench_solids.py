@@ -16,7 +16,8 @@ from mpc.backends.urdf_reader import read
 from mpc.checks.validity import _validity, findings
 from mpc.core.diagnostics import Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
-from mpc.ir.solids import solid, union
+from mpc.ir.mesh_props import solid
+from mpc.ir.solids import union
 
 MODELS = ("talos_data/robots/talos_full_v2.urdf", "ur_description/urdf/ur5_robot.urdf",
           "solo_description/robots/solo12.urdf")

@@ -105,8 +105,8 @@ def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: 
     inertial = link.inertial
     if inertial is None or inertial.mass <= 0 or not link.collisions:
         return []
-    from mpc.ir.mesh_props import MeshError
-    from mpc.ir.solids import principal, solid, union
+    from mpc.ir.mesh_props import MeshError, solid
+    from mpc.ir.solids import principal, union
 
     try:
         whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in link.collisions])
