@@ -148,8 +148,9 @@ def test_names_in_free_data_are_declared_renamed_and_pruned() -> None:
         (("link",), "thigh", "definition/loop_constraints/0/predecessor_body"),
         (("link",), "shin", "definition/loop_constraints/0/successor_body")]
     out = refs.renamed(sm, lambda kinds, name: f"l_{name}" if kinds == ("link",) else name.upper())
+    loop = {"predecessor_body": "l_thigh", "successor_body": "l_shin"}
     assert out.definition == {"jointnames_active": ["KNEE", "HIP"], "around": "l_thigh", "type": "serial",
-                              "loop_constraints": [{"predecessor_body": "l_thigh", "successor_body": "l_shin"}]}
+                              "loop_constraints": [loop]}
     pruned = refs.pruned(sm, lambda kind, name: kind == "joint" and name == "knee", "definition")
     assert pruned.definition["jointnames_active"] == ["hip"] and pruned.definition["around"] == "thigh"
     assert refs.pruned(sm, lambda kind, name: False, "definition") is sm
