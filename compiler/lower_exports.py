@@ -57,12 +57,11 @@ class _Exports:
         out: list[Export] = []
         if self.ctx.model.export_config is None:
             out.append(UrdfExport(mesh_format="input_type", span=self.ctx.model.span))
-        written = self.written
         for entry in self.entries():
             if entry.type == "submodel":
-                out.extend(self.submodel(entry, written))
+                out.extend(self.submodel(entry))
             else:
-                out.extend(self.export(entry, written, self.ctx.model.robotname))
+                out.extend(self.export(entry, self.ctx.model.robotname))
         # A joint_limits entry that lists a submodel's joints needs that submodel cut first.
         out = [e for e in out if not _lists_a_submodel(e)] + [e for e in out if _lists_a_submodel(e)]
         out.extend(self.smurf.exports(out))
@@ -74,7 +73,7 @@ class _Exports:
             out.append(self.ros_package(package))
         return tuple(out)
 
-    def export(self, entry: Any, written: dict[str, Export], robotname: str,
+    def export(self, entry: Any, robotname: str,
                submodel: str = "", inherited: bool = False) -> list[Export]:
         """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/,
         where its meshes are too: its `package://` paths point there)."""
@@ -82,23 +81,23 @@ class _Exports:
             from mpc.compiler.lower_kccd import lower_kccd
 
             if not inherited:
-                return lower_kccd(self.ctx, entry, written, submodel)
+                return lower_kccd(self.ctx, entry, self.written, submodel)
             quiet = self.ctx.quiet()  # the model's own use of the entry reported
-            lowered = lower_kccd(quiet, entry, written, submodel)
+            lowered = lower_kccd(quiet, entry, self.written, submodel)
             return [] if quiet.sink.has_errors() else lowered
         if entry.type == "render":
             from mpc.compiler.lower_render import lower_render
 
             target = f"{'submodels/' + submodel + '/' if submodel else ''}render/"
-            if target in written:
+            if target in self.written:
                 if not inherited:
                     self.ctx.sink.error(entry.span, "E0576", f"two render exports would write {target}",
-                                        notes=((written[target].span, "the other export"),))
+                                        notes=((self.written[target].span, "the other export"),))
                 return []
             render = lower_render(entry, (self.ctx.quiet() if inherited else self.ctx).sink, submodel)
             if render is None:
                 return []
-            written[target] = render
+            self.written[target] = render
             return [render]
         if entry.type in ("pdf", "joint_limits"):
             export = self.simple_export(entry, inherited)
@@ -108,16 +107,16 @@ class _Exports:
             return []
         if entry.type not in BUILT_EXPORTS:
             self.ctx.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
-                         + (" in a submodel" if submodel and entry.type == "submodel" else ""))
+                             + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
         if entry.type == "mjcf" and not inherited:  # the model's own use of the entry reported
             self.no_package_paths(entry)
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
-        if target in written:
+        if target in self.written:
             self.ctx.sink.error(entry.span, "E0503", f"two {entry.type} exports would write {target} "
                                 "(Phobos silently let the last one win); give one a filename_suffix",
-                                notes=((written[target].span, "the other export"),))
+                                notes=((self.written[target].span, "the other export"),))
             return []
         mesh_format = entry.mesh_format
         if entry.type == "mjcf" and mesh_format == "input_type":
@@ -143,7 +142,7 @@ class _Exports:
         export = replace(export, enforce_zero=entry.enforce_zero,
                          additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
         export = self.smurf.link(entry, export, submodel)
-        written[target] = export
+        self.written[target] = export
         return [export]
 
     def no_package_paths(self, entry: Any) -> None:
@@ -180,7 +179,7 @@ class _Exports:
                 out.append((key, fmt))
         return tuple(out)
 
-    def submodel(self, entry: Any, written: dict[str, Export]) -> list[Export]:
+    def submodel(self, entry: Any) -> list[Export]:
         """A `submodel` entry: the part of the robot it cuts out, then its exports (its own
         export_config, or the model's without submodels)."""
         for key, default in _SUBMODEL_LATER.items():
@@ -210,11 +209,11 @@ class _Exports:
             moves[joint] = tuple(pair)
         cut = replace(cut, move_joint_axis_to_intersection=moves)
         folder = f"submodels/{entry.name}"
-        if folder in written:
+        if folder in self.written:
             self.ctx.sink.error(entry.value_span("name"), "E0503", f"two submodels would write {folder}",
-                                notes=((written[folder].span, "the other submodel"),))
+                                notes=((self.written[folder].span, "the other submodel"),))
             return []
-        written[folder] = cut
+        self.written[folder] = cut
         out: list[Export] = [cut]
         nested = entry.export_config
         if nested is None:
@@ -223,7 +222,7 @@ class _Exports:
                 out.append(UrdfExport(mesh_format="input_type", span=entry.span, submodel=entry.name,
                                       filename=entry.filename or ""))
         for inner in nested:
-            out.extend(self.export(inner, written, entry.filename or entry.name, submodel=entry.name,
+            out.extend(self.export(inner, entry.filename or entry.name, submodel=entry.name,
                                    inherited=entry.export_config is None))
         return out
 
