@@ -16,11 +16,9 @@ from pathlib import Path
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
 from mpc.core.files import confined
-from mpc.ir.program import JOINT_SELECTIONS, JointLimitsExport
+from mpc.ir.program import JointLimitsExport
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first
-
-SELECTIONS = JOINT_SELECTIONS
 
 
 def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:

@@ -39,7 +39,7 @@ def run_tools(folder: Path, robot: str, settings: dict[str, Any], export: KccdEx
     if not cfg.is_file():
         sink.error(export.span, "E0520", f"urdf2kccd did not write {export.dirname}/{robot}.cfg")
         return
-    text = _configured(cfg.read_text(encoding="utf-8"), settings, export, folder, sink)
+    text = configured(cfg.read_text(encoding="utf-8"), settings, export, folder, sink)
     if text is None:
         return
     write_path(cfg, text)
@@ -65,7 +65,7 @@ def _run(export: KccdExport, command: list[str], folder: Path, sink: Sink) -> st
     return done.stdout
 
 
-def _configured(cfg: str, settings: dict[str, Any], export: KccdExport, folder: Path,
+def configured(cfg: str, settings: dict[str, Any], export: KccdExport, folder: Path,
                 sink: Sink) -> str | None:
     """urdf2kccd's `.cfg` with the settings written in, block by block (blank-line separated)."""
     n_points = {b["link"]: b["n_points"] for b in settings["bodies"]}

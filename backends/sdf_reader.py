@@ -21,13 +21,13 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from mpc.backends.packages import PackageResolver
 from mpc.backends.xml import XmlSource, load, parse_floats
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.fragments import Fragment, FragmentRef
-from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere, mesh_source
 from mpc.ir.kinematics import matrix_pose, pose_matrix
 from mpc.ir.robot import (
     Collision,
@@ -488,8 +488,8 @@ class _Reader:
             uri_el = s.find("uri")
             uri = (uri_el.text or "").strip()
             # model://NAME/… is found as package://NAME/… is (Gazebo searches its model path).
-            found = self.resolver.resolve("package://" + uri[8:] if uri.startswith("model://") else uri,
-                                          self.base_dir)
+            found = mesh_source(self.resolver, "package://" + uri[8:] if uri.startswith("model://") else uri,
+                                self.base_dir)
             if found.path is not None and (why := self.resolver.refusal(found.path, self.base_dir)):
                 self.error(uri_el, "E0650", f"mesh '{uri}' in {where} is not read: {why}")
                 return None

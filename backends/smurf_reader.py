@@ -21,7 +21,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from mpc.backends.packages import PackageResolver
 from mpc.backends.smurf_forms import (
     MATERIAL_COLOURS,
     MATERIAL_SCALARS,
@@ -36,6 +35,7 @@ from mpc.backends.smurf_forms import (
 )
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.packages import PackageResolver
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.robot import Material, Pose, Robot
 

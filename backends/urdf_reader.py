@@ -12,12 +12,12 @@ from pathlib import Path
 
 from lxml import etree
 
-from mpc.backends.packages import PackageResolver
 from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
-from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere, mesh_source
 from mpc.ir.robot import (
     JOINT_TYPES,
     Calibration,
@@ -332,7 +332,7 @@ class _Reader:
                 self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
                 return None
             scale = self.floats(shape, "scale", 3, where)
-            source = self.resolver.resolve(uri, self.base_dir)
+            source = mesh_source(self.resolver, uri, self.base_dir)
             if source.path is not None and (why := self.resolver.refusal(source.path, self.base_dir)):
                 self.error(shape, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
                 return None

@@ -22,8 +22,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from mpc.backends.packages import PackageResolver
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.robot import Robot
 
@@ -143,10 +143,10 @@ def _resolving(resolver: PackageResolver, near: Path) -> Iterator[None]:
 
     def absolute(spec: str) -> Any:
         if spec.startswith("package://"):
-            source = resolver.resolve(spec, near)
-            if source.path is None:
-                raise xacro.XacroException(f"include '{spec}': {source.unresolved}")
-            return str(source.path)
+            path, unresolved = resolver.locate(spec, near)
+            if path is None:
+                raise xacro.XacroException(f"include '{spec}': {unresolved}")
+            return str(path)
         return original_abs(spec)
 
     saved = substitution_args._eval_find, xacro.abs_filename_spec, list(xacro.all_includes)

@@ -14,7 +14,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
+from mpc.core.packages import PackageResolver
 
 
 def main() -> None:

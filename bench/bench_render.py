@@ -10,11 +10,11 @@ import os
 import tempfile
 import time
 
-from mpc.backends.packages import PackageResolver
 from mpc.backends.render import draw_all
 from mpc.backends.urdf_reader import read
 from mpc.checks import pictures
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.program import RenderExport, Tolerances
 

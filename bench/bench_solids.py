@@ -11,12 +11,13 @@ import statistics
 import sys
 import time
 
-from mpc.backends.packages import PackageResolver
 from mpc.backends.urdf_reader import read
-from mpc.checks.validity import _validity, findings
+from mpc.checks.validity import findings, geometric_problems
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.ir.kinematics import link_in_root, pose_matrix
-from mpc.ir.solids import solid, union
+from mpc.ir.mesh_props import solid
+from mpc.ir.solids import union
 
 MODELS = ("talos_data/robots/talos_full_v2.urdf", "ur_description/urdf/ur5_robot.urdf",
           "solo_description/robots/solo12.urdf")
@@ -37,7 +38,7 @@ def main(runs: int = 3) -> None:
     for model in MODELS:
         robot = read(erd / "robots" / model, Sink())
         assert robot is not None
-        before = _median(lambda r=robot: _validity(r, 0.003), runs)
+        before = _median(lambda r=robot: geometric_problems(r, 0.003), runs)
         after = _median(lambda r=robot: findings(r, 0.003), runs)
         print(f"{model}: {len(robot.links)} links, physical_validity {before:.2f} s, "
               f"with plausibility {after:.2f} s (median of {runs})")

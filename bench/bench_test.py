@@ -12,10 +12,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
 from mpc.checks import run_model_tests
 from mpc.compiler.driver import Options, compile_model
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 
 TESTS = """\
       - process_double_check

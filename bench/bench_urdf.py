@@ -12,8 +12,8 @@ import sys
 import time
 
 from mpc.backends import urdf
-from mpc.backends.packages import PackageResolver
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.ir.geometry import Mesh
 
 

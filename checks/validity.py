@@ -89,7 +89,7 @@ def findings(robot: Robot, distance: float, density: tuple[float, float] = DENSI
              factor: float = FACTOR) -> list[tuple[str, str, str]]:
     """(link, diagnostic code, problem) for every finding, in link order: W0701's, then the
     plausibility ones."""
-    out = [(link, "W0701", problem) for link, problem in _validity(robot, distance)]
+    out = [(link, "W0701", problem) for link, problem in geometric_problems(robot, distance)]
     for name in sorted(robot.links):
         out += [(name, code, problem) for code, problem in plausibility(robot, name, density, factor)]
     return out
@@ -105,8 +105,8 @@ def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: 
     inertial = link.inertial
     if inertial is None or inertial.mass <= 0 or not link.collisions:
         return []
-    from mpc.ir.mesh_props import MeshError
-    from mpc.ir.solids import principal, solid, union
+    from mpc.ir.mesh_props import MeshError, solid
+    from mpc.ir.solids import principal, union
 
     try:
         whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in link.collisions])
@@ -132,7 +132,7 @@ def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: 
     return out
 
 
-def _validity(robot: Robot, distance: float) -> list[tuple[str, str]]:
+def geometric_problems(robot: Robot, distance: float) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     children = child_joints(robot)
 

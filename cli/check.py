@@ -6,9 +6,12 @@ then goes through the driver's front end without the pipeline's modules being im
 
 from __future__ import annotations
 
+import argparse
+import sys
 from dataclasses import replace
 from pathlib import Path
 
+from mpc.cli.output import print_diagnostics, resolver_of, sink_of, summary
 from mpc.compiler import driver
 from mpc.compiler.inputs import Options
 from mpc.core import yaml_source as source
@@ -37,3 +40,16 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
             model, sink, replace(options, defaults=defaults)))
         return
     driver.check_file(path, sink, options, doc)
+
+
+def run(args: argparse.Namespace) -> int:
+    """`mpc check FILE…`: 1 when a file has errors."""
+    sink = sink_of(args)
+    options = Options(resolver=resolver_of(args))
+    for path in args.files:
+        check_file(path, sink, options)
+    print_diagnostics(sink, args.format)
+    if args.format == "human" and sink.diagnostics:
+        print(f"{summary(sink)} in {len(args.files)} file"
+              f"{'s' * (len(args.files) != 1)}", file=sys.stderr)
+    return 1 if sink.has_errors() else 0

@@ -1,4 +1,4 @@
-"""The `mpc` command: argument parsing, rendering diagnostics, exit codes.
+"""The `mpc` command: argument parsing, dispatch to one module per subcommand (COMMANDS), exit codes.
 
 Exit status: 0 success, 1 the input has errors, 2 the command line is wrong,
 3 mpc itself failed (a bug: please report it; MPC_DEBUG=1 shows the traceback).
@@ -7,16 +7,16 @@ Exit status: 0 success, 1 the input has errors, 2 the command line is wrong,
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import os
 import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-# The rest of mpc is imported by the command that needs it: `mpc check` turns off the cyclic
-# garbage collector first (see _check), and no command pays for another's imports.
-if TYPE_CHECKING:
-    from mpc.core.diagnostics import Sink
+# The rest of mpc is imported by the command that needs it (COMMANDS): `mpc check` turns off
+# the cyclic garbage collector first (_without_cyclic_gc), and no command pays for another's
+# imports.
 
 
 def _package(text: str) -> tuple[str, Path]:
@@ -126,156 +126,36 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _sink(args: argparse.Namespace) -> Sink:
-    from mpc.core.diagnostics import Sink
-
-    return Sink(werror=args.werror)
-
-
-def _summary(sink: Sink) -> str:
-    """"2 errors, 1 warning"."""
-    from mpc.core import render
-
-    return render.summary(sink.diagnostics)
+# The module of each subcommand and its function of the parsed arguments (→ exit status).
+COMMANDS: dict[str, tuple[str, str]] = {
+    "compile": ("mpc.cli.compile", "run"), "check": ("mpc.cli.check", "run"),
+    "schema": ("mpc.cli.schema", "run"), "test": ("mpc.cli.test", "run"),
+    "deploy": ("mpc.cli.deploy", "run"), "run": ("mpc.cli.run", "run"), "ci": ("mpc.cli.run", "ci"),
+    "view": ("mpc.cli.view", "run"),
+}
 
 
-def print_diagnostics(sink: Sink, fmt: str) -> None:
-    from mpc.core import render
+def _command(name: str) -> Callable[[argparse.Namespace], int]:
+    """The subcommand's function, its module imported only now (no command pays for another's
+    imports)."""
+    import importlib
 
-    render.print_diagnostics(sink.diagnostics, fmt)
-
-
-def _compile(args: argparse.Namespace) -> int:
-    from mpc.backends.packages import PackageResolver
-    from mpc.compiler.driver import Options, compile_model
-
-    sink = _sink(args)
-    options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
-    if args.emit in ("ir", "ir-lowered"):
-        from mpc.compiler.driver import load_program
-        from mpc.ir.text import dump
-
-        program = load_program(args.definition, sink, options, passes=args.emit == "ir")
-        print_diagnostics(sink, args.format)
-        if program is None:
-            return 1
-        sys.stdout.write(dump(program))
-        return 0
-    result = compile_model(args.definition, sink, options)
-    print_diagnostics(sink, args.format)
-    if result.out is None:
-        if args.format == "human":
-            print(f"error: could not compile '{args.definition}' ({_summary(sink)})",
-                  file=sys.stderr)
-        return 1
-    files = sorted(str(p.relative_to(result.out)) for p in result.out.rglob("*") if p.is_file())
-    models = [f for f in files if "meshes" not in Path(f).parts]
-    print(f"compiled '{args.definition}' into '{result.out}': {', '.join(models)} "
-          f"and {len(files) - len(models)} mesh files")
-    return 0
+    module, function = COMMANDS[name]
+    return getattr(importlib.import_module(module), function)
 
 
-def _check(args: argparse.Namespace) -> int:
-    # `mpc check` is short-lived and reference counting frees its garbage; collecting cycles
-    # among the tens of thousands of objects its imports create costs ~15 ms for nothing.
+@contextlib.contextmanager
+def _without_cyclic_gc(command: str) -> Iterator[None]:
+    """`mpc check` is short-lived and reference counting frees its garbage; collecting cycles
+    among the tens of thousands of objects its imports create costs ~15 ms for nothing."""
     enabled = gc.isenabled()
-    gc.disable()
+    if command == "check":
+        gc.disable()
     try:
-        return _check_files(args)
+        yield
     finally:
         if enabled:
             gc.enable()
-
-
-def _check_files(args: argparse.Namespace) -> int:
-    from mpc.backends.packages import PackageResolver
-    from mpc.cli.check import check_file
-    from mpc.compiler.inputs import Options
-
-    sink = _sink(args)
-    options = Options(resolver=PackageResolver(package_map=dict(args.package)))
-    for path in args.files:
-        check_file(path, sink, options)
-    print_diagnostics(sink, args.format)
-    if args.format == "human" and sink.diagnostics:
-        print(f"{_summary(sink)} in {len(args.files)} file"
-              f"{'s' * (len(args.files) != 1)}", file=sys.stderr)
-    return 1 if sink.has_errors() else 0
-
-
-def _schema(args: argparse.Namespace) -> int:
-    from mpc.compiler.jsonschema import render as render_schema
-
-    text = render_schema()
-    if args.out is None or str(args.out) == "-":
-        sys.stdout.write(text)
-    else:
-        from mpc.core.files import write_atomic
-
-        write_atomic(args.out, text)
-        print(f"wrote {args.out}")
-    return 0
-
-
-def _deploy(args: argparse.Namespace) -> int:
-    from mpc.cli.deploy import run
-
-    return run(args)
-
-
-def _test(args: argparse.Namespace) -> int:
-    """Compile (unless --built names an output), run the model tests, write the protocol into
-    the output folder and print its Markdown; 1 when a test failed and was not waived."""
-    import tempfile
-
-    from mpc.backends.packages import PackageResolver
-    from mpc.checks import run_model_tests
-    from mpc.compiler.driver import Options, apply, compile_model, input_loader, load_program
-
-    sink = _sink(args)
-    options = Options(out=args.out, resolver=PackageResolver(package_map=dict(args.package)))
-    if args.built is not None:
-        loader = input_loader(sink, options, (args.definition.resolve(),))
-        program = load_program(args.definition, sink, options, loader=loader)
-        robot = apply(program, sink, loader) if program is not None else None
-        out = args.built
-        if program is not None and not out.is_dir():
-            print(f"error: --built '{out}' is not a folder", file=sys.stderr)
-            return 1
-    else:
-        result = compile_model(args.definition, sink, options)
-        program, robot, out = result.program, result.robot, result.out  # type: ignore[assignment]
-    if program is None or robot is None or out is None:
-        print_diagnostics(sink, args.format)
-        print(f"error: could not compile '{args.definition}' ({_summary(sink)})",
-              file=sys.stderr)
-        return 1
-    with tempfile.TemporaryDirectory(prefix="mpc-test-") as work:
-        protocol = run_model_tests(program, out, sink, workdir=Path(work), robot=robot)
-    target = args.out if args.built is not None and args.out is not None else out  # -o with --built
-    print_diagnostics(sink, args.format)
-    print(protocol.markdown())
-    try:
-        protocol.write(target)
-    except OSError as e:
-        print(f"error: cannot write the test protocol into '{target}': {e.strerror or e}", file=sys.stderr)
-        return 1
-    print(f"wrote {target / 'test_protocol.md'}, test_protocol.json and test_protocol.junit.xml",
-          file=sys.stderr)
-    return 1 if protocol.failed else 0
-
-
-def _view(args: argparse.Namespace) -> int:
-    from mpc.cli.view import run
-
-    return run(args)
-
-
-def _pipeline(args: argparse.Namespace) -> int:
-    """`mpc run` and `mpc ci` (cli/run.py)."""
-    from mpc.cli import run as command
-
-    return command.run(args) if args.command == "run" else command.ci(args)
 
 
 def _json_on_stdout(args: argparse.Namespace) -> bool:
@@ -287,15 +167,15 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    command = {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
-               "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command]
     try:
-        if _json_on_stdout(args):
-            from mpc.core.render import json_document
+        with _without_cyclic_gc(args.command):
+            command = _command(args.command)
+            if _json_on_stdout(args):
+                from mpc.core.render import json_document
 
-            with json_document():
-                return command(args)
-        return command(args)
+                with json_document():
+                    return command(args)
+            return command(args)
     except KeyboardInterrupt:
         return 130
     except OSError as e:  # the disk, not mpc: what no phase reported with its own code

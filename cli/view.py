@@ -36,8 +36,8 @@ def load_model(path: Path, sink: Sink, package: dict[str, Path] | None = None) -
         sink.error(Span.of_file(str(path)), "E0690", f"'{path}' is neither a model definition nor a "
                    "built folder")
         return None
-    from mpc.backends.packages import PackageResolver
     from mpc.compiler.driver import InputLoader, Options, apply, load_program
+    from mpc.core.packages import PackageResolver
 
     options = Options(resolver=PackageResolver(package_map=dict(package or {})))
     loader = InputLoader(sink, options, (path.resolve(),))

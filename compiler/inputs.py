@@ -11,9 +11,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink
+from mpc.core.packages import PackageResolver
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 from mpc.ir.robot import Robot

@@ -7,17 +7,15 @@ The names it gives (joints, links) are checked against the robot when it is writ
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from mpc.compiler.lower_context import LowerContext
 from mpc.ir.program import Export, KccdExport
-
-if TYPE_CHECKING:
-    from mpc.compiler.lower import Lowering
 
 KCCD_SHAPES = ("box", "cylinder", "sphere", "convex")
 
 
-def lower_kccd(low: Lowering, entry: Any, written: dict[str, Export], submodel: str) -> list[Export]:
+def lower_kccd(low: LowerContext, entry: Any, written: dict[str, Export], submodel: str) -> list[Export]:
     """A `kccd` entry: its numbers evaluated and its per-link settings checked; the names
     it gives are checked against the robot when it is written (backends/kccd.py)."""
     parts = Path(entry.dirname).parts

@@ -68,7 +68,7 @@ def confined(root: Path, *names: str) -> Path:
 
 def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
     """The folders whose files inputs may link to, resolved (the definitions' folders,
-    --package roots, the package search path, a checkout: backends/packages.py names them)."""
+    --package roots, the package search path, a checkout: core/packages.py names them)."""
     return tuple(dict.fromkeys(Path(f).resolve() for f in folders))
 
 

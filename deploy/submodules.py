@@ -106,10 +106,10 @@ def write_files(p: Pinned, folder: Path) -> None:
         except GitFailed as e:
             raise DeployError("E0803", f"git archive failed in '{p.cache}': {e.message}") from None
         with tarfile.open(archive) as tar:
-            _extract_data(tar, folder)
+            extract_data(tar, folder)
 
 
-def _extract_data(tar: tarfile.TarFile, folder: Path) -> None:
+def extract_data(tar: tarfile.TarFile, folder: Path) -> None:
     """Extract with tarfile's "data" filter: nothing lands or links outside `folder`, and only
     files, folders and links are made. The filter exists from Python 3.11.4 on; Debian 12's
     python3 is 3.11.2, where the same rules are applied here (TarError when one is broken)."""

@@ -11,13 +11,13 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import io
+from collections.abc import Callable
 
 import numpy as np
 import trimesh
 
 from mpc.core.cache import cache_dir, load_entry, remove_entry, store_entry, touch_entry
 from mpc.ir.geometry import Mesh
-from mpc.ir.mesh_props import as_trimesh
 
 THRESHOLD = 0.05  # coacd's concavity threshold: smaller is finer (and slower)
 MAX_PARTS = 16  # a bound on the parts (collisions) one mesh becomes
@@ -29,8 +29,9 @@ def _key(mesh: Mesh) -> str:
     return h.hexdigest()
 
 
-def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
-    """The convex parts of `mesh` (scaled, with its ops), computed once.
+def parts(mesh: Mesh, build: Callable[[Mesh], trimesh.Trimesh]) -> list[trimesh.Trimesh]:
+    """The convex parts of `mesh` (scaled, with its ops), computed once; `build` makes the
+    mesh's triangles (ir/mesh_props.as_trimesh), called only when the cache has no entry.
 
     A damaged cache entry (core/cache.py checks its hash) is removed and computed
     again; a cache that cannot be written only costs the time of computing again.
@@ -50,7 +51,7 @@ def parts(mesh: Mesh) -> list[trimesh.Trimesh]:
     import coacd
 
     coacd.set_log_level("error")
-    shape = as_trimesh(mesh)
+    shape = build(mesh)
     shape.merge_vertices()  # STL files repeat each vertex per face; coacd wants a connected surface
     result = coacd.run_coacd(coacd.Mesh(shape.vertices, shape.faces), threshold=THRESHOLD, seed=0,
                              max_convex_hull=MAX_PARTS)

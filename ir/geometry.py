@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from mpc.core.packages import PackageResolver
 from mpc.core.record import record
 from mpc.core.span import Span
 
@@ -59,6 +60,12 @@ class MeshSource:
         """The file format by extension, lower case without the dot ("stl", "dae", …)."""
         name = self.path.name if self.path is not None else self.uri
         return name.rsplit(".", 1)[-1].lower() if "." in name else ""
+
+
+def mesh_source(resolver: PackageResolver, uri: str, base_dir: Path) -> MeshSource:
+    """The MeshSource of a filename written in a model file in `base_dir`."""
+    path, unresolved = resolver.locate(uri, base_dir)
+    return MeshSource(uri=uri, path=path, unresolved=unresolved)
 
 
 @record(slots=True)

@@ -18,6 +18,7 @@ import numpy as np
 
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
+from mpc.ir import refs as declared
 from mpc.ir.kinematics import links_in_root, matrix_pose, pose_matrix
 from mpc.ir.ops import Effects
 from mpc.ir.ops.joints import RemoveJoint
@@ -83,20 +84,18 @@ def merge_joints(robot: Robot, names: Iterable[str], sink: Sink, span: Span) -> 
             cut = replace(cut, parent=survivor(cut.parent), child=survivor(cut.child),
                           origin=matrix_pose(X_PC))
         cut_joints[name] = cut
+    def removed(kind: str, name: str) -> bool:
+        return kind == "joint" and name in gone
+
+    def kept(kind: str, name: str) -> bool:
+        return not removed(kind, name)
+
+    submechanisms = [declared.pruned(sm, removed, "definition") for sm in merged.submechanisms]
     return replace(
         merged,
-        motors={n: m for n, m in merged.motors.items() if m.joint not in gone},
+        motors={n: m for n, m in merged.motors.items() if declared.names_only(m, kept)},
         poses={n: {j: v for j, v in p.items() if j not in gone} for n, p in merged.poses.items()},
         sensors=sensors, cut_joints=cut_joints,
-        submechanisms=tuple(s for s in (_without(sm, gone) for sm in merged.submechanisms) if s is not None))
-
-
-def _without(sm: Any, gone: set[str]) -> Any:
-    """The submechanism without the joints in `gone`; None when none of its joints is left."""
-    definition = dict(sm.definition)
-    left = False
-    for key, value in sm.definition.items():
-        if key.startswith("jointnames") and isinstance(value, list | tuple):
-            definition[key] = [j for j in value if str(j) not in gone]
-            left = left or bool(definition[key])
-    return replace(sm, definition=definition) if left else None
+        # A submechanism left without joints goes.
+        submechanisms=tuple(sm for sm in submechanisms
+                            if any(ref.kinds == ("joint",) for ref, _, _ in declared.refs(sm))))

@@ -1,7 +1,13 @@
-"""Shapes as triangle meshes (trimesh), for the ops that need geometry: bounding
-primitives, and the meshes ir/solids.py makes solids of. Imported only by those ops."""
+"""Shapes as triangle meshes (trimesh) and as solids, for the ops that need geometry: bounding
+primitives, and the meshes ir/solids.py makes solids of. Imported only by those ops.
+
+The one recursive evaluation of a shape's mesh ops: a convex part needs the shape before it
+(ir/decompose.py) and a solid join needs its parts' solids (ir/solids.py); both of those
+modules work on meshes given to them and import nothing of this one."""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
@@ -20,6 +26,9 @@ from mpc.ir.geometry import (
     ScaleMesh,
     Sphere,
 )
+
+if TYPE_CHECKING:
+    from mpc.ir.solids import Solid
 
 
 class MeshError(Exception):
@@ -64,7 +73,8 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
         if isinstance(op, ConvexPart):
             from mpc.ir.decompose import parts
 
-            mesh = parts(Mesh(source=geometry.source, scale=op.scale, ops=geometry.ops[:n]))[op.index]
+            before = Mesh(source=geometry.source, scale=op.scale, ops=geometry.ops[:n])
+            mesh = parts(before, as_trimesh)[op.index]
             continue
         if isinstance(op, ReflectMesh):
             T = np.eye(4)
@@ -82,7 +92,7 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
         elif isinstance(op, ScaleMesh):
             mesh.apply_scale(np.asarray(op.scale))
         elif isinstance(op, JoinShapes) and op.solid:
-            from mpc.ir.solids import solid, to_trimesh, union
+            from mpc.ir.solids import to_trimesh, union
 
             mesh = to_trimesh(union([(solid(shape), tf.pose_to_matrix(xyz, rpy))
                                      for shape, xyz, rpy in op.parts]).manifold)
@@ -140,3 +150,18 @@ def scaled(shape: Geometry, factor: float) -> Geometry:
     assert isinstance(shape, Sphere)
     return Sphere(radius=factor * shape.radius)
 
+
+
+def solid(geometry: Geometry) -> Solid:
+    """The shape (with its mesh ops and scale) as a solid (ir/solids.py); MeshError when its
+    file cannot be read or its vertices are not finite numbers."""
+    from mpc.ir.solids import mesh_name, solid_of_mesh, solid_of_primitive
+
+    if isinstance(geometry, Box | Cylinder | Sphere):
+        return solid_of_primitive(geometry)
+    assert isinstance(geometry, Mesh)
+    mesh = as_trimesh(geometry)  # a negative scale reflects; trimesh turns the triangles back out
+    try:
+        return solid_of_mesh(mesh, mesh_name(geometry))
+    except ValueError as e:
+        raise MeshError(str(e)) from None

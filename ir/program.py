@@ -14,6 +14,7 @@ from typing import Literal
 from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.ops import Op
+from mpc.ir.refs import JointRef, LinkRef
 
 
 @record(slots=True, kw_only=True)
@@ -223,7 +224,7 @@ class SubmodelExport(ExportEntry):
 
     span: Span
     name: str
-    start: str = ""
+    start: LinkRef = ""
     stop: tuple[str, ...] = ()
     include_unstopped_branches: bool = False
     add_floating_base: bool = False
@@ -231,7 +232,7 @@ class SubmodelExport(ExportEntry):
     remove_fixed: bool = False
     abstract_model: bool = False
     no_submechanisms: bool = False
-    move_joint_axis_to_intersection: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    move_joint_axis_to_intersection: Mapping[JointRef, tuple[JointRef, ...]] = field(default_factory=dict)
     name_replacements: tuple[tuple[str, str], ...] = ()
     type: Literal["submodel"] = "submodel"
 
@@ -314,21 +315,21 @@ class KccdExport(ExportEntry):
     span: Span
     dirname: str = "kccd"
     join_before_convexhull: bool = True
-    remove_joints: tuple[str, ...] = ()
-    merge_additionally: tuple[str, ...] = ()
+    remove_joints: tuple[JointRef, ...] = ()
+    merge_additionally: tuple[JointRef, ...] = ()
     keep_stls: bool = False
     keep_urdf: bool = False
     reduce_faces: int = 0
     reduce_ratio: float = 0.0
-    n_points: Mapping[str, int] = field(default_factory=dict)
-    shapes: Mapping[str, str] = field(default_factory=dict)
+    n_points: Mapping[LinkRef, int] = field(default_factory=dict)
+    shapes: Mapping[LinkRef, str] = field(default_factory=dict)
     braking_model: tuple[float, ...] = ()
-    simplify_swept_from: tuple[str, ...] = ()
+    simplify_swept_from: tuple[LinkRef, ...] = ()
     safety_distance: float = 0.0
     report_up_to: float = 0.0
     computation_budget: float = -1.0
     max_approximation_order: int = 1
-    no_collision_between: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    no_collision_between: Mapping[LinkRef, tuple[LinkRef, ...]] = field(default_factory=dict)
     add_floating_base: bool = False
     submodel: str = ""
     type: Literal["kccd"] = "kccd"
@@ -394,12 +395,12 @@ class ModelTest:
     name: str
     span: Span
     dynamics: bool = False
-    links: tuple[str, ...] = ()
+    links: tuple[LinkRef, ...] = ()
     value: float | None = None
     plane: tuple[float, float, float] = (0.0, 1.0, 0.0)
     angle: float | None = None
     angles: tuple[float, ...] = ()
-    joint_angles: Mapping[str, float] | None = None
+    joint_angles: Mapping[JointRef, float] | None = None
     as_error: bool = False
     density: tuple[float, float] = DENSITY
     inertia_factor: float = FACTOR

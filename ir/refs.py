@@ -8,10 +8,14 @@ The declarations are read from the annotation text (the IR modules use
 `from __future__ import annotations`), without typing.get_type_hints: `mpc check` imports
 the IR on every editor save, and resolving hints is slow.
 
+Free data (annotations, submechanism definitions as written) has no types: FREE_DATA declares
+the keys in it that the SMURF is known to hold names under, by a path pattern per record field.
+
 `refs(obj)` lists what a record names (op `reads()`, name checks), `renamed(obj, rename)` gives
-the record with every declared reference passed through `rename(kinds, name)` (ir/rename.py).
-What this does not do: decide what a name means (that is the op's), or look into free data
-(annotations, submechanism definitions as written), which declare nothing.
+the record with every declared reference passed through `rename(kinds, name)` (ir/rename.py),
+`pruned(obj, gone)` the record without the references in sequences that name what is gone, and
+`names_only(obj, kept)` whether everything a record uses is kept (cutting, merging). What this
+does not do: decide what a name means (that is the op's).
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import dataclasses
 import re
 import sys
 from collections.abc import Callable, Iterator, Mapping
+from fnmatch import fnmatchcase
 from typing import Annotated, Any
 
 
@@ -54,11 +59,21 @@ SensorName = Annotated[str, Ref(("sensor",), defines=True)]
 PoseName = Annotated[str, Ref(("pose",), defines=True)]
 SubmechanismName = Annotated[str, Ref(("submechanism",), defines=True)]
 
+# Names in free data: (record class, field) → (path pattern, declaration) pairs. A pattern's
+# parts match keys or item positions as fnmatch does (`*` any, `jointnames*` every key so begun).
+FREE_DATA: dict[tuple[str, str], tuple[tuple[str, Ref], ...]] = {
+    ("Submechanism", "definition"): (("jointnames*/*", Ref(("joint",))), ("around", Ref(("link",))),
+                                     ("loop_constraints/*/*_body", Ref(("link",)))),
+    ("Joint", "annotations"): (("movement_depends_on/*/joint_name", Ref(("joint",))),),
+    ("Robot", "annotations"): (("self_collision/may_collide/*/*", Ref(("link",))),),
+}
+
 ALIASES: dict[str, Ref] = {name: value.__metadata__[0] for name, value in dict(globals()).items()
                            if name.endswith(("Ref", "Name")) and hasattr(value, "__metadata__")}
 
 # A field's shape, parsed from its annotation: ("ref", Ref) | ("record",) | ("seq", shape) |
-# ("map", key shape, value shape) | ("opt", shape); None: nothing declared in it.
+# ("map", key shape, value shape) | ("opt", shape) | ("free", ((pattern parts, Ref), …)) for
+# free data (FREE_DATA); None: nothing declared in it.
 Shape = tuple[Any, ...] | None
 Rename = Callable[[tuple[str, ...], str], str]  # (the kinds it may be, name) → new name
 
@@ -121,10 +136,27 @@ def shapes(cls: type) -> tuple[tuple[str, Shape], ...]:
     if found is None:
         module = vars(sys.modules[cls.__module__])
         found = tuple((f.name, shape) for f in dataclasses.fields(cls)
-                      if (shape := _parse(f.type if isinstance(f.type, str) else f.type.__name__, module))
+                      if (shape := _free((cls.__name__, f.name))
+                          or _parse(f.type if isinstance(f.type, str) else f.type.__name__, module))
                       is not None)
         _SHAPES[cls] = found
     return found
+
+
+def _free(field: tuple[str, str]) -> Shape:
+    patterns = FREE_DATA.get(field)
+    if not patterns:
+        return None
+    return ("free", tuple((tuple(pattern.split("/")), ref) for pattern, ref in patterns))
+
+
+def _children(value: Any) -> list[tuple[Any, Any]]:
+    """(key or position, item) of a mapping or sequence in free data; [] for anything else."""
+    if isinstance(value, Mapping):
+        return list(value.items())
+    if isinstance(value, list | tuple):
+        return list(enumerate(value))
+    return []
 
 
 def refs(obj: Any, path: str = "") -> Iterator[tuple[Ref, str, str]]:
@@ -141,6 +173,9 @@ def _refs(value: Any, shape: Shape, path: str) -> Iterator[tuple[Ref, str, str]]
     if tag == "ref":
         if isinstance(value, str) and value:  # "" names nothing (a default: none, or all)
             yield shape[1], value, path
+    elif tag == "free":
+        for parts, ref in shape[1]:
+            yield from _free_refs(value, parts, ref, path)
     elif tag == "opt":
         yield from _refs(value, shape[1], path)
     elif tag == "seq":
@@ -158,6 +193,16 @@ def _refs(value: Any, shape: Shape, path: str) -> Iterator[tuple[Ref, str, str]]
     elif isinstance(value, Mapping):
         for key, item in value.items():
             yield from _refs(item, shape, f"{path}/{key}")
+
+
+def _free_refs(value: Any, parts: tuple[str, ...], ref: Ref, path: str) -> Iterator[tuple[Ref, str, str]]:
+    if not parts:
+        if isinstance(value, str) and value:
+            yield ref, value, path
+        return
+    for key, item in _children(value):
+        if fnmatchcase(str(key), parts[0]):
+            yield from _free_refs(item, parts[1:], ref, f"{path}/{key}")
 
 
 def renamed(obj: Any, rename: Rename, only: tuple[str, ...] = ()) -> Any:
@@ -183,6 +228,10 @@ def _renamed(value: Any, shape: Shape, rename: Rename) -> Any:
             return value
         new = rename(shape[1].kinds, value)
         return value if new == value else new
+    if tag == "free":
+        for parts, ref in shape[1]:
+            value = _free_map(value, parts, lambda name, ref=ref: rename(ref.kinds, name))
+        return value
     if tag == "opt":
         return _renamed(value, shape[1], rename)
     if tag == "seq":
@@ -203,3 +252,61 @@ def _renamed(value: Any, shape: Shape, rename: Rename) -> Any:
         return value if same else dict(pairs)
     return value
 
+
+
+_DROPPED = object()  # what _free_map's `changed` gives for a name dropped from its list
+
+
+def _free_map(value: Any, parts: tuple[str, ...], change: Callable[[str], str | None]) -> Any:
+    """Free data with each name at `parts` changed (None: the name is dropped from its list;
+    elsewhere it stays); the same object where nothing changed."""
+    if not parts:
+        return value
+    last = len(parts) == 1
+
+    def changed(item: Any) -> Any:
+        if not last:
+            return _free_map(item, parts[1:], change)
+        if not isinstance(item, str) or not item:
+            return item
+        new = change(item)
+        return _DROPPED if new is None else item if new == item else new
+
+    if isinstance(value, Mapping):
+        out = {k: changed(v) if fnmatchcase(str(k), parts[0]) else v for k, v in value.items()}
+        if all(out[k] is v for k, v in value.items()):
+            return value
+        return {k: (value[k] if v is _DROPPED else v) for k, v in out.items()}  # a value is not dropped
+    if isinstance(value, list | tuple):
+        items = [changed(v) if fnmatchcase(str(i), parts[0]) else v for i, v in enumerate(value)]
+        if all(a is b for a, b in zip(items, value, strict=True)):
+            return value
+        return type(value)(item for item in items if item is not _DROPPED)
+    return value
+
+
+def _ref_kind(ref: Ref, name: str, joints: Any) -> str:
+    """The kind a reference names: its one kind, else a joint when `joints` has the name."""
+    return ref.kinds[0] if len(ref.kinds) == 1 or name in joints else ref.kinds[-1]
+
+
+def names_only(obj: Any, kept: Callable[[str, str], bool], joints: Any = (),
+               only: tuple[str, ...] = ()) -> bool:
+    """Whether every name the record uses (not the ones it defines) is kept: kept(kind, name).
+    joints: the joint names, for a reference that may name a joint or a link. only: these
+    fields of it (all when empty)."""
+    return all(kept(_ref_kind(ref, name, joints), name) for ref, name, path in refs(obj)
+               if not ref.defines and (not only or path.split("/", 1)[0] in only))
+
+
+def pruned(obj: Any, gone: Callable[[str, str], bool], field: str) -> Any:
+    """The record whose free data in `field` no longer lists the names that are gone:
+    gone(kind, name) (a name outside a list stays)."""
+    shape = dict(shapes(type(obj))).get(field)
+    if shape is None or shape[0] != "free":
+        return obj
+    value = old = getattr(obj, field)
+    for parts, ref in shape[1]:
+        value = _free_map(value, parts,
+                          lambda name, ref=ref: None if gone(_ref_kind(ref, name, ()), name) else name)
+    return obj if value is old else dataclasses.replace(obj, **{field: value})

@@ -1,10 +1,10 @@
 """Rename links, joints, collisions and visuals of a Robot, and every reference to them.
 
-References that follow a rename: every field typed as a reference (ir/refs.py: joint parents
-and children, mimic targets, the root, motors, sensors, poses, loop joints), the names opaque
-fragments record (gazebo references, transmission joints, plugin parameters), and the free data
-the SMURF writes (submechanisms, dependencies, self-collision pairs). Rename maps need not be
-complete: absent names stay.
+References that follow a rename: every reference ir/refs.py declares (joint parents and
+children, mimic targets, the root, motors, sensors, poses, loop joints, and the names in the
+free data the SMURF writes: submechanisms, dependencies, self-collision pairs), and the names
+opaque fragments record (gazebo references, transmission joints, plugin parameters). Rename
+maps need not be complete: absent names stay.
 """
 
 from __future__ import annotations
@@ -61,9 +61,9 @@ def rename_robot(robot: Robot, link: Rename = _same, joint: Rename = _same,
                  collision: Rename = _same, visual: Rename = _same) -> Robot:
     """`robot` with names mapped; the caller guarantees the maps create no duplicates.
 
-    Every field typed as a reference (ir/refs.py) follows: joint ends, mimics, the root, motors,
-    sensors, loop joints, poses. XML fragments and free data (submechanism definitions,
-    annotations) declare nothing and are renamed here by what they are known to hold."""
+    Every reference declared in ir/refs.py follows: joint ends, mimics, the root, motors,
+    sensors, loop joints, poses, and the names in free data (submechanism definitions, joint
+    dependencies, self-collision pairs: refs.FREE_DATA). XML fragments record their own."""
     xmlns = xmlns_of(robot)
     by_kind = {"link": link, "joint": joint, "collision": collision, "visual": visual}
 
@@ -85,46 +85,9 @@ def rename_robot(robot: Robot, link: Rename = _same, joint: Rename = _same,
     joints: dict[str, Joint] = {
         joint(name): declared.renamed(replace(item, extras=frags(item.extras)), rename)
         for name, item in robot.joints.items()}
-    renamed = declared.renamed(replace(robot, links=links, joints=joints, fragments=frags(robot.fragments)),
-                               rename, only=("root", "motors", "sensors", "cut_joints", "poses"))
-    return _follow_free_data(renamed, link, joint)
-
-
-def _follow_free_data(robot: Robot, link: Rename, joint: Rename) -> Robot:
-    """`robot` whose submechanisms, joint dependencies and self-collision pairs, free data as
-    written in the definition, name the renamed links and joints (the SMURF writes them).
-    Free annotation categories are data mpc does not interpret, and are left as they are."""
-
-    def submechanism(definition: Mapping[str, object]) -> dict[str, object]:
-        out = dict(definition)
-        for key, value in definition.items():
-            if key.startswith("jointnames") and isinstance(value, list | tuple):
-                out[key] = [joint(j) if isinstance(j, str) else j for j in value]
-            elif key == "around" and isinstance(value, str):
-                out[key] = link(value)
-            elif key == "loop_constraints" and isinstance(value, list | tuple):
-                out[key] = [{k: link(v) if k.endswith("_body") and isinstance(v, str) else v
-                             for k, v in c.items()} if isinstance(c, Mapping) else c for c in value]
-        return out
-
-    def depends(j: Joint) -> Joint:
-        deps = j.annotations.get("movement_depends_on")
-        if not isinstance(deps, list | tuple):
-            return j
-        new = [{**d, "joint_name": joint(d["joint_name"])} if isinstance(d, Mapping) and
-               isinstance(d.get("joint_name"), str) else d for d in deps]
-        return replace(j, annotations={**j.annotations, "movement_depends_on": new})
-
-    annotations = dict(robot.annotations)
-    pairs = annotations.get("self_collision", {}).get("may_collide")
-    if isinstance(pairs, list | tuple):
-        annotations["self_collision"] = {**annotations["self_collision"], "may_collide": [
-            [link(n) if isinstance(n, str) else n for n in p] if isinstance(p, list | tuple) else p
-            for p in pairs]}
-    return replace(
-        robot, joints={n: depends(j) for n, j in robot.joints.items()}, annotations=annotations,
-        submechanisms=tuple(replace(sm, definition=submechanism(sm.definition))
-                            for sm in robot.submechanisms))
+    return declared.renamed(replace(robot, links=links, joints=joints, fragments=frags(robot.fragments)),
+                            rename, only=("root", "motors", "sensors", "cut_joints", "poses", "submechanisms",
+                                          "annotations"))
 
 
 def rename_with(mapping: Mapping[str, str]) -> Rename:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from mpc.ir import refs as declared
 from mpc.ir.names import Names
 from mpc.ir.robot import Pose, Robot
 from mpc.ir.tree import joints_up
@@ -34,8 +35,11 @@ def reroot(robot: Robot, root: str) -> Robot:
     moved: dict[str, Pose] = {root: Pose()}  # A_P: each path link's new frame in its old one
     for joint in path:  # from `root` up to the old root
         moved[joint.parent] = joint.origin or Pose()
-    placed = [("loop-closure joint", c.name, {c.parent, c.child}) for c in robot.cut_joints.values()]
-    placed += [("sensor", s.name, {s.link, s.frame}) for s in robot.sensors.values()]
+    # What is placed in a link's frame: the links a loop joint or a sensor names (ir/refs.py).
+    placed = [(kind, item.name, {name for ref, name, _ in declared.refs(item)
+                                 if ref.kinds == ("link",) and not ref.defines})
+              for kind, items in (("loop-closure joint", robot.cut_joints), ("sensor", robot.sensors))
+              for item in items.values()]
     for kind, name, on in placed:
         if on & (set(moved) - {root}):
             raise RerootError(f"the {kind} '{name}' is placed in the frame of "

@@ -18,9 +18,8 @@ import numpy as np
 import trimesh
 from manifold3d import Error, Manifold, Mesh64, OpType
 
-from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.inertia import Body, combine
-from mpc.ir.mesh_props import MeshError, as_trimesh
 
 SEGMENTS = 128  # circle segments of a cylinder or sphere that overlaps another shape
 RELATIVE = 1e-9  # union volume = sum of the parts' within this: the parts do not overlap
@@ -148,24 +147,26 @@ class Solid:
     notes: list[Note] = field(default_factory=list)
 
 
-def solid(geometry: Geometry) -> Solid:
-    """The shape (with its mesh ops and scale) as a solid; mesh_props.MeshError when its file
-    cannot be read."""
+def solid_of_primitive(geometry: Box | Cylinder | Sphere) -> Solid:
+    """A primitive as a solid: exact props."""
     if isinstance(geometry, Box):
         return Solid(of_primitive(geometry), Manifold.cube(geometry.size, True))
     if isinstance(geometry, Cylinder):
         m = Manifold.cylinder(geometry.length, geometry.radius, geometry.radius, SEGMENTS, True)
         return Solid(of_primitive(geometry), m)
-    if isinstance(geometry, Sphere):
-        return Solid(of_primitive(geometry), Manifold.sphere(geometry.radius, SEGMENTS))
-    mesh = as_trimesh(geometry)  # a negative scale reflects; trimesh turns the triangles back out
+    return Solid(of_primitive(geometry), Manifold.sphere(geometry.radius, SEGMENTS))
+
+
+def solid_of_mesh(mesh: trimesh.Trimesh, name: str) -> Solid:
+    """The triangles of the mesh called `name` (with its ops and scale applied) as a solid;
+    ValueError when its vertices are not finite numbers."""
     if not np.isfinite(mesh.vertices).all():
-        raise MeshError(f"mesh '{mesh_name(geometry)}' has vertices that are not finite numbers")
+        raise ValueError(f"mesh '{name}' has vertices that are not finite numbers")
     if len(mesh.faces) == 0:
         empty = Body(0.0, np.zeros(3), np.zeros((3, 3)))
         return Solid(empty, Manifold(), closed=False,
-                     notes=[(HULL, f"mesh '{mesh_name(geometry)}' has no triangles: it adds no volume")])
-    m, notes = solid_of_trimesh(mesh, mesh_name(geometry))
+                     notes=[(HULL, f"mesh '{name}' has no triangles: it adds no volume")])
+    m, notes = solid_of_trimesh(mesh, name)
     return Solid(of_trimesh(to_trimesh(m)), m, closed=all(code != HULL for code, _ in notes), notes=notes)
 
 

@@ -197,8 +197,8 @@ class Runner:
     def options(self) -> Options:
         """Compile options of every worker (made when the first one starts: a run where all
         is cached never imports the compiler)."""
-        from mpc.backends.packages import PackageResolver
         from mpc.compiler.driver import Options
+        from mpc.core.packages import PackageResolver
 
         return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
                        defaults=self.plan.defaults)

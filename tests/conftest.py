@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-from mpc.backends.packages import PackageResolver
 from mpc.compiler.driver import Options, Result, compile_model
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.packages import PackageResolver
 
 # Property tests are bounded: a fixed number of examples and no per-example deadline (the
 # machines are shared; a slow example is not a failure). `HYPOTHESIS_PROFILE=long` digs deeper.

@@ -169,12 +169,12 @@ def _decomposed(c: Collision, link: str, effects: Effects) -> list[Collision]:
     """One collision per convex part of a mesh (coacd); primitives are convex already."""
     from mpc.ir.decompose import parts
     from mpc.ir.geometry import ConvexPart, Mesh
-    from mpc.ir.mesh_props import MeshError
+    from mpc.ir.mesh_props import MeshError, as_trimesh
 
     if not isinstance(c.geometry, Mesh):
         return [c]
     try:
-        count = len(parts(c.geometry))
+        count = len(parts(c.geometry, as_trimesh))
     except MeshError as e:
         effects.error("E0602", f"convex decomposition of a collision of link '{link}': {e}", "target")
         return [c]

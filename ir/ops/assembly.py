@@ -7,11 +7,13 @@ and attached to its parent part; after the last attach only `root` remains.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any, Literal
 
 from mpc.core.diagnostics import did_you_mean
 from mpc.core.record import record
+from mpc.ir import refs as declared
 from mpc.ir.names import Names
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix, without_link_suffix
 from mpc.ir.ops.base import Effects, Op, Phase, Ref
@@ -187,23 +189,25 @@ def keep_links(robot: Robot, kept: set[str], root: str) -> Robot:
 
 
 def _extras_kept(robot: Robot, links: set[str], joints: set[str]) -> dict[str, Any]:
-    """Motors, sensors, poses, loop joints and submechanisms that still name only what is kept."""
+    """Motors, sensors (by their link or joint), poses, loop joints and submechanisms that still
+    name only what is kept (their references as ir/refs.py declares them)."""
 
-    def sensor_kept(sensor: Any) -> bool:
-        return ((sensor.link is None or sensor.link in links)
-                and (sensor.joint is None or sensor.joint in joints))
+    def kept(kind: str, name: str) -> bool:
+        """Not one of the robot's links or joints that the cut leaves out."""
+        if kind == "link":
+            return name in links or name not in robot.links
+        return kind != "joint" or name in joints or name not in robot.joints
 
-    def submechanism_kept(sm: Any) -> bool:
-        named = {str(j) for value in sm.definition.values() if isinstance(value, list | tuple) for j in value
-                 if str(j) in robot.joints}
-        return named <= joints
+    def only_kept(items: Mapping[str, Any], only: tuple[str, ...] = ()) -> dict[str, Any]:
+        return {n: x for n, x in items.items() if declared.names_only(x, kept, robot.joints, only)}
 
     return {
-        "motors": {n: m for n, m in robot.motors.items() if m.joint in joints},
-        "sensors": {n: s for n, s in robot.sensors.items() if sensor_kept(s)},
+        "motors": only_kept(robot.motors),
+        "sensors": only_kept(robot.sensors, only=("link", "joint")),
         "poses": {n: {j: v for j, v in p.items() if j in joints} for n, p in robot.poses.items()},
-        "cut_joints": {n: c for n, c in robot.cut_joints.items() if {c.parent, c.child} <= links},
-        "submechanisms": tuple(sm for sm in robot.submechanisms if submechanism_kept(sm)),
+        "cut_joints": only_kept(robot.cut_joints),
+        "submechanisms": tuple(sm for sm in robot.submechanisms
+                               if declared.names_only(sm, kept, robot.joints)),
     }
 
 

@@ -283,8 +283,8 @@ def collision_solid(op: Op, link: str, collisions: Sequence[Collision], effects:
     convex-hull stand-ins (W0580) and repaired meshes (W0581) at the op's `field`; None after
     an unreadable mesh (E0602)."""
     from mpc.ir.kinematics import pose_matrix
-    from mpc.ir.mesh_props import MeshError
-    from mpc.ir.solids import solid, union
+    from mpc.ir.mesh_props import MeshError, solid
+    from mpc.ir.solids import union
 
     try:
         whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in collisions])

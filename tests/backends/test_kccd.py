@@ -248,7 +248,7 @@ def test_the_settings_go_into_urdf2kccds_cfg(tmp_path: Path, diags: Diags) -> No
     appended to the TITLE block, the BRAKINGMODEL template filled in, OVERWRITE lines, and
     DONTCHECK lines for the pairs (named by urdf2kccd's body names). The `.cfg` here is
     shaped as Phobos's reading of it expects; kccdcoveriv is not installed (W0520)."""
-    from mpc.backends.kccd_tools import _configured
+    from mpc.backends.kccd_tools import configured
     from mpc.core.span import Span
     from mpc.ir.program import KccdExport
 
@@ -262,7 +262,7 @@ def test_the_settings_go_into_urdf2kccds_cfg(tmp_path: Path, diags: Diags) -> No
                 "order_0_joints": {"upper": ["elbow"]}, "dont_check": [["base", "upper"]],
                 "bodies": [{"link": "base", "n_points": 25}, {"link": "upper", "n_points": 8}]}
     export = KccdExport(span=Span("m.yml", 1, 1, 1, 2))
-    assert _configured(cfg, settings, export, tmp_path, diags) == """
+    assert configured(cfg, settings, export, tmp_path, diags) == """
 TITLE arm
 SAFETYDISTANCE 0.01
 REPORTUPTO 0

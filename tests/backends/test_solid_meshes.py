@@ -16,7 +16,8 @@ from lxml import etree
 from mpc.backends.urdf_reader import read
 from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.kinematics import link_in_root, pose_matrix
-from mpc.ir.solids import closed, solid, union
+from mpc.ir.mesh_props import solid
+from mpc.ir.solids import closed, union
 from tests.conftest import ERD, Diags, compile_file, write
 
 TALOS = ERD / "talos_data/robots/talos_full_v2.urdf"

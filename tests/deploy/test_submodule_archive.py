@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from mpc.deploy.submodules import _extract_data
+from mpc.deploy.submodules import extract_data
 
 
 def _archive(*members: tuple[str, bytes | str]) -> tarfile.TarFile:
@@ -36,7 +36,7 @@ def python(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> s
 
 
 def test_files_and_links_inside_are_extracted(tmp_path: Path, python: str) -> None:
-    _extract_data(_archive(("lua/knee.lua", b"-- lua\n"), ("lua/link.lua", "knee.lua"), ("/abs", b"a")),
+    extract_data(_archive(("lua/knee.lua", b"-- lua\n"), ("lua/link.lua", "knee.lua"), ("/abs", b"a")),
                   tmp_path / "out")
     assert (tmp_path / "out/lua/knee.lua").read_bytes() == b"-- lua\n"
     assert (tmp_path / "out/lua/link.lua").readlink() == Path("knee.lua")
@@ -48,5 +48,5 @@ def test_files_and_links_inside_are_extracted(tmp_path: Path, python: str) -> No
 def test_nothing_is_written_or_linked_outside(tmp_path: Path, python: str,
                                               member: tuple[str, bytes | str]) -> None:
     with pytest.raises(tarfile.TarError):
-        _extract_data(_archive(member), tmp_path / "out")
+        extract_data(_archive(member), tmp_path / "out")
     assert sorted(p.name for p in tmp_path.rglob("*")) in ([], ["out"])

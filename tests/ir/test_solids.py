@@ -16,8 +16,8 @@ from mpc.backends.urdf_reader import read
 from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.geometry import Box, Mesh, MeshSource, ReflectMesh
 from mpc.ir.kinematics import link_in_root, pose_matrix
-from mpc.ir.mesh_props import as_trimesh
-from mpc.ir.solids import closed, solid, to_trimesh, union
+from mpc.ir.mesh_props import as_trimesh, solid
+from mpc.ir.solids import closed, to_trimesh, union
 from tests.conftest import ERD, Diags, compile_file, definition, write
 
 TALOS = ERD / "talos_data/robots/talos_full_v2.urdf"

@@ -1,4 +1,7 @@
-"""`package://` and relative mesh filenames → files on disk.
+"""`package://`, `file://` and relative filenames (of meshes, models) → files on disk.
+
+The callers build their IR values of what it finds (ir/geometry.py: mesh_source); it knows
+no IR.
 
 A package is looked up, in this order, in the package map given by the user
 (`--package NAME=DIR`), in ROS_PACKAGE_PATH, in `<prefix>/share` of each prefix of
@@ -15,8 +18,6 @@ import sys
 import sysconfig
 from dataclasses import dataclass, field
 from pathlib import Path
-
-from mpc.ir.geometry import MeshSource
 
 
 def _environment_share_dirs() -> list[Path]:
@@ -98,19 +99,17 @@ class PackageResolver:
         extra = [*self.package_map.values(), *self.search_path, *self.roots]
         return input_problem(path, package_roots([*extra, *([base_dir] if base_dir else [])]))
 
-    def resolve(self, uri: str, base_dir: Path) -> MeshSource:
-        """A mesh filename as written in a model file in `base_dir` → its MeshSource."""
+    def locate(self, uri: str, base_dir: Path) -> tuple[Path | None, str]:
+        """A filename as written in a file in `base_dir` → (the file, or None when its package
+        cannot be found; why not, a sentence for a diagnostic, else "")."""
         if uri.startswith("package://"):
             package, _, rest = uri[len("package://"):].partition("/")
             folder = self.find(package, base_dir)
             if folder is None:
-                return MeshSource(
-                    uri=uri, path=None,
-                    unresolved=f"package '{package}' was not found (searched the package map, "
-                    "ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, the Python environment and the folders "
-                    "above the model)",
-                )
-            return MeshSource(uri=uri, path=folder / rest)
+                return None, (f"package '{package}' was not found (searched the package map, "
+                              "ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, the Python environment and the "
+                              "folders above the model)")
+            return folder / rest, ""
         if uri.startswith("file://"):
-            return MeshSource(uri=uri, path=Path(uri[len("file://"):]))
-        return MeshSource(uri=uri, path=(base_dir / uri))
+            return Path(uri[len("file://"):]), ""
+        return base_dir / uri, ""

@@ -1,0 +1,75 @@
+"""`input_models` (AST) → ir.Inputs: each input's file, or its repository, and its xacro arguments.
+
+It resolves `package://` names to files (core/packages.py) but reads no model and clones no
+repository (compiler/inputs.py does, after the passes).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from mpc.compiler.lower_context import LowerContext
+from mpc.core.packages import PackageResolver
+from mpc.ir.program import Input, RepoRef
+
+
+def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Path:
+    """A file named in a definition: `package://…`, absolute, or relative to its folder."""
+    if written.startswith("package://"):
+        path, _ = resolver.locate(written, base_dir)
+        if path is not None:
+            return path
+    return (base_dir / written).resolve()
+
+
+def lower_inputs(ctx: LowerContext) -> dict[str, Input]:
+    out = {}
+    for name, entry in ctx.model.input_models.items():
+        args = xacro_args(ctx, entry)
+        if entry.basefile is not None:
+            folder = ctx.folder_of(entry, "basefile")
+            path: Path | None = resolve_file(entry.basefile, folder, ctx.resolver)
+            found, unresolved = ctx.resolver.locate(entry.basefile, folder)
+            if entry.basefile.startswith("package://") and found is None:
+                ctx.sink.error(entry.value_span("basefile"), "E0601",
+                               f"basefile '{entry.basefile}' of input model '{name}' cannot be "
+                               f"found: {unresolved}",
+                               hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH")
+                path = None
+            out[name] = Input(name=name, kind="basefile", span=entry.value_span("basefile"),
+                              path=path, is_human=entry.is_human, xacro_args=args)
+        elif entry.derived_base is not None:
+            out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
+                              path=(ctx.folder_of(entry, "derived_base") / entry.derived_base).resolve(),
+                              is_human=entry.is_human,
+                              smurf_data=ctx.model.inherit_smurf_properties)
+        elif entry.repo is not None:
+            r = entry.repo
+            out[name] = Input(name=name, kind="repo", path=None, span=entry.value_span("repo"),
+                              is_human=entry.is_human, xacro_args=args,
+                              repo=RepoRef(git=r.git, commit=r.commit, branch=r.branch,
+                                           model_in_repo=r.model_in_repo,
+                                           submechanisms_in_repo=r.submechanisms_in_repo))
+    return out
+
+
+def xacro_args(ctx: LowerContext, entry: Any) -> tuple[tuple[str, str], ...]:
+    """The input's `xacro_args` as text (xacro's arguments are strings); a warning when its
+    model file is no xacro, which ignores them."""
+    if entry.xacro_args is None:
+        return ()
+    model = entry.basefile or (entry.repo.model_in_repo if entry.repo is not None else "")
+    if not model.endswith(".xacro"):
+        ctx.sink.warning(entry.key_span("xacro_args"), "W0622", f"xacro_args apply to a .xacro model "
+                         f"file; '{model}' is none, so they are ignored")
+        return ()
+    text = {True: "true", False: "false"}
+    out = []
+    for key, value in sorted(entry.xacro_args.items()):
+        if not isinstance(value, str | int | float | bool):
+            ctx.sink.error(entry.value_span("xacro_args"), "E0240", f"xacro argument '{key}' is a "
+                           "string, a number or a boolean (xacro's arguments are text)")
+            continue
+        out.append((key, text[value] if isinstance(value, bool) else str(value)))
+    return tuple(out)
