@@ -104,6 +104,15 @@ class Store:
     def forget_state(self, model: str) -> None:
         self.state_file(model).unlink(missing_ok=True)
 
+    def last_status(self) -> dict[str, Any]:
+        """The last run's status.json, or {} when there is none or it cannot be read (it only
+        informs the order models start in)."""
+        try:
+            data = json.loads((self.meta / "status.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return {}
+        return data if isinstance(data, dict) else {}
+
     def save_status(self, status: dict[str, Any]) -> Path:
         path = self.meta / "status.json"
         write_json(path, status)
