@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -29,10 +30,10 @@ from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.geometry import Mesh, MeshSource
-from mpc.ir.kinematics import link_in_root, pose_matrix
+from mpc.ir.kinematics import links_in_root, pose_matrix
 from mpc.ir.program import KccdExport
 from mpc.ir.robot import Collision, Robot, Visual
-from mpc.ir.tree import child_joints, depth_first, joints_up
+from mpc.ir.tree import child_joints, depth_first, movable_above, parent_joint
 
 MESH_DIR = "meshes/iv"
 # Cover points for a shape KCCD fits exactly (edit_collisions `shape`), as Phobos counts them.
@@ -240,13 +241,14 @@ def settings_of(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
     """The KCCD settings file's content (see the module docstring); bodies without a hull
     (no shapes) are left out."""
     up = "../" * len(Path(export.dirname).parts)
+    above = movable_above(robot)
     out: dict[str, Any] = {
         "robot": robot.name, "urdf": f"{robot.name}.urdf",
         "safety_distance": _number(export.safety_distance), "report_up_to": _number(export.report_up_to),
         "computation_budget": _number(export.computation_budget),
         "max_approximation_order": export.max_approximation_order,
         "bodies": [{"link": b.link, "links": list(b.links), "mesh": up + b.mesh,
-                    "n_points": n_points(robot, b.link, export)} for b in bodies if b.link in hulls],
+                    "n_points": n_points(b.link, export, above)} for b in bodies if b.link in hulls],
         "dont_check": [list(pair) for pair in dont_check(robot, bodies, hulls, export)],
     }
     if export.braking_model:
@@ -261,16 +263,15 @@ def _number(x: float) -> int | float:
     return int(x) if float(x).is_integer() else x
 
 
-def n_points(robot: Robot, link: str, export: KccdExport) -> int:
+def n_points(link: str, export: KccdExport, movable: Mapping[str, int]) -> int:
     """How many points kccdcoveriv covers the body with: fewer the more movable joints lie
     between it and the root (Phobos's rule, 25 at the root towards 3), unless edit_collisions
-    gives a number or a shape."""
+    gives a number or a shape. movable: `movable_above` of the robot."""
     if link in export.n_points:
         return export.n_points[link]
     if export.shapes.get(link, "convex") != "convex":
         return SHAPE_POINTS[export.shapes[link]]
-    distance = sum(1 for j in joints_up(robot, link) if j.type != "fixed")
-    return int((25 - 3) * 0.4 ** (distance / 3) + 3)
+    return int((25 - 3) * 0.4 ** (movable[link] / 3) + 3)
 
 
 def swept_joints(robot: Robot, link: str) -> list[str]:
@@ -283,17 +284,33 @@ def swept_joints(robot: Robot, link: str) -> list[str]:
             and child in below and child != link]
 
 
+def _touching_boxes(hulls: dict[str, Any], X_R: Mapping[str, np.ndarray]) -> list[tuple[str, str]]:
+    """Pairs of hulls whose bounding boxes (axis-aligned in the root frame, at q = 0) touch;
+    sweeps along x, so only boxes that overlap in x are compared."""
+    boxes = []
+    for link, hull in hulls.items():
+        points = (X_R[link] @ np.c_[hull.vertices, np.ones(len(hull.vertices))].T).T[:, :3]
+        boxes.append((points.min(axis=0), points.max(axis=0), link))
+    boxes.sort(key=lambda box: box[0][0])
+    out = []
+    for i, (low_a, high_a, a) in enumerate(boxes):
+        for low_b, high_b, b in boxes[i + 1:]:
+            if low_b[0] > high_a[0]:
+                break
+            if np.all(low_a <= high_b) and np.all(low_b <= high_a):
+                out.append((a, b))
+    return out
+
+
 def dont_check(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
                export: KccdExport) -> list[tuple[str, str]]:
     """Body pairs KCCD need not check (Phobos's collision matrix): a body and its parent body;
     a body and the ancestors of its parent body reached by rotations only (their frames share
     an origin); bodies whose hulls' bounding boxes touch at q = 0; and no_collision_between."""
     body_of = {link: b.link for b in bodies for link in b.links}
-    parent_body: dict[str, str] = {}
-    for b in bodies:
-        up = joints_up(robot, b.link)
-        if up:
-            parent_body[b.link] = body_of[up[0].parent]
+    parents = parent_joint(robot)
+    parent_body = {b.link: body_of[parents[b.link].parent] for b in bodies if b.link in parents}
+    X_R = links_in_root(robot)
     pairs: set[tuple[str, str]] = set()
 
     def add(a: str, b: str) -> None:
@@ -306,20 +323,13 @@ def dont_check(robot: Robot, bodies: list[Body], hulls: dict[str, Any],
             continue
         add(b.link, parent)
         while parent in parent_body:
-            X = np.linalg.inv(link_in_root(robot, parent_body[parent])) @ link_in_root(robot, parent)
+            X = np.linalg.inv(X_R[parent_body[parent]]) @ X_R[parent]
             if not np.allclose(X[:3, 3], 0.0, atol=1e-2):
                 break
             parent = parent_body[parent]
             add(b.link, parent)
-    boxes = {}
-    for link, hull in hulls.items():  # axis-aligned in the root frame, at q = 0
-        points = (link_in_root(robot, link) @ np.c_[hull.vertices, np.ones(len(hull.vertices))].T).T[:, :3]
-        boxes[link] = (points.min(axis=0), points.max(axis=0))
-    names = sorted(boxes)
-    for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            if np.all(boxes[a][0] <= boxes[b][1]) and np.all(boxes[b][0] <= boxes[a][1]):
-                add(a, b)
+    for a, b in _touching_boxes(hulls, X_R):
+        add(a, b)
     for link, others in export.no_collision_between.items():
         for other in others:
             add(body_of[link], body_of[other])

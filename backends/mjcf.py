@@ -54,9 +54,12 @@ from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.tree import child_joints, depth_first
 
-__all__ = ["check", "cut_sites", "emit", "left_out", "to_string"]
+__all__ = ["MAX_BODY_DEPTH", "body_depth", "check", "cut_sites", "emit", "left_out", "to_string"]
 
 Quat = tuple[float, float, float, float]
+# MuJoCo parses MJCF with tinyxml2, which refuses elements nested deeper than 500: <mujoco>,
+# <worldbody>, the bodies and their <geom>s leave room for 496 nested bodies.
+MAX_BODY_DEPTH = 496
 Pairs = list[tuple[str, str | None]]
 MJMINVAL = 1e-15  # MuJoCo's mjMINVAL: the least mass and inertia of a moving body
 IND = "  "
@@ -120,12 +123,14 @@ def check(robot: Robot, sink: Sink, span: Span) -> bool:
     mjMINVAL unless a body welded below it has both. The MJCF is written anyway."""
     children, ok = child_joints(robot), True
     moving = {j.child for j in robot.joints.values() if j.type != "fixed"}
+    order = [link for _, link in depth_first(robot)]
+    welded_mass: dict[str, bool] = {}  # a link welded below it carries mass; from the leaves up
+    for link in reversed(order):
+        welded_mass[link] = any(j.type == "fixed" and (_mass_ok(robot.links[j.child].inertial)
+                                                       or welded_mass[j.child])
+                                for j in children.get(link, []))
 
-    def welded_mass(link: str) -> bool:
-        return any(j.type == "fixed" and (_mass_ok(robot.links[j.child].inertial) or welded_mass(j.child))
-                   for j in children.get(link, []))
-
-    for _, link in depth_first(robot):
+    for link in order:
         inertial = robot.links[link].inertial
         if link == robot.root == "world":
             continue
@@ -141,7 +146,7 @@ def check(robot: Robot, sink: Sink, span: Span) -> bool:
             elif a + b < c:
                 problems.append(f"its principal moments violate A + B ≥ C ({fmt_float(a)} + "
                                 f"{fmt_float(b)} < {fmt_float(c)})")
-        if link in moving and not _mass_ok(inertial) and not welded_mass(link):
+        if link in moving and not _mass_ok(inertial) and not welded_mass[link]:
             problems.append(f"it moves but its mass or a principal moment is below mjMINVAL "
                             f"({MJMINVAL:g}) and no link welded to it carries mass")
         if problems:
@@ -471,11 +476,37 @@ def to_string(robot: Robot, mesh_name: Callable[[Mesh], str], sink: Sink | None 
     return _Writer(robot, mesh_name, formats, enforce_zero).document()
 
 
-def _diagnose(robot: Robot, sink: Sink, span: Span) -> None:
+def body_depth(robot: Robot) -> tuple[int, str]:
+    """How deep the MJCF's bodies nest (the world's children are 1), and the deepest link:
+    the root is a body unless it is `world`; a floating joint's body is hoisted to the world."""
+    hoisted = robot.root != "world"
+    depth: dict[str, int] = {robot.root: 0 if robot.root == "world" else 1}
+    deepest = robot.root
+    for joint, link in depth_first(robot):
+        if joint is None:
+            continue
+        top = hoisted and joint.parent == robot.root and joint.type == "floating"
+        depth[link] = 1 if top else depth[joint.parent] + 1
+        if depth[link] > depth[deepest]:
+            deepest = link
+    return depth[deepest], deepest
+
+
+def _diagnose(robot: Robot, sink: Sink, span: Span) -> bool:
+    """Report what MuJoCo refuses (E0504, E0695) and what is left out (W0500); whether the
+    MJCF can be written (E0695: MuJoCo could not even parse it)."""
+    depth, deepest = body_depth(robot)
+    if depth > MAX_BODY_DEPTH:
+        sink.error(span, "E0695", f"the MJCF cannot hold this robot: its bodies would nest {depth} "
+                   f"deep (down to link '{deepest}'), and MuJoCo's XML reader refuses elements nested "
+                   f"deeper than {MAX_BODY_DEPTH} bodies; no MJCF is written",
+                   hint="export this model as URDF or SDF, or cut it into submodels")
+        return False
     check(robot, sink, span)
     missing = left_out(robot)
     if missing:
         sink.warning(span, "W0500", "the MJCF leaves out what it cannot hold: " + ", ".join(missing))
+    return True
 
 
 def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
@@ -484,7 +515,8 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
         sink.error(export.span, "E0501", f"MuJoCo reads no '{export.mesh_format}' meshes",
                    hint="use mesh_format stl or obj for an mjcf export")
         return
-    _diagnose(robot, sink, export.span)
+    if not _diagnose(robot, sink, export.span):
+        return
     prepared = meshes.for_export(robot, export, out, sink)
     if prepared is None:
         return

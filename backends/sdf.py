@@ -61,10 +61,11 @@ def sdf_names(robot: Robot) -> tuple[dict[str, str], dict[str, str]]:
     links = {name: name for name in robot.links}
     if WORLD in links and not (robot.root == WORLD and _is_empty(robot.links[WORLD])):
         links[WORLD] = _unique(WORLD, "_link", set(robot.links) | set(robot.joints))
-    taken = set(links.values()) | set(robot.joints)
+    link_names = set(links.values())
+    taken = link_names | set(robot.joints)
     joints = {}
     for name in robot.joints:
-        joints[name] = name if name not in links.values() else _unique(name, "_joint", taken)
+        joints[name] = name if name not in link_names else _unique(name, "_joint", taken)
         taken.add(joints[name])
     return links, joints
 

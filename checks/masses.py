@@ -7,7 +7,7 @@ import numpy as np
 
 from mpc.checks.protocol import Result, Tolerance, failed, skipped, verdict
 from mpc.checks.registry import Context, register
-from mpc.ir.kinematics import link_in_root
+from mpc.ir.kinematics import links_in_root
 from mpc.ir.program import ModelTest
 from mpc.ir.robot import Robot
 from mpc.ir.tree import joints_up
@@ -62,8 +62,9 @@ def compare_link_transformations(ctx: Context, test: ModelTest) -> Result:
     one model are left to topological_self_consistency."""
     new, old = ctx.built.robot, ctx.compare.robot
     rows = []
+    X_R_new, X_R_old = links_in_root(new), links_in_root(old)
     for link in sorted(set(new.links) & set(old.links)):
-        X_new, X_old = link_in_root(new, link), link_in_root(old, link)
+        X_new, X_old = X_R_new[link], X_R_old[link]
         rows.append((link, float(np.linalg.norm(X_new[:3, 3] - X_old[:3, 3])),
                      rotation_angle(X_old[:3, :3].T @ X_new[:3, :3])))
     return pose_verdict(test.name, rows, ctx.tol.distance, ctx.tol.rad)

@@ -72,16 +72,17 @@ def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
     return tuple(dict.fromkeys(Path(f).resolve() for f in folders))
 
 
-def input_problem(path: Path, roots: Iterable[Path]) -> str | None:
+def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] | None = None) -> str | None:
     """Why the input file `path` must not be read, or None.
 
     A link (or a linked folder on the way) must resolve inside one of `roots`: a mesh that
     links to /proc/self/environ or ~/.ssh would otherwise be copied into the build and
     deployed. Whatever the path, devices, FIFOs, sockets and the kernel's /proc, /sys and
-    /dev are refused.
+    /dev are refused. real_dirs: folders resolved before, kept by the caller for the files
+    of one build (the meshes of a model share a few folders).
     """
-    real = path.resolve()
-    if any(real == s or s in real.parents for s in SPECIAL_ROOTS):
+    real = _realpath(path, real_dirs)
+    if any(_within(real, str(s)) for s in SPECIAL_ROOTS):
         return f"it is '{real}', a special file of the system"
     try:
         mode = os.stat(real).st_mode
@@ -89,11 +90,27 @@ def input_problem(path: Path, roots: Iterable[Path]) -> str | None:
         return describe(e, "read")
     if not stat.S_ISREG(mode):
         return "it is not a regular file (a device, FIFO, socket or folder)"
-    if real != Path(os.path.normpath(path.absolute())):  # a link on the way
-        roots = tuple(roots)
-        if not any(r == real or r in real.parents for r in roots):
-            return f"it is a link to '{real}', outside the model's package roots"
+    link = real != os.path.normpath(os.path.abspath(path))  # a link on the way
+    if link and not any(_within(real, str(r)) for r in roots):
+        return f"it is a link to '{real}', outside the model's package roots"
     return None
+
+
+def _realpath(path: Path, real_dirs: dict[str, str] | None) -> str:
+    """os.path.realpath(path), its folder's resolved form taken from `real_dirs` when there."""
+    if real_dirs is None:
+        return os.path.realpath(path)
+    folder, name = os.path.split(os.path.abspath(path))
+    if folder not in real_dirs:
+        real_dirs[folder] = os.path.realpath(folder)
+    joined = os.path.join(real_dirs[folder], name)
+    return os.path.realpath(joined) if os.path.islink(joined) else joined
+
+
+def _within(real: str, root: str) -> bool:
+    """Whether the resolved path `real` is `root` or inside it (both absolute and resolved;
+    strings, as Path.parents is slow when every mesh of a model asks)."""
+    return real == root or real.startswith(root if root.endswith("/") else root + "/")
 
 
 def describe(error: OSError, operation: str | None = None) -> str:

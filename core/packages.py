@@ -47,6 +47,8 @@ class PackageResolver:
     # folders and the checkouts of `repo` inputs (compiler/inputs.py adds them).
     roots: list[Path] = field(default_factory=list)
     _cache: dict[str, Path | None] = field(default_factory=dict)
+    _real_roots: dict[tuple[Path, ...], tuple[Path, ...]] = field(default_factory=dict)
+    _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
 
     def __post_init__(self) -> None:
         if self.search_path is None:
@@ -96,8 +98,11 @@ class PackageResolver:
         if not path.exists():
             return None
         assert self.search_path is not None
-        extra = [*self.package_map.values(), *self.search_path, *self.roots]
-        return input_problem(path, package_roots([*extra, *([base_dir] if base_dir else [])]))
+        folders = (*self.package_map.values(), *self.search_path, *self.roots,
+                   *([base_dir] if base_dir else []))
+        if folders not in self._real_roots:  # resolved once for every mesh of a model
+            self._real_roots[folders] = package_roots(folders)
+        return input_problem(path, self._real_roots[folders], self._real_dirs)
 
     def locate(self, uri: str, base_dir: Path) -> tuple[Path | None, str]:
         """A filename as written in a file in `base_dir` → (the file, or None when its package

@@ -16,7 +16,7 @@ from itertools import combinations
 import numpy as np
 
 from mpc.ir.geometry import Geometry
-from mpc.ir.kinematics import link_in_root, pose_matrix
+from mpc.ir.kinematics import links_in_root, pose_matrix
 from mpc.ir.robot import Robot
 from mpc.ir.tree import parent_joint
 
@@ -49,10 +49,10 @@ def touching(robot: Robot) -> set[frozenset[str]]:
     import coal
 
     shapes = []
+    X_R = links_in_root(robot)
     for name, link in robot.links.items():
-        X_RL = link_in_root(robot, name)
         for c in link.collisions:
-            X = X_RL @ pose_matrix(c.origin)
+            X = X_R[name] @ pose_matrix(c.origin)
             shapes.append((name, _coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
     out: set[frozenset[str]] = set()
     request = coal.CollisionRequest()

@@ -38,6 +38,14 @@ def joints_up(robot: Robot, link: str) -> list[Joint]:
     return out
 
 
+def movable_above(robot: Robot) -> dict[str, int]:
+    """How many movable (not fixed) joints lie between each link and the root, top-down."""
+    out: dict[str, int] = {}
+    for joint, link in depth_first(robot):
+        out[link] = 0 if joint is None else out[joint.parent] + (joint.type != "fixed")
+    return out
+
+
 def depth_first(robot: Robot) -> Iterator[tuple[Joint | None, str]]:
     """(joint leading to the link, link) from the root down, children by joint name."""
     children = child_joints(robot)

@@ -74,8 +74,3 @@ def descendants(parents: Mapping[str, Iterable[str]], node: str) -> set[str]:
             todo.extend(children.get(n, ()))
     return seen
 
-
-def weights(parents: Mapping[str, Iterable[str]]) -> dict[str, int]:
-    """How many models wait for each one (its descendants): the scheduler starts the models
-    that unblock the most first, a cheap stand-in for the critical path."""
-    return {n: len(descendants(parents, n)) for n in parents}

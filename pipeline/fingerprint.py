@@ -14,14 +14,19 @@ that programs started by `post_processing` read (they are other processes).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
+import re
 import sys
 from collections.abc import Iterable
 from functools import cache
 from pathlib import Path
 from typing import Any
+
+from mpc.core.cache import cache_dir
+from mpc.core.files import write_atomic
 
 # File types that are code, not inputs: modules imported while building.
 _CODE_SUFFIXES = frozenset({".py", ".pyc", ".so", ".pyd", ".pth", ".pyi", ".typed", ".lark"})
@@ -55,10 +60,25 @@ def mpc_version() -> str:
     from mpc.core.version import mpc_version as installed_version
 
     ver = installed_version()
+    files = source_files()
+    # The digest of the same files (names, sizes, times) is kept in the cache: a run that
+    # changes nothing reads no source file.
+    stats = hashlib.sha256(ver.encode())
+    for name, file in files:
+        st = file.stat()
+        stats.update(f"{name}\0{st.st_size}\0{st.st_mtime_ns}\0".encode())
+    kept = cache_dir("version") / stats.hexdigest()
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        known = kept.read_text(encoding="utf-8")
+        if re.fullmatch(r"[0-9a-f]{16}", known):
+            return f"{ver}+{known}"
     h = hashlib.sha256(ver.encode())
-    for name, file in source_files():
+    for name, file in files:
         h.update(name.encode())
         h.update(file.read_bytes())
+    with contextlib.suppress(OSError):
+        kept.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(kept, h.hexdigest()[:16])
     return f"{ver}+{h.hexdigest()[:16]}"
 
 

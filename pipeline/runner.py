@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from mpc.core.diagnostics import Diagnostic, Severity
 from mpc.core.files import describe
 from mpc.core.span import Span
-from mpc.pipeline import dag
+from mpc.pipeline import schedule
 from mpc.pipeline.fingerprint import mpc_version, with_deps
 from mpc.pipeline.freshness import Freshness
 from mpc.pipeline.plan import Plan, PlannedModel
@@ -106,18 +106,19 @@ class Runner:
         self.done: set[str] = set()
         self.running: dict[str, _Running] = {}
         self.status_error: str | None = None  # why status.json could not be written
+        self.start = time.perf_counter()  # when the run started
         self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force)
 
     # -- the loop ----------------------------------------------------------------------------
 
     def run(self) -> RunStatus:
-        start = time.perf_counter()
+        start = self.start = time.perf_counter()
         self.store.lock()
         try:
-            weight = dag.weights(self.parents)
-            waiting = sorted(self.selected, key=lambda n: -weight[n])
+            priority = self._priorities()
+            waiting = sorted(self.selected, key=lambda n: -priority[n])
             self.reporter.planned(self.status, waiting)
-            queue: list[tuple[str, str, list[str]]] = []
+            queue: dict[str, tuple[str, str, list[str]]] = {}  # ready to build, by model
             try:
                 while waiting or queue or self.running:
                     progressed = False
@@ -126,11 +127,13 @@ class Runner:
                             waiting.remove(name)
                             decided = self._decide(name)
                             if decided is not None:
-                                queue.append(decided)
+                                queue[name] = decided
                             progressed = True
                     while queue and len(self.running) < max(1, self.opts.jobs):
+                        name = schedule.next_model(list(queue), priority,
+                                                   (self.sources[r] for r in self.running), self.sources)
                         with _uninterrupted():  # a started worker is always in self.running
-                            self._start(*queue.pop(0))
+                            self._start(*queue.pop(name))
                         progressed = True
                     if self.running:
                         self._wait()
@@ -149,6 +152,19 @@ class Runner:
                 self.status_error = e.strerror or str(e)
             self.store.unlock()
         return self.status
+
+    def _priorities(self) -> dict[str, float]:
+        """The longest remaining path from each model, in expected seconds (pipeline/schedule.py)."""
+        names = [n for n in self.parents if n in self.selected]
+        known = schedule.last_seconds(self.store.last_status(), {n: self.store.state(n) for n in names})
+        seconds = schedule.expected_seconds(self.parents, known)
+        return schedule.priorities({n: [p for p in self.parents[n] if p in self.selected] for n in names},
+                                   seconds)
+
+    @cached_property
+    def sources(self) -> dict[str, frozenset[str]]:
+        """The basefiles each model reads (two models reading one convert the same meshes)."""
+        return {n: schedule.sources(m.definition, m.data) for n, m in self.plan.models.items()}
 
     def _ready(self, name: str) -> bool:
         model = self.plan.models[name]
@@ -236,7 +252,9 @@ class Runner:
                               args=(job, run, cached, send, ignore, self.opts.werror))
         process.start()
         send.close()
-        self.running[name] = _Running(name, process, receive, pre, run, cached, time.perf_counter())
+        now = time.perf_counter()
+        self.running[name] = _Running(name, process, receive, pre, run, cached, now)
+        self.status.models[name].started = now - self.start
         self.reporter.started(name, process.pid or 0)
 
     def _wait(self) -> None:
@@ -258,6 +276,7 @@ class Runner:
             r.process.join()
             r.conn.close()
             del self.running[r.model]
+            self.status.models[r.model].seconds = time.perf_counter() - r.started
             # Moving the output into place and saving its state happen together or not at
             # all: an interruption waits until both are done.
             with _uninterrupted():

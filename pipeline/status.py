@@ -34,13 +34,17 @@ class StageRecord:
 
 @dataclass
 class ModelRecord:
-    """A model of this run: its definition, parents and the record of each selected stage."""
+    """A model of this run: its definition, parents and the record of each selected stage;
+    for a model a worker built, when the worker started (seconds since the run started) and
+    its wall time, until the worker ended."""
 
     name: str
     definition: str
     parents: tuple[str, ...]
     stages: dict[str, StageRecord] = field(default_factory=dict)
     warnings: list[Diagnostic] = field(default_factory=list)  # from planning
+    started: float | None = None
+    seconds: float | None = None
 
     @property
     def failed(self) -> bool:
@@ -101,6 +105,8 @@ class RunStatus:
                     "state": model_state(m),
                     "warnings": diagnostics_json(m.warnings),
                     "stages": {stage: record_json(r) for stage, r in m.stages.items()},
+                    **({"started": round(m.started, 3)} if m.started is not None else {}),
+                    **({"seconds": round(m.seconds, 3)} if m.seconds is not None else {}),
                 }
                 for name, m in self.models.items()
             },

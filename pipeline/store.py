@@ -38,6 +38,7 @@ class Store:
         self.build = build
         self.meta = build / ".mpc"
         self._lock: IO[str] | None = None
+        self._states: dict[str, tuple[dict[str, Any], str | None]] = {}  # read once a run
 
     def output(self, model: str) -> Path:
         return self.build / model
@@ -84,13 +85,25 @@ class Store:
         return self._read_state(model)[1]
 
     def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
+        if model not in self._states:
+            self._states[model] = self._load_state(model)
+        return self._states[model]
+
+    def _load_state(self, model: str) -> tuple[dict[str, Any], str | None]:
         from mpc.core import yaml_source as source
         from mpc.core.diagnostics import Sink
 
         path = self.state_file(model)
-        if not path.exists() and not path.is_symlink():
-            return {}, None
-        # JSON is YAML: the bounded loader refuses deep nesting, huge numbers and the like
+        try:
+            data = _strict_json(path.read_bytes())
+        except FileNotFoundError:
+            if not path.is_symlink():
+                return {}, None
+        except (OSError, ValueError, RecursionError):
+            pass
+        else:
+            return (data, None) if well_formed(data) else ({}, "not a state mpc writes")
+        # Not JSON as mpc writes it: JSON is YAML, and the bounded loader says where and why
         sink = Sink()
         doc = source.load(path, sink)
         if doc is None:
@@ -99,15 +112,46 @@ class Store:
         return (doc.data, None) if well_formed(doc.data) else ({}, "not a state mpc writes")
 
     def save_state(self, model: str, state: dict[str, Any]) -> None:
+        self._states.pop(model, None)
         write_json(self.state_file(model), state)
 
     def forget_state(self, model: str) -> None:
+        self._states.pop(model, None)
         self.state_file(model).unlink(missing_ok=True)
+
+    def last_status(self) -> dict[str, Any]:
+        """The last run's status.json, or {} when there is none or it cannot be read (it only
+        informs the order models start in)."""
+        try:
+            data = json.loads((self.meta / "status.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return {}
+        return data if isinstance(data, dict) else {}
 
     def save_status(self, status: dict[str, Any]) -> Path:
         path = self.meta / "status.json"
         write_json(path, status)
         return path
+
+
+def _strict_json(text: bytes) -> Any:
+    """JSON as mpc writes it, read fast; ValueError (or RecursionError, for deep nesting) for
+    anything else: duplicate keys, NaN, numbers of more than 50 digits."""
+    def unique(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        out = dict(pairs)
+        if len(out) != len(pairs):
+            raise ValueError("a key twice")
+        return out
+
+    def bounded(digits: str) -> int:
+        if len(digits) > 50:
+            raise ValueError("a number too long")
+        return int(digits)
+
+    def refuse(constant: str) -> Any:
+        raise ValueError(constant)
+
+    return json.loads(text, object_pairs_hook=unique, parse_int=bounded, parse_constant=refuse)
 
 
 def write_json(path: Path, data: Any) -> None:

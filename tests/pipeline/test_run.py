@@ -242,3 +242,22 @@ def test_on_a_terminal_a_live_display_then_the_table(fleet: Fleet) -> None:
     assert "2 models" in plain  # the progress bar's label
     assert re.search(r"✓ pendulum ok \d+ files, 3 meshes", plain)
     assert "2 models: 2 ok in" in plain
+
+
+def test_the_longest_remaining_path_starts_first(fleet: Fleet) -> None:
+    """No model was built before, so each counts alike: the arm chain (4 models deep) starts
+    first, then the quad diamond (3 deep), though pipeline.yml lists them last."""
+    assert fleet.cold.started()[:2] == ["arm", "quad"]
+
+
+def test_status_json_records_when_each_built_model_started_and_its_wall_time(fleet: Fleet) -> None:
+    status = fleet.cold.status
+    started = [*BUILT, "broken"]
+    assert sorted(started, key=lambda m: status["models"][m]["started"]) == fleet.cold.started()
+    for name in started:
+        model = status["models"][name]
+        compile_ = model["stages"]["compile"]["seconds"]
+        assert 0 < compile_ <= model["seconds"], name
+        assert 0 <= model["started"] <= model["started"] + model["seconds"] <= status["seconds"], name
+    assert "started" not in status["models"]["broken_child"]  # skipped: no worker
+    assert all("started" not in m and "seconds" not in m for m in fleet.noop.status["models"].values())
