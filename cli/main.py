@@ -115,6 +115,9 @@ def _parser() -> argparse.ArgumentParser:
     summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
     summary.add_argument("--markdown", type=Path, metavar="FILE",
                          help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
+    from mpc.cli.lsp import add_arguments as lsp_arguments
+
+    lsp_arguments(sub.add_parser("lsp", help="the language server for editors (LSP over stdio)"), _package)
     view = sub.add_parser("view", help="show a model in the browser (a local web viewer)")
     view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
     view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
@@ -271,6 +274,12 @@ def _view(args: argparse.Namespace) -> int:
     return run(args)
 
 
+def _lsp(args: argparse.Namespace) -> int:
+    from mpc.cli.lsp import run
+
+    return run(args)
+
+
 def _pipeline(args: argparse.Namespace) -> int:
     """`mpc run` and `mpc ci` (cli/run.py)."""
     from mpc.cli import run as command
@@ -288,7 +297,7 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     command = {"compile": _compile, "check": _check, "schema": _schema, "test": _test,
-               "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view}[args.command]
+               "deploy": _deploy, "run": _pipeline, "ci": _pipeline, "view": _view, "lsp": _lsp}[args.command]
     try:
         if _json_on_stdout(args):
             from mpc.core.render import json_document

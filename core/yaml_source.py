@@ -15,6 +15,8 @@ from __future__ import annotations
 import os
 import re
 import stat
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -237,6 +239,29 @@ class _Builder:
         return out
 
 
+# What `overlay` sets: texts read instead of files, and the sets collecting what was loaded.
+_overlay: dict[str, str] = {}
+_loaded: list[set[str]] = []
+
+
+@contextmanager
+def overlay(texts: Mapping[str, str]) -> Iterator[set[str]]:
+    """Within it, `load` reads `texts` (by absolute path) instead of those files (an editor's
+    unsaved buffers, for `mpc lsp`), and the set it gives collects the absolute path of every
+    file `load` was asked for (what a check depends on). Not for threads: one at a time."""
+    saved = dict(_overlay)
+    _overlay.clear()
+    _overlay.update(texts)
+    loaded: set[str] = set()
+    _loaded.append(loaded)
+    try:
+        yield loaded
+    finally:
+        _loaded.pop()
+        _overlay.clear()
+        _overlay.update(saved)
+
+
 def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None = None) -> Document | None:
     """Load a YAML file; None (with diagnostics) when it cannot be read or parsed.
 
@@ -244,6 +269,12 @@ def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None
     error when it is missing.
     """
     file = display or str(path)
+    if _loaded or _overlay:
+        absolute = os.path.abspath(path)
+        for loaded in _loaded:
+            loaded.add(absolute)
+        if absolute in _overlay:
+            return loads(_overlay[absolute], file, sink)
     try:
         text = _read(path, LIMITS)
     except _NotAFile:
