@@ -11,8 +11,8 @@ def add_arguments(parser: argparse.ArgumentParser, package: Callable[[str], Any]
     """The options of `mpc lsp`; `package`: how `--package NAME=DIR` is parsed (cli/main.py)."""
     parser.add_argument("--stdio", action="store_true",
                         help="talk LSP on stdin and stdout (the default and only transport; editors pass it)")
-    parser.add_argument("--debounce-ms", type=float, default=10.0, metavar="MS",
-                        help="check a changed buffer once it has been quiet this long (default: 10)")
+    parser.add_argument("--debounce-ms", type=float, default=5.0, metavar="MS",
+                        help="check a changed buffer once it has been quiet this long (default: 5)")
     parser.add_argument("--package", type=package, action="append", default=[], metavar="NAME=DIR",
                         help="where the ROS package NAME is (for package:// paths); repeatable")
 

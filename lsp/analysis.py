@@ -50,8 +50,8 @@ class Analysis:
     """What one check of a buffer found.
 
     program: as lowered (its ops carry the spans of what they name); None when the
-    definition did not get that far. ran: after the passes, when they found no error.
-    steps: the ops in the order they run, on names.
+    definition did not get that far. passed: after the passes; ran: the same, when they found
+    no error. steps(): the ops in the order they run, on names (worked out when asked).
     inputs: the robots of the input models read from files, by input name.
     depends: the YAML files the check read (defaults chain, derived_base definitions).
     """
@@ -62,33 +62,42 @@ class Analysis:
     pipeline: bool = False
     doc: source.Document | None = None
     program: Program | None = None
-    steps: list[Step] = field(default_factory=list)
     inputs: dict[str, Robot] = field(default_factory=dict)
     depends: set[str] = field(default_factory=set)
     sites: list[Site] = field(default_factory=list)
+    passed: Program | None = None
     ran: Program | None = None
     loader: InputLoader | None = None
     _built: Robot | None = None
+    _steps: list[Step] | None = None
+
+    def steps(self) -> list[Step]:
+        """Each op that ran on known names, in the order they run, with the names around it."""
+        if self._steps is None:
+            steps: list[Step] = []
+            if self.passed is not None and self.loader is not None:
+                symbolic(self.passed, PassContext(Sink(), self.loader.names, Severity.WARNING),
+                         lambda op, before, after: steps.append(Step(op, before, after)))
+            self._steps = steps
+        return self._steps
 
     def names_at(self, line: int, col: int, indent: int) -> Names | None:
         """The names of the robot where the cursor is (1-based line, col; `indent` of its line):
         before the op whose entry holds the cursor, else after the last op written above it."""
-        if not self.steps:
+        steps = self.steps()
+        if not steps:
             return None
-        holding = [s for s in self.steps
+        holding = [s for s in steps
                    if (s.op.span.line, s.op.span.col) <= (line, col)
                    and (s.op.span.line == line or s.op.span.col - 1 < indent)]
-        above = [s for s in self.steps if (s.op.span.line, s.op.span.col) <= (line, col)]
+        above = [s for s in steps if (s.op.span.line, s.op.span.col) <= (line, col)]
         if holding:
             nearest = max(holding, key=lambda s: (s.op.span.line, s.op.span.col))
             if nearest is max(above, key=lambda s: (s.op.span.line, s.op.span.col)):
                 return nearest.before
         if above:
             return max(above, key=lambda s: (s.op.span.line, s.op.span.col)).after
-        return self.steps[0].before
-
-    def final_names(self) -> Names | None:
-        return self.steps[-1].after if self.steps else None
+        return steps[0].before
 
     def built(self) -> Robot | None:
         """The robot the definition describes (its ops applied), built once when asked."""
@@ -104,7 +113,7 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
     analysis = Analysis(path, text, sink.diagnostics)
     with source.overlay(open_texts) as loaded:
         try:
-            analysis.doc = doc = source.loads(text, str(path), sink)
+            analysis.doc = doc = source.loads(text, str(path), sink, fast=True)
             if doc is None:
                 return analysis
             if isinstance(doc.data, dict) and "pipeline" in doc.data:
@@ -136,12 +145,9 @@ def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, opti
     analysis.program, analysis.loader = lowered, loader
     errors = sink.error_count
     program = run_passes(lowered, PassContext(sink, loader.names, Severity.WARNING))
+    analysis.passed = program
     if sink.error_count == errors:
         analysis.ran = program
-    steps: list[Step] = []
-    symbolic(program, PassContext(Sink(), loader.names, Severity.WARNING),
-             lambda op, before, after: steps.append(Step(op, before, after)))
-    analysis.steps = steps
     for name, inp in lowered.inputs.items():
         if inp.kind != "derived_base":
             robot = loader.robot(inp) if inp.kind == "basefile" else None

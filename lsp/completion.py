@@ -39,7 +39,7 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
     ctx = context(lines, position.line, col)
     start = lsp.Position(line=position.line, character=position.character - utf16_length(ctx.word))
     where = lsp.Range(start=start, end=position)
-    named = good if good is not None and good.steps else analysis
+    named = analysis if analysis.passed is not None or good is None else good
     indent = len(lines.line(position.line)) - len(lines.line(position.line).lstrip(" -"))
     names = named.names_at(position.line + 1, col, indent)
     items: list[lsp.CompletionItem] = []

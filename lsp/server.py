@@ -2,7 +2,7 @@
 the editor features of completion.py, hover.py and navigation.py.
 
 A change is checked after a short quiet time (debounce; `mpc lsp --debounce-ms`, default
-10 ms), so that a burst of keystrokes is checked once; a
+5 ms), so that a burst of keystrokes is checked once; a
 request (completion, hover…) checks a pending change first, so it always sees the buffer
 as it is. After a file is checked, the open files whose check read it (its `defaults`
 chain, its derived_base parents) are checked again. Input models stay in one ModelCache for
@@ -36,9 +36,9 @@ class MpcServer(LanguageServer):
         resolver = PackageResolver(package_map=dict(packages or {}))
         self.options = Options(resolver=resolver, models=ModelCache())
         self.analyses: dict[str, Analysis] = {}
-        self.named: dict[str, Analysis] = {}  # the last analysis of each buffer that knew its names
+        self.named: dict[str, Analysis] = {}  # the last analysis of each buffer that got a program
         self.pending: dict[str, asyncio.TimerHandle] = {}
-        self.debounce = 0.010
+        self.debounce = 0.005
 
     def path(self, uri: str) -> Path:
         return Path(to_fs_path(uri) or uri)
@@ -56,7 +56,7 @@ class MpcServer(LanguageServer):
         path = self.path(uri)
         analysis = analyse(path, document.source, self.open_texts(), self.options)
         self.analyses[uri] = analysis
-        if analysis.steps:
+        if analysis.passed is not None:
             self.named[uri] = analysis
         self.publish_diagnostics(uri, convert(analysis.diagnostics, path, Lines(analysis.text)),
                                  version=document.version)
