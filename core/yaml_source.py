@@ -325,11 +325,18 @@ class _FastComposer(yaml.cyaml.CParser, _Resolver):  # type: ignore[misc]
         _Resolver.__init__(self)
 
 
+# Where libyaml and PyYAML part (found by fuzzing, tests/lsp/test_text.py): tabs, tags, `? ` keys, flow
+# mappings and pairs in flow lists (PyYAML refuses some that libyaml takes, or places a key or an
+# empty value one column apart), a byte order mark inside the text and line breaks other than \n
+# (columns), and the end of a text without a final line break (the collections closing there).
+_DIFFERENT = re.compile("[\t\r\x85\u2028\u2029\ufeff{!]|\\?(?:\\s|$)|\\[[^\\]]*:")
+
+
 def _fast_node(text: str, limits: Limits) -> Node | None:
     """The node of `text` composed by libyaml, or None when it is not sure to be what _Composer
     makes: libyaml is missing, or the text is malformed or beyond a limit (then _Composer
     reports it, in its words)."""
-    if not getattr(yaml, "__with_libyaml__", False):
+    if not getattr(yaml, "__with_libyaml__", False) or not text.endswith("\n") or _DIFFERENT.search(text):
         return None
     try:
         depth = aliases = 0
