@@ -121,13 +121,14 @@ def test_code_action_applies_the_did_you_mean(server: Client, folder: Path) -> N
 
 
 def labels(server: Client, uri: str, line: int, character: int) -> list[str]:
-    return [i["label"] for i in server.request("textDocument/completion", server.at(uri, line, character))["items"]]
+    answer = server.request("textDocument/completion", server.at(uri, line, character))
+    return [item["label"] for item in answer["items"]]
 
 
 def test_completion_of_names_as_they_are_at_the_cursor(server: Client, folder: Path) -> None:
     uri, _ = opened(server, folder / "complete.yml", DEFINITION)
     # collisions run after the frames' renaming: the link is upper_arm there
-    text = DEFINITION.replace("    upper_arm:\n      shape: box\n", "    upper_arm:\n      shape: box\n    \n")
+    text = DEFINITION.replace("      shape: box\n", "      shape: box\n    \n")
     server.change(uri, 2, text)
     after = labels(server, uri, 23, 4)
     assert {"upper_arm", "base", "lower", "tool"} <= set(after) and "upper" not in after
@@ -152,10 +153,12 @@ def hover(server: Client, uri: str, line: int, character: int) -> str:
 
 def test_hover(server: Client, folder: Path) -> None:
     uri, _ = opened(server, folder / "hover.yml", DEFINITION)
-    assert hover(server, uri, 9, 6) == ("**link upper**\n\nmass: 1 kg\n\nparent joint: shoulder (revolute)\n\n"
-                                        "pose in the root frame: xyz [0, 0, 0.1], rpy [0, 0, 0]\n\narm.urdf:20")
-    assert hover(server, uri, 16, 6).startswith("**joint shoulder** (revolute): base → upper\n\n"
-                                                "axis: [0, 1, 0]\n\nlower: -1.5, upper: 1.5, effort: 10, velocity: 2")
+    assert hover(server, uri, 9, 6) == (
+        "**link upper**\n\nmass: 1 kg\n\nparent joint: shoulder (revolute)\n\n"
+        "pose in the root frame: xyz [0, 0, 0.1], rpy [0, 0, 0]\n\narm.urdf:20")
+    assert hover(server, uri, 16, 6) == (
+        "**joint shoulder** (revolute): base → upper\n\n"
+        "axis: [0, 1, 0]\n\nlower: -1.5, upper: 1.5, effort: 10, velocity: 2\n\narm.urdf:13")
     assert hover(server, uri, 17, 19) == "= 0.785398"  # on the 45 of ["deg", 45]
     assert "position limits" in hover(server, uri, 17, 7)  # the key `min`
 
@@ -191,8 +194,8 @@ def test_a_defaults_file_updates_the_files_using_it(server: Client, folder: Path
     defaults = folder / "arm_defaults.yml"
     base_text = "default_model:\n  joints:\n    shoulder:\n      damping: 0.1\n"
     defaults_uri, _ = opened(server, defaults, base_text)
-    uri, diagnostics = opened(server, folder / "user.yml", "defaults: arm_defaults.yml\n" + DEFINITION.replace(
-        "elbo:", "elbow:"))
+    text = "defaults: arm_defaults.yml\n" + DEFINITION.replace("elbo:", "elbow:")
+    uri, diagnostics = opened(server, folder / "user.yml", text)
     assert diagnostics == []
     server.change(defaults_uri, 2, base_text.replace("shoulder", "shouldr"))  # unsaved: the buffer counts
     (diagnostic,) = server.diagnostics(uri)
