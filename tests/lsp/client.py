@@ -22,6 +22,7 @@ class Client:
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                      env=env, cwd=cwd)
         self.next_id = 0
+        self.capabilities: dict[str, Any] = {}
         self.answers: dict[int, queue.Queue[dict[str, Any]]] = {}
         self.published: queue.Queue[tuple[float, dict[str, Any]]] = queue.Queue()
         self.lock = threading.Lock()
@@ -75,6 +76,7 @@ class Client:
         result = self.request("initialize", {"processId": None, "rootUri": root.as_uri(),
                                              "capabilities": {}})
         self.notify("initialized")
+        self.capabilities = result["capabilities"]
         return result
 
     def open(self, path: Path, text: str | None = None) -> str:

@@ -57,7 +57,8 @@ model:
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     work = tmp_path_factory.mktemp("lsp")
-    shutil.copy(EXAMPLES / "arm.urdf", work / "arm.urdf")
+    for name in ("arm.urdf", "arm.urdf.xacro", "arm_segment.xacro"):
+        shutil.copy(EXAMPLES / name, work / name)
     shutil.copytree(EXAMPLES / "meshes", work / "meshes")
     return work
 
@@ -67,7 +68,7 @@ def server(folder: Path) -> Client:
     client = Client(env={**os.environ, "MPC_CACHE_DIR": str(folder / "cache")}, cwd=folder)
     client.initialize(folder)
     yield client
-    assert client.close() == 0
+    assert client.close() == 0  # shutdown and exit end the server cleanly
 
 
 def opened(server: Client, path: Path, text: str) -> tuple[str, list[dict]]:
@@ -76,15 +77,10 @@ def opened(server: Client, path: Path, text: str) -> tuple[str, list[dict]]:
     return uri, server.diagnostics(uri, 1)
 
 
-def test_capabilities(folder: Path) -> None:
-    client = Client(cwd=folder)
-    try:
-        capabilities = client.initialize(folder)["capabilities"]
-    finally:
-        assert client.close() == 0  # shutdown and exit end the server cleanly
+def test_capabilities(server: Client) -> None:
     for provider in ("completionProvider", "hoverProvider", "definitionProvider", "renameProvider",
                      "codeActionProvider", "documentSymbolProvider"):
-        assert capabilities[provider], provider
+        assert server.capabilities[provider], provider
 
 
 def test_diagnostics_are_mpc_checks_at_their_range(server: Client, folder: Path) -> None:
@@ -144,7 +140,7 @@ def test_completion_of_enumerations_and_files(server: Client, folder: Path) -> N
     uri, _ = opened(server, folder / "enums.yml", text)
     assert labels(server, uri, 28, 12)[:4] == ["urdf", "sdf", "mjcf", "smurf"]
     server.change(uri, 2, text.replace("basefile: arm.urdf", "basefile: "))
-    assert labels(server, uri, 5, 16) == ["arm.urdf", "meshes/"]
+    assert labels(server, uri, 5, 16) == ["arm.urdf", "arm.urdf.xacro", "arm_segment.xacro", "meshes/"]
 
 
 def hover(server: Client, uri: str, line: int, character: int) -> str:
@@ -171,6 +167,20 @@ def test_definition_opens_the_urdf_line_and_files(server: Client, folder: Path) 
     joint_line = (folder / "arm.urdf").read_text().split("\n")[12]
     assert joint_line.strip().startswith('<joint name="shoulder"')
     assert server.request("textDocument/definition", server.at(uri, 5, 18))["uri"] == urdf
+
+
+def test_definition_into_a_xacro_file(server: Client, folder: Path) -> None:
+    text = ("model:\n  robotname: arm\n  modelname: arm-model\n  input_models:\n    arm:\n"
+            "      basefile: arm.urdf.xacro\n  assemble:\n    model: arm\n  frames:\n    tool:\n"
+            "      parent: base\n      xyz: [0, 0, 0.1]\n  joints:\n    shoulder:\n      damping: 0.5\n")
+    uri, diagnostics = opened(server, folder / "xacro.yml", text)
+    assert diagnostics == []
+    xacro = (folder / "arm.urdf.xacro").as_uri()
+    assert server.request("textDocument/definition", server.at(uri, 10, 15)) == {  # parent: base
+        "uri": xacro, "range": {"start": {"line": 4, "character": 2}, "end": {"line": 4, "character": 19}}}
+    # a joint a macro names: the file
+    macro = server.request("textDocument/definition", server.at(uri, 13, 5))
+    assert (macro["uri"], macro["range"]["start"]) == (xacro, {"line": 0, "character": 0})
 
 
 def test_rename_across_the_definition(server: Client, folder: Path) -> None:
