@@ -79,23 +79,12 @@ def values_at(keys: tuple[str, ...]) -> list[str]:
 
 
 def tags_under(keys: tuple[str, ...]) -> list[str]:
-    """The `type`s a list's entries may have (export_config: urdf, sdf, …)."""
+    """The `type`s the entries of a list may have (keys ending in "-"; export_config: urdf, sdf, …)."""
     out: list[str] = []
-    nodes = _resolve(schema())
-    for key in keys:
-        nxt: list[dict[str, Any]] = []
-        for n in nodes:
-            if key == "-":
-                item = n.get("items")
-                if isinstance(item, dict):
-                    out.extend(t for t in (item.get("discriminator") or {}).get("mapping", {})
-                               if t not in out)
-                    nxt.extend(_resolve(item))
-            elif key in n.get("properties", {}):
-                nxt.extend(_resolve(n["properties"][key]))
-            elif isinstance(n.get("additionalProperties"), dict):
-                nxt.extend(_resolve(n["additionalProperties"]))
-        nodes = nxt
+    for n in at(keys[:-1]) if keys[-1:] == ("-",) else ():
+        item = n.get("items")
+        mapping = ((item.get("discriminator") or {}).get("mapping") or {}) if isinstance(item, dict) else {}
+        out.extend(tag for tag in mapping if tag not in out)
     return out
 
 

@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tests.lsp.definitions import EXPORT, HEAD
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "specs" / "examples"
 
 CONFIG = """\
@@ -40,20 +42,7 @@ vim.api.nvim_create_autocmd("BufReadPost", {pattern = "*.yml", callback = functi
 end})
 """
 
-DEFINITION = """\
-model:
-  robotname: arm
-  modelname: arm-model
-  input_models:
-    arm:
-      basefile: arm.urdf
-  assemble:
-    model: arm
-    remove_beyond: uppr
-  export_config:
-    - type: urdf
-      mesh_format: stl
-"""
+DEFINITION = HEAD + "    remove_beyond: uppr\n" + EXPORT
 
 
 def test_neovim_shows_the_diagnostics(tmp_path: Path) -> None:

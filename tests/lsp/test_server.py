@@ -18,18 +18,11 @@ from mpc.cli.check import check_file
 from mpc.compiler.inputs import Options
 from mpc.core.diagnostics import Sink
 from tests.lsp.client import Client
+from tests.lsp.definitions import EXPORT, HEAD
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "specs" / "examples"
 
-DEFINITION = """\
-model:
-  robotname: arm
-  modelname: arm-model
-  input_models:
-    arm:
-      basefile: arm.urdf
-  assemble:
-    model: arm
+DEFINITION = HEAD + """\
   frames:
     upper:
       name_editing:
@@ -48,10 +41,7 @@ model:
   poses:
     init:
       shoulder: [deg, 30]
-  export_config:
-    - type: urdf
-      mesh_format: stl
-"""
+""" + EXPORT
 
 
 @pytest.fixture(scope="module")
@@ -105,6 +95,13 @@ def test_change_is_checked_again(server: Client, folder: Path) -> None:
     server.change(uri, 3, DEFINITION.replace("parent: lower", "parent: lowr"))
     (diagnostic,) = [d for d in server.diagnostics(uri, 3) if "lowr" in d["message"]]
     assert diagnostic["range"]["start"] == {"line": 13, "character": 14}
+    # a two-line problem: the other line is related information
+    server.change(uri, 4, DEFINITION.replace("  input_models:\n", "  robotname: b\n  input_models:\n"))
+    (duplicate,) = server.diagnostics(uri, 4)
+    assert (duplicate["code"], duplicate["message"]) == ("E0103", "duplicate key 'robotname'")
+    assert duplicate["range"] == {"start": {"line": 3, "character": 2}, "end": {"line": 3, "character": 11}}
+    assert duplicate["relatedInformation"] == [{"message": "first written here", "location": {
+        "uri": uri, "range": {"start": {"line": 1, "character": 2}, "end": {"line": 1, "character": 11}}}}]
 
 
 def test_code_action_applies_the_did_you_mean(server: Client, folder: Path) -> None:
