@@ -83,21 +83,22 @@ class Analysis:
 
     def names_at(self, line: int, col: int, indent: int) -> Names | None:
         """The names of the robot where the cursor is (1-based line, col; `indent` of its line):
-        before the op whose entry holds the cursor, else after the last op written above it."""
+        before the op whose entry holds the cursor, else after the last op written above it.
+        Ops written in other files (a defaults file) count where they run, not where they are."""
         steps = self.steps()
-        if not steps:
-            return None
-        holding = [s for s in steps
-                   if (s.op.span.line, s.op.span.col) <= (line, col)
-                   and (s.op.span.line == line or s.op.span.col - 1 < indent)]
-        above = [s for s in steps if (s.op.span.line, s.op.span.col) <= (line, col)]
-        if holding:
-            nearest = max(holding, key=lambda s: (s.op.span.line, s.op.span.col))
-            if nearest is max(above, key=lambda s: (s.op.span.line, s.op.span.col)):
-                return nearest.before
-        if above:
-            return max(above, key=lambda s: (s.op.span.line, s.op.span.col)).after
-        return steps[0].before
+        here = [s for s in steps if s.op.span.file == str(self.path)]
+        if not here:
+            return steps[-1].after if steps else None
+
+        def where(step: Step) -> tuple[int, int]:
+            return step.op.span.line, step.op.span.col
+
+        above = [s for s in here if where(s) <= (line, col)]
+        if not above:
+            return min(here, key=where).before
+        nearest = max(above, key=where)
+        return nearest.before if nearest.op.span.line == line or nearest.op.span.col - 1 < indent \
+            else nearest.after
 
     def built(self) -> Robot | None:
         """The robot the definition describes (its ops applied), built once when asked."""
