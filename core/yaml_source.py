@@ -315,13 +315,16 @@ def _read(path: Path, limits: Limits) -> str:
     return data.decode("utf-8")
 
 
-class _FastComposer(yaml.cyaml.CParser, _Resolver):  # type: ignore[misc]
+_CParser: Any = getattr(getattr(yaml, "cyaml", None), "CParser", None)  # None without libyaml
+
+
+class _FastComposer(*((_CParser,) if _CParser else ()), _Resolver):  # type: ignore[misc]
     """libyaml's composer (C, about 20 times faster) with the resolver above. It counts
     nothing and composes recursively in C, so `_fast_node` lets it compose only text whose
     events (an iteration, not a recursion) stay within the limits."""
 
     def __init__(self, stream: str) -> None:
-        yaml.cyaml.CParser.__init__(self, stream)
+        _CParser.__init__(self, stream)
         _Resolver.__init__(self)
 
 
@@ -336,11 +339,15 @@ def _fast_node(text: str, limits: Limits) -> Node | None:
     """The node of `text` composed by libyaml, or None when it is not sure to be what _Composer
     makes: libyaml is missing, or the text is malformed or beyond a limit (then _Composer
     reports it, in its words)."""
-    if not getattr(yaml, "__with_libyaml__", False) or not text.endswith("\n") or _DIFFERENT.search(text):
+    if not text.endswith("\n") or _DIFFERENT.search(text):
         return None
+    if _CParser is None:
+        return None
+    events = _FastComposer(text)
     try:
         depth = aliases = 0
-        for event in yaml.parse(text, Loader=_FastComposer):
+        while events.check_event():
+            event = events.get_event()
             if isinstance(event, yaml.CollectionStartEvent):
                 depth += 1
                 if depth > limits.depth:
@@ -358,6 +365,8 @@ def _fast_node(text: str, limits: Limits) -> Node | None:
             loader.dispose()
     except yaml.YAMLError:
         return None
+    finally:
+        events.dispose()
 
 
 def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS, fast: bool = False) -> Document | None:
