@@ -43,6 +43,12 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
     indent = len(lines.line(position.line)) - len(lines.line(position.line).lstrip(" -"))
     names = named.names_at(position.line + 1, col, indent)
     items: list[lsp.CompletionItem] = []
+    if ctx.key is None and ctx.keys[-1:] == ("-",):  # an item of a block list: a name or a test
+        key = ctx.keys[-2] if len(ctx.keys) > 1 else ""
+        if ctx.keys[-3:] == ("test", "tests", "-"):
+            items += [_item(t, lsp.CompletionItemKind.EnumMember, where) for t in test_names()]
+        if key in VALUE_NAMES and names is not None:
+            items += _names(names, VALUE_NAMES[key], where, key=False)
     if ctx.key is None:
         kind = KEYED_BY.get(ctx.keys[-1]) if len(ctx.keys) == 2 and ctx.keys[0] == "model" else None
         if ctx.keys[:2] == ("model", "poses") and len(ctx.keys) == 3:
@@ -55,7 +61,7 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
         return _files(analysis.path, ctx, where)
     items += [_item(v, lsp.CompletionItemKind.EnumMember, where)
               for v in schema_data.values_at((*ctx.keys, ctx.key))]
-    if (ctx.keys[-1:] == ("test",) and ctx.key == "tests") or ctx.keys[-2:] == ("test", "tests"):
+    if ctx.keys[-1:] == ("test",) and ctx.key == "tests":
         items += [_item(t, lsp.CompletionItemKind.EnumMember, where) for t in test_names()]
     kind = VALUE_NAMES.get(ctx.key)
     if kind is None and ctx.keys[:2] == ("model", "poses") and len(ctx.keys) == 3:
