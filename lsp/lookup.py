@@ -36,7 +36,7 @@ def target(analysis: Analysis, line: int, col: int) -> Target | None:
     lines = Lines(analysis.text)
     text = lines.line(line)
     for match in _WORD.finditer(text):
-        if match.start() < col <= match.end() + 1 and match.start() + 1 <= col:
+        if match.start() + 1 <= col <= match.end() + 1:  # on the word or just after it
             break
     else:
         return None

@@ -1,12 +1,11 @@
 """The language server: LSP over stdio (pygls) → analyses of the open buffers → diagnostics and
 the editor features of completion.py, hover.py and navigation.py.
 
-A change is checked after a short quiet time (debounce; `mpc lsp --debounce-ms`, default
-5 ms), so that a burst of keystrokes is checked once; a
-request (completion, hover…) checks a pending change first, so it always sees the buffer
-as it is. After a file is checked, the open files whose check read it (its `defaults`
-chain, its derived_base parents) are checked again. Input models stay in one ModelCache for
-the server's life, re-read only when their file changes.
+A change is checked after a short quiet time (debounce; `mpc lsp --debounce-ms`, default 5 ms),
+so that a burst of keystrokes is checked once; a request (completion, hover…) checks a pending
+change first, so it always sees the buffer as it is. After a file is checked, the open files
+whose check read it (as their `defaults` chain, as a derived_base parent) are checked again.
+Input models stay in one ModelCache for the server's life, re-read only when their file changes.
 """
 
 from __future__ import annotations
