@@ -115,6 +115,9 @@ def _parser() -> argparse.ArgumentParser:
     summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
     summary.add_argument("--markdown", type=Path, metavar="FILE",
                          help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
+    from mpc.cli.lsp import add_arguments as lsp_arguments
+
+    lsp_arguments(sub.add_parser("lsp", help="the language server for editors (LSP over stdio)"), _package)
     view = sub.add_parser("view", help="show a model in the browser (a local web viewer)")
     view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
     view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
@@ -131,7 +134,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "compile": ("mpc.cli.compile", "run"), "check": ("mpc.cli.check", "run"),
     "schema": ("mpc.cli.schema", "run"), "test": ("mpc.cli.test", "run"),
     "deploy": ("mpc.cli.deploy", "run"), "run": ("mpc.cli.run", "run"), "ci": ("mpc.cli.run", "ci"),
-    "view": ("mpc.cli.view", "run"),
+    "view": ("mpc.cli.view", "run"), "lsp": ("mpc.cli.lsp", "run"),
 }
 
 

@@ -10,7 +10,7 @@ import math
 import operator
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, lru_cache
 from typing import TYPE_CHECKING
 
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
@@ -41,8 +41,10 @@ def parser() -> Lark:
     return load()
 
 
+@lru_cache(maxsize=4096)
 def parse(text: str) -> Node:
-    """Expression text → node tree; raises lark's UnexpectedInput on a syntax error."""
+    """Expression text → node tree; raises lark's UnexpectedInput on a syntax error. Kept per
+    text: a definition repeats its expressions, and `mpc lsp` parses it on every keystroke."""
     from mpc.compiler.expr_syntax import ExprTransformer
 
     return ExprTransformer().transform(parser().parse(text))

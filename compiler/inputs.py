@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mpc.core import yaml_source as source
-from mpc.core.diagnostics import Sink
+from mpc.core.diagnostics import Diagnostic, Sink
 from mpc.core.packages import PackageResolver
 from mpc.ir.names import Names
 from mpc.ir.program import Input
@@ -30,6 +30,39 @@ class Options:
     # `out` (a staging folder) into place, which post_processing commands see as their target.
     defaults: Callable[[source.Document], source.Document] | None = None
     target: Path | None = None
+    # A long-lived process (`mpc lsp`): input models kept across compilations until their file
+    # changes. None: each compilation reads its inputs once.
+    models: ModelCache | None = None
+
+
+@dataclass
+class ModelCache:
+    """Input models read once and kept while their file stays the same (modification time and
+    size): a server re-checks a definition on every keystroke without re-reading a URDF.
+
+    Each entry keeps the diagnostics its reading reported, replayed into the sink of every
+    compilation that takes it. Only the model file itself is watched, not what a xacro includes.
+    """
+
+    _models: dict[tuple[str, tuple[tuple[str, str], ...]], tuple[tuple[int, int], Robot | None,
+                                                                 list[Diagnostic]]] = \
+        field(default_factory=dict)
+
+    def read(self, path: Path, xacro_args: tuple[tuple[str, str], ...], sink: Sink,
+             reader: Callable[[Sink], Robot | None]) -> Robot | None:
+        """The robot of `path`, from the cache or by `reader` (which reports into a sink)."""
+        try:
+            stat = path.stat()
+        except OSError:
+            return reader(sink)  # the reader says why
+        key, stamp = (str(path.resolve()), xacro_args), (stat.st_mtime_ns, stat.st_size)
+        entry = self._models.get(key)
+        if entry is None or entry[0] != stamp:
+            own = Sink()
+            entry = self._models[key] = (stamp, reader(own), own.diagnostics)
+        for diagnostic in entry[2]:
+            sink.report(diagnostic)
+        return entry[1]
 
 
 # How a derived_base definition is built, or its names found (compiler/driver.py's `build` and
@@ -95,18 +128,24 @@ class InputLoader:
 
     def _read(self, path: Path, inp: Input) -> Robot | None:
         """A model file, by its extension: URDF, SDF, SMURF, or a xacro (expanded with its args)."""
-        from mpc.backends import BACKENDS
-
         if why := self.options.resolver.refusal(path):
             self.sink.error(inp.span, "E0650", f"input model '{path}' is not read: {why}")
             return None
+        if self.options.models is not None:
+            return self.options.models.read(path, inp.xacro_args, self.sink,
+                                            lambda sink: self._parse(path, inp, sink))
+        return self._parse(path, inp, self.sink)
+
+    def _parse(self, path: Path, inp: Input, sink: Sink) -> Robot | None:
+        from mpc.backends import BACKENDS
+
         suffix = path.suffix.lower()
         if suffix == ".xacro":
             from mpc.backends import xacro_reader
 
-            return xacro_reader.read(path, self.sink, self.options.resolver, inp.xacro_args, inp.span)
+            return xacro_reader.read(path, sink, self.options.resolver, inp.xacro_args, inp.span)
         reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
-        return reader.read(path, self.sink, self.options.resolver)
+        return reader.read(path, sink, self.options.resolver)
 
     def _repo_file(self, inp: Input, fetch: bool) -> Path | None:
         from mpc.compiler.repos import checkout

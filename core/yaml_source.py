@@ -15,6 +15,8 @@ from __future__ import annotations
 import os
 import re
 import stat
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -237,6 +239,29 @@ class _Builder:
         return out
 
 
+# What `overlay` sets: texts read instead of files, and the sets collecting what was loaded.
+_overlay: dict[str, str] = {}
+_loaded: list[set[str]] = []
+
+
+@contextmanager
+def overlay(texts: Mapping[str, str]) -> Iterator[set[str]]:
+    """Within it, `load` reads `texts` (by absolute path) instead of those files (an editor's
+    unsaved buffers, for `mpc lsp`), and the set it gives collects the absolute path of every
+    file `load` was asked for (what a check depends on). Not for threads: one at a time."""
+    saved = dict(_overlay)
+    _overlay.clear()
+    _overlay.update(texts)
+    loaded: set[str] = set()
+    _loaded.append(loaded)
+    try:
+        yield loaded
+    finally:
+        _loaded.pop()
+        _overlay.clear()
+        _overlay.update(saved)
+
+
 def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None = None) -> Document | None:
     """Load a YAML file; None (with diagnostics) when it cannot be read or parsed.
 
@@ -244,6 +269,12 @@ def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None
     error when it is missing.
     """
     file = display or str(path)
+    if _loaded or _overlay:
+        absolute = os.path.abspath(path)
+        for loaded in _loaded:
+            loaded.add(absolute)
+        if absolute in _overlay:
+            return loads(_overlay[absolute], file, sink)
     try:
         text = _read(path, LIMITS)
     except _NotAFile:
@@ -284,12 +315,73 @@ def _read(path: Path, limits: Limits) -> str:
     return data.decode("utf-8")
 
 
-def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS) -> Document | None:
-    """Parse YAML text that came from `file`."""
+_CParser: Any = getattr(getattr(yaml, "cyaml", None), "CParser", None)  # None without libyaml
+
+
+class _FastComposer(*((_CParser,) if _CParser else ()), _Resolver):  # type: ignore[misc]
+    """libyaml's composer (C, about 20 times faster) with the resolver above. It counts
+    nothing and composes recursively in C, so `_fast_node` lets it compose only text whose
+    events (an iteration, not a recursion) stay within the limits."""
+
+    def __init__(self, stream: str) -> None:
+        _CParser.__init__(self, stream)
+        _Resolver.__init__(self)
+
+
+# Where libyaml and PyYAML part (found by fuzzing, tests/lsp/test_text.py): tabs, tags, `? ` keys, flow
+# mappings and pairs in flow lists (PyYAML refuses some that libyaml takes, or places a key or an
+# empty value one column apart), a byte order mark inside the text and line breaks other than \n
+# (columns), and the end of a text without a final line break (the collections closing there).
+_DIFFERENT = re.compile("[\t\r\x85\u2028\u2029\ufeff{!]|\\?(?:\\s|$)|\\[[^\\]]*:")
+
+
+def _fast_node(text: str, limits: Limits) -> Node | None:
+    """The node of `text` composed by libyaml, or None when it is not sure to be what _Composer
+    makes: libyaml is missing, or the text is malformed or beyond a limit (then _Composer
+    reports it, in its words)."""
+    if not text.endswith("\n") or _DIFFERENT.search(text):
+        return None
+    if _CParser is None:
+        return None
+    events = _FastComposer(text)
+    try:
+        depth = aliases = 0
+        while events.check_event():
+            event = events.get_event()
+            if isinstance(event, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > limits.depth:
+                    return None
+            elif isinstance(event, yaml.CollectionEndEvent):
+                depth -= 1
+            elif isinstance(event, yaml.AliasEvent):
+                aliases += 1
+                if aliases > limits.aliases:
+                    return None
+        loader = _FastComposer(text)
+        try:
+            return loader.get_single_node()
+        finally:
+            loader.dispose()
+    except yaml.YAMLError:
+        return None
+    finally:
+        events.dispose()
+
+
+def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS, fast: bool = False) -> Document | None:
+    """Parse YAML text that came from `file`.
+
+    fast: compose with libyaml where it is sure to give the same nodes (`mpc lsp`, which parses
+    a buffer on each keystroke); the same Document and diagnostics, sooner.
+    """
     if len(text) > limits.bytes:
         sink.error(Span.of_file(file), "E0113", f"'{file}' has {len(text)} characters; "
                    f"at most {limits.bytes} are read")
         return None
+    node = _fast_node(text, limits) if fast else None
+    if node is not None:
+        return _document(node, file, sink, limits)
     loader: _Composer | None = None
     try:
         loader = _Composer(text, limits)  # the reader checks the characters already
@@ -318,6 +410,10 @@ def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS) -> Document
     if node is None:
         sink.error(Span.of_file(file), "E0104", f"'{file}' is empty")
         return None
+    return _document(node, file, sink, limits)
+
+
+def _document(node: Node, file: str, sink: Sink, limits: Limits) -> Document | None:
     doc = Document(file, None)
     builder = _Builder(doc, sink, limits)
     doc.data = builder.build(node, ())

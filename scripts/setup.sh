@@ -29,6 +29,7 @@ command -v git-lfs >/dev/null || packages+=(git-lfs)
 command -v chromium >/dev/null || packages+=(chromium)  # the test of `mpc view` loads its page
 command -v rsync >/dev/null || packages+=(rsync)
 command -v npm >/dev/null || packages+=(npm)
+command -v nvim >/dev/null || packages+=(neovim)  # the editor test of `mpc lsp` (tests/lsp/test_neovim.py)
 "$PYTHON" -c "import ensurepip, venv" 2>/dev/null || packages+=(python3-venv)
 if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
   echo "setup: apt-get install ${packages[*]}" >&2

@@ -202,4 +202,4 @@ def test_mpc_version_hashes_the_sources_of_mpc_and_nothing_else() -> None:
             "backends/urdf.py"} <= names
     packages = {name.split("/")[0] for name in names}
     assert packages == {"backends", "checks", "cli", "compiler", "core", "deploy", "grammar", "ir",
-                        "pipeline"}
+                        "lsp", "pipeline"}

@@ -1,0 +1,137 @@
+"""Go to definition (a link or joint into its model file's line; `derived_base`, `defaults` and
+`basefile` into their file), document symbols, rename of a link or joint across the definition,
+and code actions that apply a did-you-mean.
+
+What this does not do: find what is under the cursor (lookup.py).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from lsprotocol import types as lsp
+
+from mpc.core.span import Span
+from mpc.ir.robot import Joint
+from mpc.lsp.analysis import Analysis
+from mpc.lsp.diagnostics import DID_YOU_MEAN, location, uri_of
+from mpc.lsp.lookup import element, target
+from mpc.lsp.text import Lines
+
+_FILE_KEYS = ("derived_base", "defaults", "basefile")
+
+
+def definition(analysis: Analysis, position: lsp.Position) -> lsp.Location | None:
+    lines = Lines(analysis.text)
+    found = target(analysis, position.line, lines.column(position))
+    if found is None:
+        return None
+    if not found.on_key and found.key in _FILE_KEYS:
+        return _file(analysis, found.key, found.word, found.span.line)
+    if found.kinds:
+        hit = element(analysis, found.word, found.kinds)
+        if hit is not None and hit[1].span is not None:
+            return _in_source(hit[1].span, "joint" if isinstance(hit[1], Joint) else "link", found.word)
+    return None
+
+
+_XACRO = " (expanded by xacro)"
+
+
+def _in_source(span: Span, kind: str, name: str) -> lsp.Location:
+    """Where the element is written. A xacro model's spans are lines of the URDF xacro expanded
+    it to (backends/xacro_reader.py): there, the line of the xacro file that writes the element
+    with that very name, else the file's first line (a name that a macro puts together)."""
+    if not span.file.endswith(_XACRO):
+        return location(span)
+    path = Path(span.file[:-len(_XACRO)])
+    pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name)}[\"']")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        text = ""
+    match = pattern.search(text)
+    if match is None:
+        return location(Span(str(path), 1, 1, 1, 1))
+    lines = Lines(text)
+    line = text.count("\n", 0, match.start()) + 1
+    col = match.start() - (text.rfind("\n", 0, match.start()) + 1) + 1
+    return lsp.Location(uri=uri_of(str(path)), range=lines.range(Span(str(path), line, col, line,
+                                                                      col + len(match.group()))))
+
+
+def _file(analysis: Analysis, key: str, written: str, line: int) -> lsp.Location | None:
+    """The file a `derived_base`, `defaults` or `basefile` value (on 1-based `line`) names."""
+    path: Path | None = (analysis.path.parent / written) if "://" not in written else None
+    for inp in analysis.program.inputs.values() if analysis.program is not None else ():
+        if inp.span.line == line and inp.path is not None:  # package:// paths, as the compiler found them
+            path = inp.path
+    if path is None or not path.is_file():
+        return None
+    start = lsp.Position(line=0, character=0)
+    return lsp.Location(uri=uri_of(str(path)), range=lsp.Range(start=start, end=start))
+
+
+def symbols(analysis: Analysis) -> list[lsp.DocumentSymbol]:
+    """The keys of the buffer as a tree (sections, entries, their keys), three levels deep."""
+    doc = analysis.doc
+    if doc is None:
+        return []
+    lines = Lines(analysis.text)
+    by_parent: dict[tuple, list[lsp.DocumentSymbol]] = {}
+    for path in sorted(doc.keys, key=len, reverse=True):
+        if len(path) > 4 or not all(isinstance(p, str) for p in path):
+            continue
+        key_span = doc.keys[path]
+        value = doc.values.get(path, key_span)
+        whole = Span(key_span.file, key_span.line, key_span.col, value.end_line, value.end_col)
+        kind = lsp.SymbolKind.Namespace if isinstance(doc.data_at(path), dict) else lsp.SymbolKind.Field
+        symbol = lsp.DocumentSymbol(name=str(path[-1]), kind=kind, range=lines.range(whole),
+                                    selection_range=lines.range(key_span),
+                                    children=by_parent.pop(path, None))
+        by_parent.setdefault(path[:-1], []).insert(0, symbol)
+    out = by_parent.get((), [])
+    out.sort(key=lambda s: (s.range.start.line, s.range.start.character))
+    for symbol in out:
+        _sort(symbol)
+    return out
+
+
+def _sort(symbol: lsp.DocumentSymbol) -> None:
+    if symbol.children:
+        symbol.children.sort(key=lambda s: (s.range.start.line, s.range.start.character))
+        for child in symbol.children:
+            _sort(child)
+
+
+def rename(analysis: Analysis, position: lsp.Position, new_name: str) -> lsp.WorkspaceEdit | None:
+    """Every place of the definition that names the same link or joint, renamed."""
+    lines = Lines(analysis.text)
+    found = target(analysis, position.line, lines.column(position))
+    if found is None or not set(found.kinds) & {"link", "joint"}:
+        return None
+    edits = []
+    for site in analysis.sites:
+        if not set(site.kinds) & set(found.kinds) or site.span.line != site.span.end_line:
+            continue
+        written = lines.line(site.span.line - 1)[site.span.col - 1:site.span.end_col - 1]
+        quote = written[:1] if written[:1] in "'\"" and written[-1:] == written[:1] else ""
+        if written.strip("'\"") == found.word:
+            edits.append(lsp.TextEdit(range=lines.range(site.span), new_text=f"{quote}{new_name}{quote}"))
+    if not any(e.range == lines.range(found.span) for e in edits):
+        edits.append(lsp.TextEdit(range=lines.range(found.span), new_text=new_name))
+    return lsp.WorkspaceEdit(changes={uri_of(str(analysis.path)): edits})
+
+
+def code_actions(uri: str, diagnostics: list[lsp.Diagnostic]) -> list[lsp.CodeAction]:
+    """A quick fix for every diagnostic that says 'did you mean …?': write that instead."""
+    out = []
+    for d in diagnostics:
+        match = DID_YOU_MEAN.search(d.message)
+        if match is None or d.range.start.line != d.range.end.line:
+            continue
+        out.append(lsp.CodeAction(title=f"Change to '{match.group(1)}'", kind=lsp.CodeActionKind.QuickFix,
+                                  diagnostics=[d], is_preferred=True, edit=lsp.WorkspaceEdit(
+                                      changes={uri: [lsp.TextEdit(range=d.range, new_text=match.group(1))]})))
+    return out
