@@ -289,14 +289,17 @@ def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path
     """The meshes of an export (urdf, sdf, mjcf): those its file references, in `mesh_format`
     (their plan, or None after an error), then the same in each `additional` format
     (`additional_meshes`: written beside, referenced by nothing)."""
-    files = plan(robot, mesh_format, sink, export_span)
-    if files is None or not copy(files, out, sink, export_span, robot):
-        return None
-    for fmt in additional:
-        extra = plan(robot, fmt, sink, export_span)
-        if extra is None or not copy(extra, out, sink, export_span, robot):
+    from mpc.core.profile import stage
+
+    with stage("meshes"):
+        files = plan(robot, mesh_format, sink, export_span)
+        if files is None or not copy(files, out, sink, export_span, robot):
             return None
-    return files
+        for fmt in additional:
+            extra = plan(robot, fmt, sink, export_span)
+            if extra is None or not copy(extra, out, sink, export_span, robot):
+                return None
+        return files
 
 
 def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: Path,
