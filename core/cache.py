@@ -1,6 +1,7 @@
 """Where mpc keeps what it can compute again: `$MPC_CACHE_DIR`, else `$XDG_CACHE_HOME/mpc`,
-else `~/.cache/mpc`, one folder per kind (git checkouts, meshes); and entries that carry
-the hash of their bytes, so that a damaged one is never returned."""
+else `~/.cache/mpc`, one folder per kind (git checkouts, meshes); entries that carry the
+hash of their bytes, so that a damaged one is never returned; and the lock that lets one
+process compute an entry while the others that need it wait for it (`single_flight`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import contextlib
 import hashlib
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 
@@ -27,6 +29,7 @@ def cache_dir(kind: str) -> Path:
 # The files an entry keeps beside it: its hash, and the notes its computation left (a mesh's
 # broken DAE references, W0605). They are touched, removed and passed on with the entry.
 SIDECARS = (".sha256", ".ignored")
+LOCK = ".lock"  # beside an entry: `single_flight`; neither part of the entry nor removed with it
 
 
 def _hash_file(entry: Path) -> Path:
@@ -84,3 +87,42 @@ def remove_entry(entry: Path) -> None:
             shutil.rmtree(path)
         elif path.exists() or path.is_symlink():
             path.unlink()
+
+
+# -- single flight -----------------------------------------------------------------------------
+# Two processes (workers of `mpc run`, concurrent `mpc compile`s) that miss the same entry
+# would both compute it. Each takes an exclusive lock on `<entry>.lock` first and looks again
+# once it holds it: the second finds the first's result. flock locks belong to the open file,
+# so a process that dies (killed, crashed) releases its lock with it: a lock file left behind
+# is never stale, and the next process simply takes it. A process holds at most two such locks,
+# always a derived entry's before its source's, so no two processes wait for each other.
+
+
+@contextlib.contextmanager
+def single_flight(entry: Path) -> Iterator[None]:
+    """Hold the lock of `entry` (waiting while another process holds it); raises OSError
+    when the lock cannot be made (a read-only cache: the caller computes without it)."""
+    import fcntl
+
+    lock = entry.with_name(entry.name + LOCK)
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def trace(event: str) -> None:
+    """Append `event` (one line) to `$MPC_CACHE_TRACE` when it is set: each computation of an
+    entry, so that a test or a user can count them. Silent when the file cannot be written."""
+    path = os.environ.get("MPC_CACHE_TRACE")
+    if not path:
+        return
+    with contextlib.suppress(OSError):
+        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            os.write(fd, f"{os.getpid()} {event}\n".encode())
+        finally:
+            os.close(fd)

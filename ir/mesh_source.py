@@ -1,0 +1,138 @@
+"""A mesh file → its triangles, parsed once per content hash, ever.
+
+The first read of a file (by the sha256 of its bytes and its format) keeps its *normalized
+form* in the cache (core/cache.py: `meshes/normal/`): an `.npz` of the vertices, triangles,
+texture coordinates and vertex colours as the reader gave them, plus its name and material
+name (an OBJ export writes them), and the broken DAE references that were ignored to read
+it. Every later read, by any build, process or output format, rebuilds the same trimesh
+from it, so what is derived (STL, OBJ, bobj, a mirror, a hull) is byte for byte what the
+parsed file gives. Two processes that need the same missing entry parse the file once
+(`single_flight`). A mesh whose look the form cannot carry (a texture image) is parsed
+directly each time. Nothing here writes outside the cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+FORM = "1"  # changes when the normalized form or the readers change, so old entries go unused
+
+
+def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
+    """The file's mesh as its reader gives it (unscaled, no ops); raises what the readers
+    raise. ignored: receives the broken references of a DAE file that were ignored to read it."""
+    from mpc.core.cache import cache_dir, load_entry, notes_file, remove_entry, single_flight
+
+    data = path.read_bytes()
+    suffix = path.suffix.lower()
+    digest = hashlib.sha256(data + f"|{FORM}|{suffix}".encode()).hexdigest()
+    entry = cache_dir("meshes") / "normal" / digest[:2] / f"{digest}.npz"
+    try:
+        with single_flight(entry):
+            stored, bad = load_entry(entry)
+            if bad is not None:
+                remove_entry(entry)
+            if stored is not None:
+                notes = notes_file(entry)
+                if ignored is not None and notes.is_file():
+                    ignored.extend(notes.read_text(encoding="utf-8").splitlines())
+                return _rebuild(stored)
+            broken: list[str] = []
+            mesh = _parse(path, data, suffix, broken)
+            if ignored is not None:
+                ignored.extend(broken)
+            form = _normalized(mesh)
+            if form is not None:
+                _store(entry, form, broken)
+            return mesh
+    except OSError:  # a cache that cannot be used (read-only, full): the file is parsed instead
+        broken = []
+        mesh = _parse(path, data, suffix, broken)
+        if ignored is not None:
+            ignored.extend(broken)
+        return mesh
+
+
+def _parse(path: Path, data: bytes, suffix: str, broken: list[str]) -> trimesh.Trimesh:
+    from mpc.core.cache import trace
+
+    trace(f"parse {path.name} {hashlib.sha256(data).hexdigest()[:12]}")
+    if suffix == ".bobj":
+        from mpc.core import bobj
+
+        return bobj.loads(data)
+    if suffix == ".dae":
+        from mpc.core import collada
+
+        mesh, found = collada.read(path)
+        broken.extend(found)
+        return mesh
+    return trimesh.load(path, force="mesh", process=False)
+
+
+def _normalized(mesh: trimesh.Trimesh) -> bytes | None:
+    """The npz of what the exports and ops read from the mesh; None when it has more
+    (a texture image, cached normals, another kind of visual)."""
+    from trimesh.visual import ColorVisuals, TextureVisuals
+
+    arrays: dict[str, np.ndarray] = {"vertices": np.asarray(mesh.vertices), "faces": np.asarray(mesh.faces)}
+    meta: dict[str, object] = {"metadata": {k: v for k, v in mesh.metadata.items()
+                                            if isinstance(v, (str, int, float))}}
+    if len(meta["metadata"]) != len(mesh.metadata) or "vertex_normals" in mesh._cache.cache:  # type: ignore[arg-type]
+        return None
+    visual = mesh.visual
+    if isinstance(visual, TextureVisuals):
+        material = visual.material
+        if material is not None and (getattr(material, "image", None) is not None
+                                     or getattr(material, "baseColorTexture", None) is not None):
+            return None
+        meta["texture"] = True
+        if material is not None:
+            simple = material.to_simple() if hasattr(material, "to_simple") else material
+            if type(simple).__name__ != "SimpleMaterial" or any(
+                    getattr(simple, k, None) is not None for k in ("image",)):
+                return None
+            meta["material"] = {"name": simple.name, "ambient": simple.ambient.tolist(),
+                                "diffuse": simple.diffuse.tolist(), "specular": simple.specular.tolist(),
+                                "glossiness": float(simple.glossiness)}
+        if visual.uv is not None:
+            arrays["uv"] = np.asarray(visual.uv)
+    elif isinstance(visual, ColorVisuals):
+        if visual.kind is not None:
+            return None
+    else:
+        return None
+    arrays["meta"] = np.frombuffer(json.dumps(meta, sort_keys=True).encode(), dtype=np.uint8)
+    out = io.BytesIO()
+    np.savez(out, **arrays)
+    return out.getvalue()
+
+
+def _rebuild(data: bytes) -> trimesh.Trimesh:
+    from trimesh.visual import TextureVisuals
+    from trimesh.visual.material import SimpleMaterial
+
+    with np.load(io.BytesIO(data), allow_pickle=False) as z:
+        meta = json.loads(z["meta"].tobytes())
+        mesh = trimesh.Trimesh(z["vertices"], z["faces"], process=False, metadata=meta["metadata"])
+        if meta.get("texture"):
+            material = meta.get("material")
+            mesh.visual = TextureVisuals(
+                uv=z["uv"] if "uv" in z.files else None,
+                material=None if material is None else SimpleMaterial(**material))
+    return mesh
+
+
+def _store(entry: Path, form: bytes, broken: list[str]) -> None:
+    from mpc.core.cache import notes_file, store_entry
+    from mpc.core.files import write_atomic
+
+    if broken:  # written before the entry, so that an entry never lacks its record
+        write_atomic(notes_file(entry), "".join(f"{line}\n" for line in sorted(set(broken))))
+    store_entry(entry, form)
