@@ -30,6 +30,7 @@ def cache_dir(kind: str) -> Path:
 # broken DAE references, W0605). They are touched, removed and passed on with the entry.
 SIDECARS = (".sha256", ".ignored")
 LOCK = ".lock"  # beside an entry: `single_flight`; neither part of the entry nor removed with it
+BESIDE = (*SIDECARS, LOCK)  # every file that is kept beside an entry and is no entry itself
 
 
 def _hash_file(entry: Path) -> Path:
@@ -108,7 +109,11 @@ def single_flight(entry: Path) -> Iterator[None]:
     lock.parent.mkdir(parents=True, exist_ok=True)
     fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            trace(f"wait {entry.name}")  # another process computes it
+            fcntl.flock(fd, fcntl.LOCK_EX)
         yield
     finally:
         os.close(fd)  # releases the lock

@@ -27,12 +27,11 @@ FORM = "1"  # changes when the normalized form or the readers change, so old ent
 def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
     """The file's mesh as its reader gives it (unscaled, no ops); raises what the readers
     raise. ignored: receives the broken references of a DAE file that were ignored to read it."""
-    from mpc.core.cache import cache_dir, load_entry, notes_file, remove_entry, single_flight
+    from mpc.core.cache import load_entry, notes_file, remove_entry, single_flight
 
     data = path.read_bytes()
     suffix = path.suffix.lower()
-    digest = hashlib.sha256(data + f"|{FORM}|{suffix}".encode()).hexdigest()
-    entry = cache_dir("meshes") / "normal" / digest[:2] / f"{digest}.npz"
+    entry = entry_of(data, suffix)
     try:
         with single_flight(entry):
             stored, bad = load_entry(entry)
@@ -57,6 +56,14 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
         if ignored is not None:
             ignored.extend(broken)
         return mesh
+
+
+def entry_of(data: bytes, suffix: str) -> Path:
+    """Where the cache keeps the normalized form of a file with these bytes and extension."""
+    from mpc.core.cache import cache_dir
+
+    digest = hashlib.sha256(data + f"|{FORM}|{suffix}".encode()).hexdigest()
+    return cache_dir("meshes") / "normal" / digest[:2] / f"{digest}.npz"
 
 
 def _parse(path: Path, data: bytes, suffix: str, broken: list[str]) -> trimesh.Trimesh:
