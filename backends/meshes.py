@@ -230,11 +230,9 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
-    from mpc.core.cache import cache_dir
+    from mpc.core.cache import cache_dir, file_digest
 
-    h = hashlib.sha256(src.read_bytes())
-    h.update(f"{ENGINE}|{ops!r}|{suffix}".encode())
-    digest = h.hexdigest()
+    digest = hashlib.sha256(f"{file_digest(src)}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 

@@ -5,8 +5,9 @@ both attached to the torso, exporting urdf, sdf, smurf and joint_limits; written
 example-robot-data into a temporary folder. Cold: an empty MPC_CACHE_DIR; warm: the same
 build again on the filled cache. Each is `mpc compile` in a fresh process, run several
 times; the figures are medians. Peak memory is the largest RSS of a build process (and its
-mesh workers). Stages come from MPC_PROFILE (core/profile.py); "startup" is the rest of the
-process's time (the interpreter and imports).
+mesh workers). A first build, not counted, compiles Python's bytecode. Stages come from
+MPC_PROFILE (core/profile.py); "startup" is the rest of the process's time (the interpreter
+and imports). Figures on a loaded machine: compare the CPU times.
 
 Run: python bench/bench_assembly.py [--runs N]
 """
@@ -51,9 +52,11 @@ DEFINITION = """model:
 
 
 def build(spec: Path, out: Path, cache: Path, profile: Path) -> tuple[float, float, dict[str, float]]:
-    """One `mpc compile` in a fresh process: (seconds, peak RSS in MiB, seconds per stage)."""
+    """One `mpc compile` in a fresh process: (seconds, peak RSS in MiB, seconds per stage; "cpu" is
+    the CPU time of the process and its mesh workers)."""
     profile.unlink(missing_ok=True)
     env = {**os.environ, "MPC_CACHE_DIR": str(cache), "MPC_PROFILE": str(profile)}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # users' builds import compiled bytecode
     shutil.rmtree(out, ignore_errors=True)
     t0 = time.perf_counter()
     child = subprocess.Popen([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o", str(out)],
@@ -64,10 +67,11 @@ def build(spec: Path, out: Path, cache: Path, profile: Path) -> tuple[float, flo
     if os.waitstatus_to_exitcode(status) != 0:
         raise SystemExit(f"the build failed:\n{output}")
     stages: dict[str, float] = {}
-    for line in profile.read_text().splitlines():
+    for line in (profile.read_text().splitlines() if profile.exists() else []):  # an mpc without stages
         for name, value in json.loads(line)["stages"].items():
             stages[name] = stages.get(name, 0.0) + value
     stages["startup"] = max(0.0, seconds - sum(stages.values()))
+    stages["cpu"] = usage.ru_utime + usage.ru_stime
     return seconds, usage.ru_maxrss / 1024, stages  # the child's peak, its mesh workers' included
 
 
@@ -83,6 +87,7 @@ def main() -> None:
         spec = tmp / "assembly.yml"
         spec.write_text(DEFINITION.format(talos=robots / "talos_data/robots/talos_full_v2.urdf",
                                           ur5=robots / "ur_description/urdf/ur5_robot.urdf"))
+        build(spec, tmp / "out", tmp / "cache-first", tmp / "profile")  # compiles Python's bytecode
         results: dict[str, list[tuple[float, float, dict[str, float]]]] = {"cold": [], "warm": []}
         for run in range(args.runs):
             cache = tmp / f"cache{run}"
@@ -90,13 +95,14 @@ def main() -> None:
             results["warm"].append(build(spec, tmp / "out", cache, tmp / "profile"))
         links = (tmp / "out/urdf/talos_assembly.urdf").read_text().count("<link ")
         print(f"the assembly: {links} links; load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
-        names = sorted({n for runs in results.values() for _, _, s in runs for n in s},
+        names = sorted({n for runs in results.values() for _, _, s in runs for n in s} - {"cpu"},
                        key=lambda n: -statistics.median(s.get(n, 0.0) for _, _, s in results["cold"]))
         for label, runs in results.items():
             seconds = statistics.median(r[0] for r in runs)
             peak = max(r[1] for r in runs)
+            cpu = statistics.median(s["cpu"] for _, _, s in runs)
             print(f"{label}: {seconds:6.3f} s (median of {len(runs)}; min {min(r[0] for r in runs):.3f}), "
-                  f"peak {peak:.0f} MiB")
+                  f"CPU {cpu:.3f} s, peak {peak:.0f} MiB")
             print("  " + ", ".join(f"{n} {statistics.median(s.get(n, 0.0) for _, _, s in runs):.3f}"
                                    for n in names))
         cold, warm = (statistics.median(r[0] for r in results[k]) for k in ("cold", "warm"))

@@ -9,6 +9,7 @@ import contextlib
 import hashlib
 import os
 import shutil
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -131,3 +132,36 @@ def trace(event: str) -> None:
             os.write(fd, f"{os.getpid()} {event}\n".encode())
         finally:
             os.close(fd)
+
+
+# -- file digests ------------------------------------------------------------------------------
+# A warm build finds its mesh entries by the hash of each source file. The hash is remembered by
+# the file's identity and status (path, device, inode, size, modification and change times to
+# the nanosecond), as git's index does, in `digests/`; a file changed since gets another key.
+# A file modified in the last seconds is hashed every time (its time stamp may not yet show
+# a change made in the same tick).
+_digests: dict[tuple[object, ...], str] = {}
+_SETTLED_NS = 2_000_000_000
+
+
+def file_digest(path: Path) -> str:
+    """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
+    st = path.stat()
+    identity = (str(path.resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+    if identity in _digests:
+        return _digests[identity]
+    name = hashlib.sha256(repr(identity).encode()).hexdigest()
+    memo = cache_dir("digests") / name[:2] / name
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        known = memo.read_text(encoding="ascii").strip()
+        if len(known) == 64 and all(c in "0123456789abcdef" for c in known):
+            _digests[identity] = known
+            return known
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
+        _digests[identity] = digest
+        from mpc.core.files import write_atomic
+
+        with contextlib.suppress(OSError):
+            write_atomic(memo, digest + "\n")
+    return digest
