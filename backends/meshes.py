@@ -232,7 +232,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     from mpc.core.cache import cache_dir, file_digest
 
-    digest = hashlib.sha256(f"{file_digest(src)}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
+    # The name too: an OBJ names its object after the file (mesh_source.entry_of).
+    digest = hashlib.sha256(f"{file_digest(src)}|{src.name}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 

@@ -9,7 +9,6 @@ import contextlib
 import hashlib
 import os
 import shutil
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -102,13 +101,18 @@ def remove_entry(entry: Path) -> None:
 
 @contextlib.contextmanager
 def single_flight(entry: Path) -> Iterator[None]:
-    """Hold the lock of `entry` (waiting while another process holds it); raises OSError
-    when the lock cannot be made (a read-only cache: the caller computes without it)."""
+    """Hold the lock of `entry`, waiting while another process holds it. Where no lock can be
+    made (a read-only cache, a file in the way) the caller goes on without one: computing the
+    entry reports the cache's problem."""
     import fcntl
 
     lock = entry.with_name(entry.name + LOCK)
-    lock.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    except OSError:
+        yield
+        return
     try:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -135,33 +139,18 @@ def trace(event: str) -> None:
 
 
 # -- file digests ------------------------------------------------------------------------------
-# A warm build finds its mesh entries by the hash of each source file. The hash is remembered by
-# the file's identity and status (path, device, inode, size, modification and change times to
-# the nanosecond), as git's index does, in `digests/`; a file changed since gets another key.
-# A file modified in the last seconds is hashed every time (its time stamp may not yet show
-# a change made in the same tick).
+# A build finds its mesh entries by the hash of each source file, for each export and format:
+# the hash is remembered for the process by the file's identity and status (path, device,
+# inode, size, modification and change times to the nanosecond), as git's index does. It is
+# not remembered across processes: `mpc run` learns what a build depends on from the files it
+# reads (pipeline/fingerprint.py), so every build reads its meshes once.
 _digests: dict[tuple[object, ...], str] = {}
-_SETTLED_NS = 2_000_000_000
 
 
 def file_digest(path: Path) -> str:
     """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
     st = path.stat()
     identity = (str(path.resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
-    if identity in _digests:
-        return _digests[identity]
-    name = hashlib.sha256(repr(identity).encode()).hexdigest()
-    memo = cache_dir("digests") / name[:2] / name
-    with contextlib.suppress(OSError, UnicodeDecodeError):
-        known = memo.read_text(encoding="ascii").strip()
-        if len(known) == 64 and all(c in "0123456789abcdef" for c in known):
-            _digests[identity] = known
-            return known
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
-        _digests[identity] = digest
-        from mpc.core.files import write_atomic
-
-        with contextlib.suppress(OSError):
-            write_atomic(memo, digest + "\n")
-    return digest
+    if identity not in _digests:
+        _digests[identity] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _digests[identity]

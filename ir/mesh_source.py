@@ -1,6 +1,6 @@
 """A mesh file → its triangles, parsed once per content hash, ever.
 
-The first read of a file (by the sha256 of its bytes and its format) keeps its *normalized
+The first read of a file (by the sha256 of its bytes and its name) keeps its *normalized
 form* in the cache (core/cache.py: `meshes/normal/`): an `.npz` of the vertices, triangles,
 texture coordinates and vertex colours as the reader gave them, plus its name and material
 name (an OBJ export writes them), and the broken DAE references that were ignored to read
@@ -30,7 +30,7 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
     from mpc.core.cache import file_digest, load_entry, notes_file, remove_entry, single_flight, touch_entry
 
     suffix = path.suffix.lower()
-    entry = entry_of(file_digest(path), suffix)
+    entry = entry_of(file_digest(path), path.name)
     try:
         with single_flight(entry):
             stored, bad = load_entry(entry)
@@ -58,12 +58,13 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
         return mesh
 
 
-def entry_of(content: str, suffix: str) -> Path:
-    """Where the cache keeps the normalized form of a file with this content (its sha256)
-    and extension."""
+def entry_of(content: str, name: str) -> Path:
+    """Where the cache keeps the normalized form of a file with this content (its sha256) and
+    name: the readers name a mesh after its file when the format has no name for it (an OBJ
+    export writes that name), and read it by its extension."""
     from mpc.core.cache import cache_dir
 
-    digest = hashlib.sha256(f"{content}|{FORM}|{suffix}".encode()).hexdigest()
+    digest = hashlib.sha256(f"{content}|{FORM}|{name}".encode()).hexdigest()
     return cache_dir("meshes") / "normal" / digest[:2] / f"{digest}.npz"
 
 

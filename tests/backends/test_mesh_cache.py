@@ -22,7 +22,7 @@ import pytest
 from mpc.backends.meshes import _cached_path
 from mpc.core.diagnostics import Sink
 from tests.conftest import ERD, compile_file, definition, write
-from tests.fixtures import ARM_URDF
+from tests.fixtures import ARM_URDF, tetra_stl
 
 ROOT = Path(__file__).resolve().parents[2]
 FOREARM = ERD / "ur_description/meshes/ur5/visual/forearm.dae"
@@ -112,3 +112,20 @@ def test_a_warm_build_imports_no_mesh_library(tmp_path: Path, monkeypatch: pytes
     assert (tmp_path / "warm/meshes/stl/forearm.stl").read_bytes() == \
         (tmp_path / "cold/meshes/stl/forearm.stl").read_bytes()
     assert _warm_modules(ROOT / "examples/talos.yml", tmp_path / "talos", env) == "0 []"
+
+
+def test_files_with_the_same_bytes_keep_their_own_names(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """An OBJ names its object after the STL file it came from, even when another file with
+    the same bytes was parsed first (the normalized form is kept per content and name)."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    tetra_stl(tmp_path / "model/meshes/tetra.stl")
+    shutil.copyfile(tmp_path / "model/meshes/tetra.stl", tmp_path / "model/meshes/twin.stl")
+    urdf = ARM_URDF.replace("<collision>\n      <geometry><box size=\"0.05 0.05 0.4\"/></geometry>",
+                            "<collision>\n      <geometry><mesh filename=\"meshes/twin.stl\"/></geometry>")
+    assert "twin.stl" in urdf
+    write(tmp_path / "model/arm.urdf", urdf)
+    spec = write(tmp_path / "model/arm.yml", definition("arm.urdf", "obj", "arm"))
+    assert compile_file(spec, tmp_path / "out", Sink()).out is not None
+    for name in ("tetra", "twin"):
+        assert f"\no {name}.stl\n" in (tmp_path / f"out/meshes/obj/{name}.obj").read_text()
