@@ -259,12 +259,12 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
 
 
 def _start_method() -> str:
-    """fork, with trimesh imported once here for every worker; forkserver when forking is
-    unsafe: threads are running, or MuJoCo (and its GL context) is loaded."""
+    """fork, with trimesh imported once here for every worker; forkserver once MuJoCo is
+    loaded (its GL context and threads must not be copied into a worker). The workers run
+    only mesh code, which holds no lock of another thread across a fork."""
     import sys
-    import threading
 
-    if threading.active_count() > 1 or "mujoco" in sys.modules:
+    if "mujoco" in sys.modules:
         return "forkserver"
     import mpc.ir.mesh_props  # noqa: F401  (trimesh, shared by the forked workers)
 
