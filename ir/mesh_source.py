@@ -1,18 +1,19 @@
 """A mesh file → its triangles, parsed once per content hash, ever.
 
 The first read of a file (by the sha256 of its bytes and its name) keeps its *normalized
-form* in the cache (core/cache.py: `meshes/normal/`): an `.npz` of the vertices, triangles,
-texture coordinates and vertex colours as the reader gave them, plus its name and material
-name (an OBJ export writes them), and the broken DAE references that were ignored to read
-it. Every later read, by any build, process or output format, rebuilds the same trimesh
-from it, so what is derived (STL, OBJ, bobj, a mirror, a hull) is byte for byte what the
-parsed file gives. Two processes that need the same missing entry parse the file once
-(`single_flight`). A mesh whose look the form cannot carry (a texture image) is parsed
-directly each time. Nothing here writes outside the cache.
+form* in the cache (core/cache.py: `meshes/normal/`): an `.npz` of the vertices, triangles
+and texture coordinates as the reader gave them, plus its names and material (an OBJ export
+writes them), and the broken DAE references that were ignored to read it. Every later read,
+by any build, process or output format, rebuilds the same trimesh from it, so what is
+derived (STL, OBJ, bobj, a mirror, a hull) is byte for byte what the parsed file gives. Two
+processes that need the same missing entry parse the file once (`single_flight`). A mesh
+with more than the form carries (colours) is parsed each time. Nothing here writes outside
+the cache.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import json
@@ -29,32 +30,28 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
     raise. ignored: receives the broken references of a DAE file that were ignored to read it."""
     from mpc.core.cache import file_digest, load_entry, notes_file, remove_entry, single_flight, touch_entry
 
-    suffix = path.suffix.lower()
     entry = entry_of(file_digest(path), path.name)
-    try:
-        with single_flight(entry):
+    with single_flight(entry):
+        try:
             stored, bad = load_entry(entry)
             if bad is not None:
                 remove_entry(entry)
-            if stored is not None:
-                touch_entry(entry)  # used: a CI job passes it on
-                notes = notes_file(entry)
-                if ignored is not None and notes.is_file():
-                    ignored.extend(notes.read_text(encoding="utf-8").splitlines())
-                return _rebuild(stored)
-            broken: list[str] = []
-            mesh = _parse(path, suffix, broken)
-            if ignored is not None:
-                ignored.extend(broken)
-            form = _normalized(mesh)
-            if form is not None:
-                _store(entry, form, broken)
-            return mesh
-    except OSError:  # a cache that cannot be used (read-only, full): the file is parsed instead
-        broken = []
-        mesh = _parse(path, suffix, broken)
+        except OSError:  # a cache that cannot be used: the file is parsed
+            stored = None
+        if stored is not None:
+            touch_entry(entry)  # used: a CI job passes it on
+            notes = notes_file(entry)
+            if ignored is not None and notes.is_file():
+                ignored.extend(notes.read_text(encoding="utf-8").splitlines())
+            return _rebuild(stored)
+        broken: list[str] = []
+        mesh = _parse(path, path.suffix.lower(), broken)
         if ignored is not None:
             ignored.extend(broken)
+        form = _normalized(mesh)
+        if form is not None:
+            with contextlib.suppress(OSError):  # a read-only or full cache: parsed again next time
+                _store(entry, form, broken)
         return mesh
 
 
@@ -86,35 +83,36 @@ def _parse(path: Path, suffix: str, broken: list[str]) -> trimesh.Trimesh:
 
 
 def _normalized(mesh: trimesh.Trimesh) -> bytes | None:
-    """The npz of what the exports and ops read from the mesh; None when it has more
-    (a texture image, cached normals, another kind of visual)."""
+    """The npz of what the exports and ops read from the mesh; None when it has more (vertex
+    or face colours, normals from the file, metadata that is no text or number): such a mesh
+    is parsed each time. A texture image is not kept: no output reads it (an OBJ names its
+    material file, which mpc does not write), nor does any mesh op."""
     from trimesh.visual import ColorVisuals, TextureVisuals
+    from trimesh.visual.material import SimpleMaterial
 
-    arrays: dict[str, np.ndarray] = {"vertices": np.asarray(mesh.vertices), "faces": np.asarray(mesh.faces)}
-    meta: dict[str, object] = {"metadata": {k: v for k, v in mesh.metadata.items()
-                                            if isinstance(v, (str, int, float))}}
-    if len(meta["metadata"]) != len(mesh.metadata) or "vertex_normals" in mesh._cache.cache:  # type: ignore[arg-type]
+    metadata = {k: v for k, v in mesh.metadata.items() if isinstance(v, str | int | float)}
+    if len(metadata) != len(mesh.metadata) or "vertex_normals" in mesh._cache.cache:
         return None
+    arrays: dict[str, np.ndarray] = {"vertices": np.asarray(mesh.vertices), "faces": np.asarray(mesh.faces)}
+    meta: dict[str, object] = {"metadata": metadata}
     visual = mesh.visual
-    if isinstance(visual, TextureVisuals):
-        material = visual.material
-        if material is not None and (getattr(material, "image", None) is not None
-                                     or getattr(material, "baseColorTexture", None) is not None):
-            return None
+    if isinstance(visual, ColorVisuals) and visual.kind is None:
+        pass  # no colours
+    elif isinstance(visual, TextureVisuals):
         meta["texture"] = True
-        if material is not None:
-            simple = material.to_simple() if hasattr(material, "to_simple") else material
-            if type(simple).__name__ != "SimpleMaterial" or any(
-                    getattr(simple, k, None) is not None for k in ("image",)):
-                return None
-            meta["material"] = {"name": simple.name, "ambient": simple.ambient.tolist(),
-                                "diffuse": simple.diffuse.tolist(), "specular": simple.specular.tolist(),
-                                "glossiness": float(simple.glossiness)}
         if visual.uv is not None:
             arrays["uv"] = np.asarray(visual.uv)
-    elif isinstance(visual, ColorVisuals):
-        if visual.kind is not None:
-            return None
+        material = visual.material
+        if material is not None:
+            simple = material.to_simple() if hasattr(material, "to_simple") else material
+            if not isinstance(simple, SimpleMaterial):
+                return None
+            try:
+                meta["material"] = {"name": str(simple.name), "glossiness": float(simple.glossiness),
+                                    **{k: np.asarray(getattr(simple, k)).tolist()
+                                       for k in ("ambient", "diffuse", "specular")}}
+            except (TypeError, ValueError):  # a material with parts missing: not kept
+                return None
     else:
         return None
     arrays["meta"] = np.frombuffer(json.dumps(meta, sort_keys=True).encode(), dtype=np.uint8)

@@ -129,3 +129,18 @@ def test_files_with_the_same_bytes_keep_their_own_names(tmp_path: Path,
     assert compile_file(spec, tmp_path / "out", Sink()).out is not None
     for name in ("tetra", "twin"):
         assert f"\no {name}.stl\n" in (tmp_path / f"out/meshes/obj/{name}.obj").read_text()
+
+
+def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """STL and OBJ (mirrored too) from one parse of the DAE; a later build's bobj from none."""
+    spec = _arm(tmp_path / "model")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
+    text = spec.read_text()
+    spec.write_text(text + "    - {type: urdf, mesh_format: obj, filename_suffix: _obj}\n")
+    assert compile_file(spec, tmp_path / "one", Sink()).out is not None
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse"]
+    spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
+    assert compile_file(spec, tmp_path / "two", Sink()).out is not None
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
