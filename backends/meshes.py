@@ -253,7 +253,9 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context(_start_method())) as pool:
+        context = multiprocessing.get_context(_start_method())
+        with ProcessPoolExecutor(workers, mp_context=context, initializer=_environment,
+                                 initargs=(dict(os.environ),)) as pool:
             results = list(pool.map(_materialise, *zip(*jobs, strict=True)))
     return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
 
@@ -269,6 +271,13 @@ def _start_method() -> str:
     import mpc.ir.mesh_props  # noqa: F401  (trimesh, shared by the forked workers)
 
     return "fork"
+
+
+def _environment(environ: dict[str, str]) -> None:
+    """A worker's environment is the build's: a forkserver's workers inherit the one it was
+    started with, and the cache folder (MPC_CACHE_DIR) may have changed since."""
+    os.environ.clear()
+    os.environ.update(environ)
 
 
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:

@@ -8,7 +8,6 @@ one dictionary lookup and nothing is written. Nothing here prints or changes a b
 from __future__ import annotations
 
 import atexit
-import json
 import os
 import time
 from collections.abc import Iterator
@@ -50,6 +49,8 @@ def _write(pid: int) -> None:
     path = os.environ.get("MPC_PROFILE")
     if not path or os.getpid() != pid or not _totals:
         return
+    import json
+
     try:
         with open(path, "a", encoding="utf-8") as f:
             f.write(json.dumps({"pid": pid, "stages": {k: round(v, 6) for k, v in _totals.items()}}) + "\n")
