@@ -230,34 +230,74 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
-    from mpc.core.cache import cache_dir
+    from mpc.core.cache import cache_dir, file_digest
 
-    h = hashlib.sha256(src.read_bytes())
-    h.update(f"{ENGINE}|{ops!r}|{suffix}".encode())
-    digest = h.hexdigest()
+    # The name too: an OBJ names its object after the file (mesh_source.entry_of).
+    digest = hashlib.sha256(f"{file_digest(src)}|{src.name}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 
 def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
     """Materialise each job into its cache path; {cache path: (code, problem)} for those
-    that failed."""
-    if len(jobs) < 4:
+    that failed. Several jobs run in a pool of processes, one per core; the first job of each
+    source file goes first, so that distinct files are parsed side by side rather than one
+    worker waiting for another's parse of the same file (mesh_source.read's single flight)."""
+    firsts: dict[Path, int] = {}
+    order = sorted(range(len(jobs)), key=lambda i: (firsts.setdefault(jobs[i][0], len(firsts))
+                                                   if jobs[i][0] not in firsts else len(jobs) + i))
+    jobs = [jobs[i] for i in order]
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if workers < 2 or len(jobs) < 3:
         results = [_materialise(*job) for job in jobs]
     else:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        workers = min(len(jobs), os.cpu_count() or 1)
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        context = multiprocessing.get_context(_start_method())
+        with ProcessPoolExecutor(workers, mp_context=context, initializer=_environment,
+                                 initargs=(dict(os.environ),)) as pool:
             results = list(pool.map(_materialise, *zip(*jobs, strict=True)))
     return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
 
 
+def _start_method() -> str:
+    """fork, with trimesh imported once here for every worker; forkserver once MuJoCo is
+    loaded (its GL context and threads must not be copied into a worker). The workers run
+    only mesh code, which holds no lock of another thread across a fork."""
+    import sys
+
+    if "mujoco" in sys.modules:
+        return "forkserver"
+    import mpc.ir.mesh_props  # noqa: F401  (trimesh, shared by the forked workers)
+
+    return "fork"
+
+
+def _environment(environ: dict[str, str]) -> None:
+    """A worker's environment is the build's: a forkserver's workers inherit the one it was
+    started with, and the cache folder (MPC_CACHE_DIR) may have changed since."""
+    os.environ.clear()
+    os.environ.update(environ)
+
+
 def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
     """Apply `ops` to the mesh in `src` and keep it as the cache entry `dest`; (code, why not),
-    or None."""
-    from mpc.core.cache import notes_file, store_entry
-    from mpc.core.files import describe, write_atomic
+    or None. Done once across processes: one that finds `dest` locked waits, then uses it."""
+    from mpc.core.cache import load_entry, single_flight
+    from mpc.core.files import describe
+
+    try:
+        with single_flight(dest):
+            if load_entry(dest)[0] is not None:
+                return None  # another process made it while this one waited
+            return _derive(src, ops, dest)
+    except OSError as e:
+        return "E0652", describe(e, "write the mesh cache entry")
+
+
+def _derive(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] | None:
+    from mpc.core.cache import notes_file, store_entry, trace
+    from mpc.core.files import write_atomic
     from mpc.ir.geometry import MeshSource
     from mpc.ir.mesh_props import MeshError, as_trimesh
 
@@ -269,18 +309,16 @@ def _materialise(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, s
         return "E0603", str(e)
     if len(mesh.faces) == 0:
         return "E0603", "it has no triangles after reading"
+    trace(f"derive {dest.name}")
     if dest.suffix == ".bobj":
         from mpc.core import bobj
 
         data: bytes | str = bobj.dumps(mesh)
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
-    try:
-        if ignored:  # written before the entry, so that an entry never lacks its record
-            write_atomic(notes_file(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
-        store_entry(dest, data if isinstance(data, bytes) else data.encode())
-    except OSError as e:
-        return "E0652", describe(e, "write the mesh cache entry")
+    if ignored:  # written before the entry, so that an entry never lacks its record
+        write_atomic(notes_file(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
+    store_entry(dest, data if isinstance(data, bytes) else data.encode())
     return None
 
 
@@ -289,14 +327,17 @@ def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path
     """The meshes of an export (urdf, sdf, mjcf): those its file references, in `mesh_format`
     (their plan, or None after an error), then the same in each `additional` format
     (`additional_meshes`: written beside, referenced by nothing)."""
-    files = plan(robot, mesh_format, sink, export_span)
-    if files is None or not copy(files, out, sink, export_span, robot):
-        return None
-    for fmt in additional:
-        extra = plan(robot, fmt, sink, export_span)
-        if extra is None or not copy(extra, out, sink, export_span, robot):
+    from mpc.core.profile import stage
+
+    with stage("meshes"):
+        files = plan(robot, mesh_format, sink, export_span)
+        if files is None or not copy(files, out, sink, export_span, robot):
             return None
-    return files
+        for fmt in additional:
+            extra = plan(robot, fmt, sink, export_span)
+            if extra is None or not copy(extra, out, sink, export_span, robot):
+                return None
+        return files
 
 
 def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: Path,

@@ -23,6 +23,7 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Severity, Sink
 from mpc.core.files import OutsideOutput, confined, describe
+from mpc.core.profile import stage
 from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
@@ -278,7 +279,8 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
             if model is None:
                 continue
         folder.mkdir(parents=True, exist_ok=True)
-        BACKENDS[export.type]().emit(model, export, folder, sink)
+        with stage(export.type):
+            BACKENDS[export.type]().emit(model, export, folder, sink)
     return not sink.has_errors()
 
 
@@ -326,10 +328,12 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     result = Result()
     try:
         loader = input_loader(sink, options, (path.resolve(),))
-        result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
+        with stage("lower"):
+            result.program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
         if result.program is None:
             return result
-        result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
+        with stage("apply ops"):
+            result.robot = apply(result.program, sink, loader)   # read inputs, apply ops
     except OSError as e:  # what the readers do not report themselves (a name too long, say)
         sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
         return Result()
@@ -337,8 +341,11 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         return result
     from mpc.backends.solid_checks import check_closed
 
-    check_closed(result.robot, sink, result.program.span)  # meshes that an op left open (W0582)
+    with stage("apply ops"):
+        check_closed(result.robot, sink, result.program.span)  # meshes that an op left open (W0582)
     out = options.out or Path("build") / result.program.modelname
-    if emit(result.program, result.robot, out, sink, options.target):  # emit, rename into place
+    with stage("write"):
+        written = emit(result.program, result.robot, out, sink, options.target)
+    if written:  # emit, rename into place
         result.out = out
     return result

@@ -109,7 +109,10 @@ class InputLoader:
         """The input's robot, read or compiled once; None after reporting why."""
         key = self._key(inp)
         if key not in self._robots:
-            self._robots[key] = self._load(inp)
+            from mpc.core.profile import stage
+
+            with stage("load inputs"):
+                self._robots[key] = self._load(inp)
         return self._robots[key]
 
     def _load(self, inp: Input) -> Robot | None:

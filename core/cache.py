@@ -1,6 +1,7 @@
 """Where mpc keeps what it can compute again: `$MPC_CACHE_DIR`, else `$XDG_CACHE_HOME/mpc`,
-else `~/.cache/mpc`, one folder per kind (git checkouts, meshes); and entries that carry
-the hash of their bytes, so that a damaged one is never returned."""
+else `~/.cache/mpc`, one folder per kind (git checkouts, meshes); entries that carry the
+hash of their bytes, so that a damaged one is never returned; and the lock that lets one
+process compute an entry while the others that need it wait for it (`single_flight`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import contextlib
 import hashlib
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 
@@ -27,6 +29,8 @@ def cache_dir(kind: str) -> Path:
 # The files an entry keeps beside it: its hash, and the notes its computation left (a mesh's
 # broken DAE references, W0605). They are touched, removed and passed on with the entry.
 SIDECARS = (".sha256", ".ignored")
+LOCK = ".lock"  # beside an entry: `single_flight`; neither part of the entry nor removed with it
+BESIDE = (*SIDECARS, LOCK)  # every file that is kept beside an entry and is no entry itself
 
 
 def _hash_file(entry: Path) -> Path:
@@ -84,3 +88,69 @@ def remove_entry(entry: Path) -> None:
             shutil.rmtree(path)
         elif path.exists() or path.is_symlink():
             path.unlink()
+
+
+# -- single flight -----------------------------------------------------------------------------
+# Two processes (workers of `mpc run`, concurrent `mpc compile`s) that miss the same entry
+# would both compute it. Each takes an exclusive lock on `<entry>.lock` first and looks again
+# once it holds it: the second finds the first's result. flock locks belong to the open file,
+# so a process that dies (killed, crashed) releases its lock with it: a lock file left behind
+# is never stale, and the next process simply takes it. A process holds at most two such locks,
+# always a derived entry's before its source's, so no two processes wait for each other.
+
+
+@contextlib.contextmanager
+def single_flight(entry: Path) -> Iterator[None]:
+    """Hold the lock of `entry`, waiting while another process holds it. Where no lock can be
+    made (a read-only cache, a file in the way) the caller goes on without one: computing the
+    entry reports the cache's problem."""
+    import fcntl
+
+    lock = entry.with_name(entry.name + LOCK)
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    except OSError:
+        yield
+        return
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            trace(f"wait {entry.name}")  # another process computes it
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def trace(event: str) -> None:
+    """Append `event` (one line) to `$MPC_CACHE_TRACE` when it is set: each computation of an
+    entry, so that a test or a user can count them. Silent when the file cannot be written."""
+    path = os.environ.get("MPC_CACHE_TRACE")
+    if not path:
+        return
+    with contextlib.suppress(OSError):
+        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            os.write(fd, f"{os.getpid()} {event}\n".encode())
+        finally:
+            os.close(fd)
+
+
+# -- file digests ------------------------------------------------------------------------------
+# A build finds its mesh entries by the hash of each source file, for each export and format:
+# the hash is remembered for the process by the file's identity and status (path, device,
+# inode, size, modification and change times to the nanosecond), as git's index does. It is
+# not remembered across processes: `mpc run` learns what a build depends on from the files it
+# reads (pipeline/fingerprint.py), so every build reads its meshes once.
+_digests: dict[tuple[object, ...], str] = {}
+
+
+def file_digest(path: Path) -> str:
+    """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
+    st = path.stat()
+    identity = (str(path.resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+    if identity not in _digests:
+        _digests[identity] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return _digests[identity]

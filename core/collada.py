@@ -12,27 +12,76 @@ from __future__ import annotations
 import io
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import trimesh
 
 from mpc.core.span import hardened_parser
 
+if TYPE_CHECKING:
+    import collada
+
 
 def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:
     """The triangles of a DAE file, scaled to metres by its `<unit>`, and the broken references
     (pycollada's messages, sorted) that were ignored to read them; raises what pycollada and
-    lxml raise for a file that is not COLLADA at all."""
-    import collada
+    lxml raise for a file that is not COLLADA at all.
 
+    pycollada parses the file once (twice only when references are broken), and its document
+    is turned into a mesh as trimesh's own COLLADA loader does, so the triangles, texture
+    coordinates and names are those that `trimesh.load` gives.
+    """
     data = path.read_bytes()
-    ignore = [collada.common.DaeBrokenRefError, collada.common.DaeUnsupportedError]
-    errors = collada.Collada(io.BytesIO(data), ignore=ignore).errors
-    broken = tuple(sorted({str(getattr(e, "msg", e)) for e in errors}))
+    document = _parse(data)
+    broken = tuple(sorted({str(getattr(e, "msg", e)) for e in document.errors}))
     if broken:
         data = _without_material_bindings(data)
-    mesh = trimesh.load(io.BytesIO(data), file_type="dae", force="mesh", process=False)
+        document = _parse(data, strict=False)
+    mesh = _as_trimesh(document)
     mesh.apply_scale(_unit(data))
     return mesh, broken
+
+
+def _kinds() -> tuple[tuple[type, ...], tuple[type, ...]]:
+    """The errors pycollada may find that mpc ignores (broken and unsupported references,
+    reported as W0605), and those that trimesh's loader ignores too: a file with one of the
+    latter only is refused, as when pycollada raised it."""
+    from collada import common
+
+    broken = (common.DaeBrokenRefError, common.DaeUnsupportedError)
+    return broken, (*broken, common.DaeError, common.DaeIncompleteError, common.DaeMalformedError)
+
+
+def _parse(data: bytes, strict: bool = True) -> collada.Collada:
+    """pycollada's document of `data`; strict: raises the first error that is not a broken
+    reference (the file is refused), else ignores what trimesh's loader ignores."""
+    import collada
+
+    broken, ignored = _kinds()
+    document = collada.Collada(io.BytesIO(data), ignore=list(ignored))
+    refused = next((e for e in document.errors if not isinstance(e, broken)), None)
+    if strict and refused is not None:
+        raise refused
+    return document
+
+
+def _as_trimesh(document: collada.Collada) -> trimesh.Trimesh:
+    """The document's geometry as one mesh, as `trimesh.load(…, force="mesh", process=False)`
+    makes it (trimesh.exchange.dae.load_collada, given the parsed document)."""
+    import numpy as np
+    from trimesh.exchange import dae
+    from trimesh.exchange.load import _load_kwargs
+
+    materials = {m.id: dae._parse_material(m.effect, None) for m in document.materials}
+    unit = document.assetInfo.unitmeter
+    metadata = {"units": "meters"} if unit is None or np.isclose(unit, 1.0) else {"units": f"{unit} * meters"}
+    meshes: dict = {}
+    counts: dict = {}
+    graph: list = []
+    for node in document.scene.nodes:
+        dae._parse_node(node=node, parent_matrix=dae._EYE, material_map=materials, meshes=meshes,
+                        meshes_count=counts, graph=graph, resolver=None, metadata=metadata)
+    return _load_kwargs(process=False, **{"class": "Scene", "graph": graph, "geometry": meshes}).to_mesh()
 
 
 def _without_material_bindings(data: bytes) -> bytes:

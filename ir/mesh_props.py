@@ -55,18 +55,9 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
         if path is None or not path.is_file():
             raise MeshError(f"mesh '{geometry.source.uri}' cannot be found")
         try:
-            if path.suffix.lower() == ".bobj":
-                from mpc.core import bobj
+            from mpc.ir import mesh_source
 
-                mesh = bobj.loads(path.read_bytes())
-            elif path.suffix.lower() == ".dae":
-                from mpc.core import collada
-
-                mesh, broken = collada.read(path)
-                if ignored is not None:
-                    ignored.extend(broken)
-            else:
-                mesh = trimesh.load(path, force="mesh", process=False)
+            mesh = mesh_source.read(path, ignored)  # parsed once per content, ever
         except Exception as e:  # trimesh raises many kinds; all mean "cannot read this file"
             raise MeshError(f"cannot read mesh '{path}': {e}") from None
     for n, op in enumerate(geometry.ops):

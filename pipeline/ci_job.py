@@ -27,7 +27,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from mpc.core.cache import SIDECARS, cache_dir, sidecars
+from mpc.core.cache import BESIDE, cache_dir, sidecars
 from mpc.pipeline import dag
 from mpc.pipeline.plan import Plan
 from mpc.pipeline.status import (
@@ -95,7 +95,7 @@ def inventory() -> dict[Path, int]:
         folder = cache_dir(kind)
         if folder.is_dir():
             for path in folder.rglob("*"):
-                if path.is_file() and not path.name.startswith(".") and not path.name.endswith(SIDECARS):
+                if path.is_file() and not path.name.startswith(".") and not path.name.endswith(BESIDE):
                     out[path] = path.stat().st_mtime_ns
     return out
 

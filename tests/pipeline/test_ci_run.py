@@ -147,7 +147,9 @@ def test_the_fleet_pipeline_runs_in_gitlab_ci_local(team: Path, reference: dict[
     second, results = _run_pipeline(team)
     assert results == expected, second.stdout[-4000:] + second.stderr
     status = json.loads((team / "fleet/build/.mpc/status.json").read_text())
-    assert status["cache"] == {"made": 0, "reused": made}  # every mesh came from the pushed cache
+    # every mesh came from the pushed cache: its STL entries; the normalized forms of the DAE
+    # files they came from (one each, made too) are not needed again
+    assert status["cache"] == {"made": 0, "reused": made // 2}
     assert _states(status) == _states(reference["status"])
     for model in MODELS:
         assert _same_tree(team / "fleet/build" / model, reference["build"] / model) == [], model

@@ -1,0 +1,146 @@
+"""The mesh cache computes each entry once across processes, and a warm build stays light.
+
+Two `mpc compile` runs that need the same missing mesh: one converts it, the other waits for
+its result (core/cache.py `single_flight`), counted through MPC_CACHE_TRACE. A process that
+dies holding the lock does not block the next. A warm build of meshes already in the cache
+imports no mesh library.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mpc.backends.meshes import _cached_path
+from mpc.core.diagnostics import Sink
+from tests.conftest import ERD, compile_file, definition, write
+from tests.fixtures import ARM_URDF, tetra_stl
+
+ROOT = Path(__file__).resolve().parents[2]
+FOREARM = ERD / "ur_description/meshes/ur5/visual/forearm.dae"
+HEAVY = ("trimesh", "scipy", "pinocchio", "mujoco", "manifold3d", "collada")
+
+
+def _arm(folder: Path) -> Path:
+    """A definition whose arm has a real DAE mesh (the UR5's forearm), exported as STL."""
+    (folder / "meshes").mkdir(parents=True)
+    shutil.copyfile(FOREARM, folder / "meshes/forearm.dae")
+    write(folder / "arm.urdf", ARM_URDF.replace("meshes/tetra.stl", "meshes/forearm.dae"))
+    return write(folder / "arm.yml", definition("arm.urdf", "stl", "arm"))
+
+
+def _mpc(spec: Path, out: Path, env: dict[str, str]) -> subprocess.Popen[str]:
+    return subprocess.Popen([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o", str(out)],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def _trace(path: Path) -> list[str]:
+    return [line.split(" ", 1)[1] for line in path.read_text().splitlines()] if path.exists() else []
+
+
+def test_two_processes_on_the_same_cold_mesh_convert_it_once(tmp_path: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = _arm(tmp_path / "model")
+    cache, trace = tmp_path / "cache", tmp_path / "trace"
+    monkeypatch.setenv("MPC_CACHE_DIR", str(cache))
+    env = {**os.environ, "MPC_CACHE_TRACE": str(trace)}
+    # The test holds the entry's lock first, so that both builds are certain to meet there.
+    entry = _cached_path(tmp_path / "model/meshes/forearm.dae", (), ".stl")
+    lock = entry.with_name(entry.name + ".lock")
+    lock.parent.mkdir(parents=True)
+    holder = os.open(lock, os.O_RDWR | os.O_CREAT)
+    fcntl.flock(holder, fcntl.LOCK_EX)
+    builds = [_mpc(spec, tmp_path / f"out{n}", env) for n in (1, 2)]
+    deadline = time.monotonic() + 120
+    while _trace(trace).count(f"wait {entry.name}") < 2 and time.monotonic() < deadline:
+        assert all(b.poll() is None for b in builds), [b.communicate()[0] for b in builds]
+        time.sleep(0.05)
+    os.close(holder)  # both wait: let them go
+    for build in builds:
+        assert build.wait(120) == 0, build.communicate()[0]
+    events = _trace(trace)
+    assert events.count(f"wait {entry.name}") == 2
+    assert [e for e in events if not e.startswith("wait")] == [
+        f"parse forearm.dae {hashlib.sha256(FOREARM.read_bytes()).hexdigest()[:12]}", f"derive {entry.name}"]
+    assert (tmp_path / "out1/meshes/stl/forearm.stl").read_bytes() == \
+        (tmp_path / "out2/meshes/stl/forearm.stl").read_bytes()
+
+
+def test_a_process_that_died_holding_the_lock_blocks_nobody(tmp_path: Path) -> None:
+    spec = _arm(tmp_path / "model")
+    cache, trace = tmp_path / "cache", tmp_path / "trace"
+    env = {**os.environ, "MPC_CACHE_DIR": str(cache), "MPC_CACHE_TRACE": str(trace)}
+    hold = ("import sys, time\nfrom pathlib import Path\nfrom mpc.backends.meshes import _cached_path\n"
+            "from mpc.core.cache import single_flight\n"
+            "with single_flight(_cached_path(Path(sys.argv[1]), (), '.stl')):\n"
+            "    print('locked', flush=True)\n    time.sleep(600)\n")
+    holder = subprocess.Popen([sys.executable, "-c", hold, str(tmp_path / "model/meshes/forearm.dae")],
+                              env=env, stdout=subprocess.PIPE, text=True)
+    assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+    holder.kill()  # killed while holding the lock; its lock file stays behind
+    holder.wait()
+    assert list(cache.rglob("*.stl.lock"))
+    build = _mpc(spec, tmp_path / "out", env)
+    assert build.wait(120) == 0, build.communicate()[0]
+    assert [e.split()[0] for e in _trace(trace)] == ["parse", "derive"]
+
+
+def _warm_modules(spec: Path, out: Path, env: dict[str, str]) -> str:
+    probe = ("import sys\nfrom mpc.cli.main import main\n"
+             "code = main(['compile', sys.argv[1], '-o', sys.argv[2]])\n"
+             f"print(code, sorted(m for m in {HEAVY!r} if m in sys.modules))\n")
+    done = subprocess.run([sys.executable, "-c", probe, str(spec), str(out)], env=env, capture_output=True,
+                          text=True, check=True)
+    return done.stdout.splitlines()[-1]
+
+
+def test_a_warm_build_imports_no_mesh_library(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The DAE arm once built (in this process), and the bundled example (STL copied as is)."""
+    spec = _arm(tmp_path / "model")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    assert compile_file(spec, tmp_path / "cold", Sink()).out is not None
+    env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
+    assert _warm_modules(spec, tmp_path / "warm", env) == "0 []"
+    assert (tmp_path / "warm/meshes/stl/forearm.stl").read_bytes() == \
+        (tmp_path / "cold/meshes/stl/forearm.stl").read_bytes()
+    assert _warm_modules(ROOT / "examples/talos.yml", tmp_path / "talos", env) == "0 []"
+
+
+def test_files_with_the_same_bytes_keep_their_own_names(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """An OBJ names its object after the STL file it came from, even when another file with
+    the same bytes was parsed first (the normalized form is kept per content and name)."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    tetra_stl(tmp_path / "model/meshes/tetra.stl")
+    shutil.copyfile(tmp_path / "model/meshes/tetra.stl", tmp_path / "model/meshes/twin.stl")
+    urdf = ARM_URDF.replace("<collision>\n      <geometry><box size=\"0.05 0.05 0.4\"/></geometry>",
+                            "<collision>\n      <geometry><mesh filename=\"meshes/twin.stl\"/></geometry>")
+    assert "twin.stl" in urdf
+    write(tmp_path / "model/arm.urdf", urdf)
+    spec = write(tmp_path / "model/arm.yml", definition("arm.urdf", "obj", "arm"))
+    assert compile_file(spec, tmp_path / "out", Sink()).out is not None
+    for name in ("tetra", "twin"):
+        assert f"\no {name}.stl\n" in (tmp_path / f"out/meshes/obj/{name}.obj").read_text()
+
+
+def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """STL and OBJ (mirrored too) from one parse of the DAE; a later build's bobj from none."""
+    spec = _arm(tmp_path / "model")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
+    text = spec.read_text()
+    spec.write_text(text + "    - {type: urdf, mesh_format: obj, filename_suffix: _obj}\n")
+    assert compile_file(spec, tmp_path / "one", Sink()).out is not None
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse"]
+    spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
+    assert compile_file(spec, tmp_path / "two", Sink()).out is not None
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
