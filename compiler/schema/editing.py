@@ -6,12 +6,14 @@ Entries keep undeclared keys as free annotations for SMURF.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
+
+from pydantic import ConfigDict
 
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
-from mpc.compiler.schema.base import Before, Expr, Field, Node, OneOrMore, Vec3, str_or_list
+from mpc.compiler.schema.base import Before, Expr, Field, Length, Node, OneOrMore, Vec3, one_of, str_or_list
 
-Color = Annotated[list[Expr], Field(min_length=3, max_length=4)]
+Color = Annotated[list[Expr], Length(3, 4)]
 
 
 class Transform(Node):
@@ -27,6 +29,8 @@ class MaterialDef(Node):
 
     SECTION: ClassVar[str] = "a material"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"diffuseColor": "diffuse", "ambientColor": "ambient",
                                          "specularColor": "specular", "emissionColor": "emissive",
                                          "diffuseTexture": "texture"}
@@ -57,6 +61,8 @@ class FrameDef(Node):
 
     SECTION: ClassVar[str] = "a frame"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"estimate_missing_com": "estimate_missing_coms"}
     transform_link: Transform | None = None
     transform_frame: Transform | None = None
@@ -81,7 +87,8 @@ class FramesSection(Node):
     """`frames` (alias `links`): per-link operations, `$default` for every link."""
 
     SECTION: ClassVar[str] = "frames"
-    ENTRIES: ClassVar[type | None] = FrameDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, FrameDef] = Field(init=False)
     default: FrameDef | None = Field(None, alias="$default")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
 
@@ -101,6 +108,8 @@ class MotorDef(Node):
 
     SECTION: ClassVar[str] = "a motor"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     name: str | None = None
     type: str | None = None
     p: Expr | None = None
@@ -108,6 +117,9 @@ class MotorDef(Node):
     d: Expr | None = None
     maxEffort: Expr | None = None  # the language's spelling
     maxSpeed: Expr | None = None
+
+
+Active = one_of(bool, MotorDef)
 
 
 class ConstraintAxis(Node):
@@ -131,6 +143,8 @@ class JointDef(Node):
 
     SECTION: ClassVar[str] = "a joint"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"lower": "min", "upper": "max", "effort": "eff",
                                          "velocity": "vel"}
     min: Expr | None = None
@@ -148,11 +162,11 @@ class JointDef(Node):
     parent: str | None = None
     child: str | None = None
     constraint_axes: list[ConstraintAxis] | None = None
-    move_joint_axis_to_intersection: Annotated[list[str], Field(min_length=2, max_length=2)] | None = None
+    move_joint_axis_to_intersection: Annotated[list[str], Length(2, 2)] | None = None
     mimic: MimicDef | None = None
     movement_depends_on: Annotated[list[MimicDef], Before(
         lambda v: [v] if isinstance(v, dict) else v)] | None = None
-    active: bool | MotorDef | None = None
+    active: Active | None = None
     motor: MotorDef | None = None
     name_editing: NameEditing | None = None
 
@@ -161,7 +175,8 @@ class JointsSection(Node):
     """`joints`: per-joint settings plus section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "joints"
-    ENTRIES: ClassVar[type | None] = JointDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, JointDef] = Field(init=False)
     default: JointDef | None = Field(None, alias="$default")
     replace_joint_types: dict[JointTypeName, JointTypeName] | None = Field(
         None, alias="$replace_joint_types")
@@ -170,9 +185,12 @@ class JointsSection(Node):
     backup: Limits | None = Field(None, alias="$backup")
 
 
-RemoveWhat = Annotated[bool | list[str], Before(
+RemoveWhat = Annotated[one_of(bool, list[str]), Before(
     lambda v: str_or_list(v) if isinstance(v, str) else v)]
 ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
+
+
+Join = one_of(bool, Literal["union"])
 
 
 class CollisionDef(Node):
@@ -180,11 +198,13 @@ class CollisionDef(Node):
 
     SECTION: ClassVar[str] = "a collision entry"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     remove: RemoveWhat = False
     shape: ShapeName | None = None
     oriented: bool = True
     scale: Expr = 1
-    join: bool | Literal["union"] = False
+    join: Join = False
     bitmask: int | None = None
     ccfm: Expr | None = None
 
@@ -193,7 +213,8 @@ class CollisionsSection(Node):
     """`collisions`: per-link (or per-collision) entries, bitmasks, section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "collisions"
-    ENTRIES: ClassVar[type | None] = CollisionDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, CollisionDef] = Field(init=False)
     default: CollisionDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
@@ -208,6 +229,8 @@ class VisualDef(Node):
 
     SECTION: ClassVar[str] = "a visual entry"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     remove: RemoveWhat = False
     material: str | None = None
 
@@ -216,7 +239,8 @@ class VisualsSection(Node):
     """`visuals`: per-link entries and section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "visuals"
-    ENTRIES: ClassVar[type | None] = VisualDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, VisualDef] = Field(init=False)
     default: VisualDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
