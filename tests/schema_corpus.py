@@ -15,8 +15,8 @@ tests/compiler/test_schema_differential.py compares the current validator with i
 from __future__ import annotations
 
 import copy
-import hashlib
 import gzip
+import hashlib
 import json
 import random
 import re
@@ -53,7 +53,8 @@ def _sources() -> Iterator[tuple[str, str, Path]]:
 
 
 def base_documents() -> list[tuple[str, str, Any]]:
-    """(name, digest of its text, Document) of every source that loads (the YAML's own errors are not the schema's)."""
+    """(name, digest of its text, Document) of every source that loads (the YAML's own
+    errors are not the schema's)."""
     from mpc.compiler import inherit
     from mpc.core import yaml_source as source
     from mpc.core.diagnostics import Sink

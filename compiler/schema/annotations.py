@@ -1,7 +1,5 @@
 """AST of sensors, poses, submechanisms, exoskeletons, annotations and post_processing."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import ConfigDict

@@ -1,7 +1,5 @@
 """AST of `input_models` and `assemble`: where models come from and how they are joined."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
 from mpc.compiler.schema.base import Before, Expr, JsonSchema, Length, Node, OneOrMore, Vec3
@@ -121,7 +119,7 @@ class AssemblyEntry(Node):
     remove_beyond: OneOrMore | None = None
     take_leaf: str | None = None
     mirror: Mirror | None = None
-    children: list[AssembleChild] = []
+    children: list["AssembleChild"] = []
 
 
 class AssembleChild(AssemblyEntry):

@@ -28,15 +28,21 @@ that takes mappings, a list to the one that takes lists, and a union of nodes by
 costs no schema building: `mpc check` starts cold on every save of an editor.
 """
 
-from __future__ import annotations
-
 import typing
 from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, PrivateAttr, Tag, ValidationError
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Discriminator,
+    PrivateAttr,
+    Tag,
+    ValidationError,
+    model_validator,
+)
 from pydantic import Field as Field
-from pydantic import model_validator
 from pydantic_core import PydanticCustomError, core_schema
 
 from mpc.core.diagnostics import Sink, did_you_mean
@@ -76,7 +82,7 @@ class After:
         return value
 
 
-def Before(fn: Callable[[Any], Any]) -> BeforeValidator:  # noqa: N802  (reads as a marker)
+def Before(fn: Callable[[Any], Any]) -> BeforeValidator:
     """Reshape the value before it is checked."""
     return BeforeValidator(fn)
 
@@ -271,11 +277,11 @@ def one_of(*members: Any) -> Any:
         pick, custom_error_type="mpc_union", custom_error_message=wanted)]
 
 
-def tagged(*members: type[Node]) -> Any:
+def tagged(*members: type["Node"]) -> Any:
     """A union of nodes told apart by their `type` literal (export entries)."""
     tags: dict[str, type[Node]] = {}
 
-    def kinds() -> dict[str, type[Node]]:  # on first use: the members may contain this union
+    def kinds() -> dict[str, type["Node"]]:  # on first use: the members may contain this union
         if not tags:
             tags.update((t, m) for m in members for t in typing.get_args(_type_literal(m)))
         return tags
@@ -507,7 +513,7 @@ class Walk:
 
     def report(self, err: Any, base: Path_) -> None:
         """One of pydantic's errors, `loc` below the node at `base`, as a diagnostic."""
-        kind, loc, value = err["type"], tuple(err["loc"]), err.get("input")
+        kind, loc = err["type"], tuple(err["loc"])
         if kind == "mpc_reported":
             return
         doc = self.doc
@@ -600,7 +606,7 @@ def _one_of(words: list[str]) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
 
 
-def validate_as(cls: type[Node], doc: Document, sink: Sink, what: str) -> Node | None:
+def validate_as(cls: type["Node"], doc: Document, sink: Sink, what: str) -> Node | None:
     """Validate `doc` as a `cls`; the node, or None when it has errors (all reported)."""
     if not isinstance(doc.data, dict):
         sink.error(doc.value_span(()), "E0203", f"{what} is a mapping, not {describe(doc.data)}")

@@ -1,7 +1,5 @@
 """AST roots: a model definition file (`model:`) and a pipeline file (`pipeline:`)."""
 
-from __future__ import annotations
-
 from typing import Annotated, ClassVar
 
 from mpc.compiler.schema.annotations import (

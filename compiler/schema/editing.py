@@ -4,8 +4,6 @@ Each section is keyed by the names it edits; `$keys` are section-wide settings.
 Entries keep undeclared keys as free annotations for SMURF.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import ConfigDict

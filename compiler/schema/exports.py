@@ -1,7 +1,5 @@
 """AST of `export_config`: one entry per output, told apart by `type`."""
 
-from __future__ import annotations
-
 from typing import Annotated, ClassVar, Literal
 
 from mpc.compiler.schema.base import (
@@ -135,7 +133,7 @@ class SubmodelExport(_Export):
     add_floating_base: bool = False
     filename: FileName | None = None
     only_urdf: bool = False
-    export_config: list[ExportEntry] | None = None
+    export_config: list["ExportEntry"] | None = None
 
 
 # Told apart by `type` (compiler/schema/base.py: tagged).

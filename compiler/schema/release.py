@@ -1,7 +1,5 @@
 """AST of `test` and `deployment`: how a model is checked and where it goes."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
 from mpc.compiler.schema.base import After, Expr, Node, OneOrMore, one_of
