@@ -4,8 +4,8 @@ Input: the pydantic models of compiler/schema/ (`model_json_schema()`) and the k
 of specs/*.md. Output: the schema `mpc schema` prints and specs/model-definition.schema.json
 holds (a test keeps the committed file equal to what this module generates). What it adds
 to pydantic's schema: closed sections (`additionalProperties: false`), the old spellings
-(deprecated), titles a user knows (the section's name, never a class name, and no
-per-property titles), a description for every property taken from the key tables of
+(deprecated), titles a user knows (a section's name or a property's key, never a class
+name), a description for every property taken from the key tables of
 specs/ (meaning, type and default), and examples from the runnable examples of specs/.
 It does not validate anything: compiler/schema/ does.
 
@@ -246,12 +246,16 @@ def definition_schema() -> dict[str, Any]:
         props = node.get("properties", {})
         for key, prop in props.items():
             _untitle(prop)
+            prop["title"] = key  # what the user wrote: the heading of a hover
             prop["description"] = _describe(name, key, tables)
+            if "`" in prop["description"]:  # editors that render markdown show it as code
+                prop["markdownDescription"] = prop["description"]
             if name == "ModelSection" and key in examples:
                 prop["examples"] = [examples[key]]
         for alias, target in cls.ALIASES.items():  # old spellings: same schema, deprecated
             if target in props:
-                props[alias] = {**props[target], "deprecated": True,
+                props[alias] = {**{k: v for k, v in props[target].items() if k != "markdownDescription"},
+                                "deprecated": True, "title": alias,
                                 "description": f"old spelling of '{target}'"}
             if target in node.get("required", []):
                 node["required"].remove(target)
@@ -259,8 +263,8 @@ def definition_schema() -> dict[str, Any]:
                 node.setdefault("allOf", []).append({"anyOf": either})
         if "additionalProperties" in node and isinstance(node["additionalProperties"], dict):
             _untitle(node["additionalProperties"])
-    schema = defs.pop("Definition")
-    schema["$defs"] = dict(sorted(defs.items()))
+    schema = _simplify(defs.pop("Definition"))
+    schema["$defs"] = _simplify(dict(sorted(defs.items())))
     # `defaults` is resolved before validation (compiler/inherit.py), so the AST has no field.
     schema["properties"]["defaults"] = {
         "type": "string", "description": "a defaults file (relative to this file) whose "
@@ -281,6 +285,34 @@ def _subclasses(cls: type) -> list[type]:
     for sub in cls.__subclasses__():
         out += [sub, *_subclasses(sub)]
     return out
+
+
+_TYPED = {"array": {"items", "minItems", "maxItems"}, "string": {"minLength", "maxLength"},
+          "object": {"additionalProperties", "propertyNames", "minProperties"}}
+
+
+def _simplify(schema: Any) -> Any:
+    """`anyOf` of members of distinct types as one schema (`type: [number, string, null]`) or
+    as `oneOf`: the same language, and editors show the property once, not once per member
+    (the YAML language server hovered `eff` as `Eff || Eff || Eff || Eff`)."""
+    if isinstance(schema, dict):
+        schema = {k: _simplify(v) for k, v in schema.items()}
+        members = schema.get("anyOf")
+        if isinstance(members, list):
+            kinds = [m.get("type") if "$ref" not in m else "object" for m in members]
+            if all(isinstance(k, str) for k in kinds) and len(set(kinds)) == len(kinds):
+                if all("$ref" not in m and set(m) - {"type"} <= _TYPED.get(k, set())
+                       for m, k in zip(members, kinds, strict=True)):
+                    del schema["anyOf"]
+                    for m in members:
+                        schema.update({k: v for k, v in m.items() if k != "type"})
+                    schema["type"] = kinds
+                else:
+                    schema["oneOf"] = schema.pop("anyOf")
+        return schema
+    if isinstance(schema, list):
+        return [_simplify(v) for v in schema]
+    return schema
 
 
 def _untitle(schema: Any) -> None:
