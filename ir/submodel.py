@@ -15,7 +15,7 @@ from mpc.ir.robot import Robot
 from mpc.ir.tree import joints_up
 
 
-def _stops(pattern: str, links: set[str]) -> set[str] | None:
+def matching(pattern: str, links: set[str]) -> set[str]:
     """The links a `stop` entry names: the link of that name, or those its regex matches."""
     if pattern in links:
         return {pattern}
@@ -39,7 +39,7 @@ def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
     if export.stop:
         stops: set[str] = set()
         for pattern in export.stop:
-            found = _stops(pattern, below)
+            found = matching(pattern, below)
             if not found:
                 sink.error(export.span, "E0310", f"submodel '{export.name}': stop '{pattern}' names no "
                            f"link below '{start}'{did_you_mean(pattern, below)}")
@@ -99,7 +99,7 @@ def _merged(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
 
     gone: set[str] = set()
     for pattern in export.remove_joints:
-        found = _stops(pattern, set(part.joints))
+        found = matching(pattern, set(part.joints))
         if not found:
             sink.error(export.span, "E0310", f"submodel '{export.name}': remove_joints '{pattern}' names "
                        f"no joint of the submodel{did_you_mean(pattern, set(part.joints))}")
