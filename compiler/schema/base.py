@@ -350,8 +350,13 @@ class Node(BaseModel):
         """What is wrong with the node as a whole, once its fields are right (None: nothing)."""
         return None
 
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        """(code, key, message) of the keys given here that would change nothing: warned of,
+        never silently ignored."""
+        return []
+
     @classmethod
-    def keys(cls) -> dict[str, str]:
+    def declared(cls) -> dict[str, str]:
         """Declared key in the document → attribute name."""
         plan = cls.__dict__.get("_keys")
         if plan is None:
@@ -467,7 +472,7 @@ class Walk:
 
     def node(self, cls: type[Node], data: dict, handler: Any) -> Any:
         path = self.where.get(id(data), ())
-        keys = cls.keys()
+        keys = cls.declared()
         clean: dict[str, Any] = {}
         failed = False
         for key, value in data.items():
@@ -509,6 +514,8 @@ class Walk:
             self.sink.error(self.doc.value_span(self.written(path)), "E0203",
                             f"'{_key(self.written(path))}': {why}")
             raise PydanticCustomError("mpc_reported", "reported")
+        for code, key, message in node.no_effect():
+            self.sink.warning(self.doc.span(self.written((*path, key))), code, message)
         return node
 
     def report(self, err: Any, base: Path_) -> None:

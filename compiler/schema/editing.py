@@ -80,6 +80,19 @@ class FrameDef(Node):
     type: JointTypeName | None = None
     mass: Expr | None = None
 
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        if self.joint is None and self.parent is None:
+            return []
+        out = [("W0253", key, f"'{key}' has no effect on a new frame, which has no "
+                f"{'visuals' if key == 'material' else 'collisions'} of its own")
+               for key in ("material", "estimate_missing_coms", "estimate_missing_inertia")
+               if getattr(self, key)]
+        if self.joint is not None:
+            out += [("W0257", key, f"'{key}' has no effect next to 'joint', which gives the new "
+                     "frame's joint") for key in ("parent", "jointname", "xyz", "rpy", "axis", "type")
+                    if key in self.given]
+        return out
+
 
 class FramesSection(Node):
     """`frames` (alias `links`): per-link operations, `$default` for every link."""
@@ -168,6 +181,24 @@ class JointDef(Node):
     motor: MotorDef | None = None
     name_editing: NameEditing | None = None
 
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        # what is set to false or nothing asks for nothing (`active: false` on a cut joint)
+        given = [k for k, n in self.declared().items() if n in self.given and getattr(self, n)]
+        given += list(self.entries)
+        if self.cut_joint:
+            return [("W0251", k, f"'{k}' has no effect on a cut joint, which takes only 'parent', "
+                     "'child', 'type', 'constraint_axes' and annotations")
+                    for k in given if k in self.declared() and k not in _CUT_JOINT_KEYS]
+        if self.remove:
+            return [("W0250", k, f"'{k}' has no effect: the joint is removed ('remove: true')")
+                    for k in given if k != "remove"]
+        return [("W0252", k, f"'{k}' has no effect without 'cut_joint: true' (a joint's links "
+                 "change with frames' reparent_to)") for k in ("parent", "child", "constraint_axes")
+                if k in self.given]
+
+
+_CUT_JOINT_KEYS = ("cut_joint", "parent", "child", "type", "constraint_axes", "remove")
+
 
 class JointsSection(Node):
     """`joints`: per-joint settings plus section-wide `$keys`."""
@@ -181,6 +212,19 @@ class JointsSection(Node):
     all: bool = Field(False, alias="$all")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
     backup: Limits | None = Field(None, alias="$backup")
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        if self.all and self.default is None:
+            return [("W0256", "$all", "'$all' has no effect without '$default', the values it "
+                     "applies to every joint")]
+        return []
+
+
+def _exclude_without_default(section: Node) -> list[tuple[str, str, str]]:
+    if "exclude" in section.given and section.default is None:  # type: ignore[attr-defined]
+        return [("W0255", "$exclude", "'$exclude' has no effect without '$default': it names "
+                 "the links that '$default' leaves out")]
+    return []
 
 
 RemoveWhat = Annotated[one_of(bool, list[str]), Before(
@@ -216,6 +260,9 @@ class CollisionsSection(Node):
     default: CollisionDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        return _exclude_without_default(self)
     auto_bitmask: bool = False
     apply_primitives: bool = False
     no_collision_between: dict[str, OneOrMore] = {}
@@ -242,3 +289,6 @@ class VisualsSection(Node):
     default: VisualDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        return _exclude_without_default(self)

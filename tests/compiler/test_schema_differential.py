@@ -16,6 +16,9 @@ from tests.schema_corpus import FIXTURE, MUTANTS, SEED, corpus, diagnostics
 
 # document id → (what the old validator said, what the new one says), for improvements.
 DELIBERATE: dict[str, tuple[list[list], list[list]]] = {}
+# What the old validator never said: keys that have no effect where they stand (issue 20),
+# warned of by the schema now; each kind has its own test in tests/compiler/broken/.
+NEW_WARNINGS = {"W0250", "W0251", "W0252", "W0253", "W0255", "W0256", "W0257"}
 
 
 def test_the_new_validator_reports_what_the_old_one_did() -> None:
@@ -28,6 +31,7 @@ def test_the_new_validator_reports_what_the_old_one_did() -> None:
             continue
         compared += 1
         got, want = diagnostics(doc), expected[name]
+        got = [d for d in got if d[0] not in NEW_WARNINGS]
         if name in DELIBERATE:
             assert (want, got) == DELIBERATE[name], name
         elif got != want:
