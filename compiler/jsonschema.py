@@ -235,8 +235,8 @@ def definition_schema() -> dict[str, Any]:
     schema = Definition.model_json_schema(by_alias=True)
     defs = schema.pop("$defs")
     defs["Definition"] = schema
-    tables = _tables()
-    examples = _examples()
+    # specs/ is beside the code in a checkout; an installed mpc without it describes less
+    tables, examples = (_tables(), _examples()) if SPECS.is_dir() else ({}, {})
     classes = {c.__name__: c for c in _subclasses(Node)}
     for name, node in defs.items():
         cls = classes[name]
@@ -247,7 +247,7 @@ def definition_schema() -> dict[str, Any]:
         for key, prop in props.items():
             _untitle(prop)
             prop["title"] = key  # what the user wrote: the heading of a hover
-            prop["description"] = _describe(name, key, tables)
+            prop["description"] = _describe(name, key, tables) or prop.get("description", "")
             if "`" in prop["description"]:  # editors that render markdown show it as code
                 prop["markdownDescription"] = prop["description"]
             if name == "ModelSection" and key in examples:
@@ -381,6 +381,8 @@ def _describe(cls: str, key: str, tables: dict[str, list[tuple[str, str, Row]]])
             if token == prefix + key or (token.endswith("…") and key.startswith(token[:-1])) or (
                     prefix and token == key):
                 return _text(row)
+    if not tables:
+        return ""
     raise KeyError(f"specs/ does not describe {cls}.{key}: add it to a key table or to PROSE")
 
 

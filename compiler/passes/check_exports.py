@@ -15,7 +15,6 @@ from __future__ import annotations
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.names import Names
 from mpc.ir.program import JointLimitsExport, KccdExport, Program, SubmodelExport
-from mpc.ir.submodel import matching
 
 SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
 
@@ -39,6 +38,8 @@ def check_exports(program: Program, names: Names, sink: Sink) -> None:
 
 def _submodel(export: SubmodelExport, names: Names, sink: Sink) -> None:
     """What ir/submodel.py's `cut` reports, on names: start, stop, remove_joints, moved axes."""
+    from mpc.ir.submodel import matching  # with the ops it imports: only for a submodel
+
     start = export.start or names.root
     if start not in names.links:
         sink.error(export.span, "E0310", f"submodel '{export.name}' starts at unknown link '{start}'"

@@ -19,6 +19,7 @@ FIXTURES = sorted((ROOT / "tests/fixtures/reference").glob("*.yml"))
 
 def test_committed_schema_is_fresh() -> None:
     assert COMMITTED.read_text() == render(), "run `mpc schema` and commit the result"
+    jsonschema.Draft202012Validator.check_schema(json.loads(COMMITTED.read_text()))
 
 
 @pytest.mark.parametrize("path", FIXTURES, ids=[p.stem for p in FIXTURES])
