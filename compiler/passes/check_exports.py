@@ -38,34 +38,12 @@ def check_exports(program: Program, names: Names, sink: Sink) -> None:
 
 def _submodel(export: SubmodelExport, names: Names, sink: Sink) -> None:
     """What ir/submodel.py's `cut` reports, on names: start, stop, remove_joints, moved axes."""
-    from mpc.ir.submodel import matching  # with the ops it imports: only for a submodel
+    from mpc.ir.submodel import matching, part_links  # with the ops it imports: only for a submodel
 
-    start = export.start or names.root
-    if start not in names.links:
-        sink.error(export.span, "E0310", f"submodel '{export.name}' starts at unknown link '{start}'"
-                   f"{did_you_mean(start, set(names.links))}")
+    part = part_links(names, export, sink)
+    if part is None:
         return
-    below = names.subtree(start)
-    kept = set(below)
-    stops: set[str] = set()
-    for pattern in export.stop:
-        found = matching(pattern, below)
-        if not found:
-            sink.error(export.span, "E0310", f"submodel '{export.name}': stop '{pattern}' names no "
-                       f"link below '{start}'{did_you_mean(pattern, below)}")
-            return
-        stops |= found
-    if stops:
-        for stop in stops:
-            kept -= names.subtree(stop) - {stop}
-        if not export.include_unstopped_branches:
-            parents = {child: parent for parent, child in names.joints.values()}
-            kept = {start}
-            for link in stops:
-                while link in parents:
-                    if link in below:
-                        kept.add(link)
-                    link = parents[link]
+    kept = part[1]
     joints = {j for j, (p, c) in names.joints.items() if p in kept and c in kept}
     gone: set[str] = set()
     for pattern in export.remove_joints:
