@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from mpc.backends.packages import PackageResolver
+from mpc.core.packages import PackageResolver
 
 DEFINITION = """model:
   robotname: talos_assembly

@@ -23,8 +23,8 @@ import numpy as np
 import trimesh
 from lxml import etree
 
-from mpc.backends.packages import PackageResolver
 from mpc.core import collada
+from mpc.core.packages import PackageResolver
 from mpc.core.span import hardened_parser
 
 

@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mpc.core import yaml_source as source
-from mpc.core.diagnostics import Diagnostic, Sink
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.packages import PackageResolver
+from mpc.core.span import Span
+from mpc.ir.geometry import Mesh
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 from mpc.ir.robot import Robot
@@ -89,6 +91,7 @@ class InputLoader:
     names_of: FindNames | None = None
     _robots: dict[tuple[str, str], Robot | None] = field(default_factory=dict)
     _names: dict[tuple[str, str], Names | None] = field(default_factory=dict)
+    missing_meshes: list[Diagnostic] = field(default_factory=list)  # symbolic: E0602, reported last
 
     def __post_init__(self) -> None:
         for definition in self.stack:  # inputs may link to files beside their definitions
@@ -182,4 +185,31 @@ class InputLoader:
         if inp.kind == "repo" and self._repo_file(inp, fetch=False) is None:
             return None  # `mpc check` does not clone; names are checked once it is cached
         robot = self.robot(inp)
+        if robot is not None and self.symbolic:
+            self.missing_meshes += _missing_meshes(robot, inp.span)
         return Names.of(robot) if robot is not None else None
+
+
+def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
+    """`mpc check`: the input model's mesh files that do not exist (E0602, as writing them
+    would say); none is read. Every mesh of the input counts, also one a later edit removes.
+    The driver reports them after the names are checked, which they do not hinder."""
+    seen: set[Path] = set()
+    out = []
+    for name, link in robot.links.items():
+        for element, items in (("visual", link.visuals), ("collision", link.collisions)):
+            for item in items:
+                mesh = item.geometry
+                if not isinstance(mesh, Mesh):
+                    continue
+                src, span = mesh.source, mesh.span or where
+                if src.path is None:
+                    out.append(Diagnostic(
+                        Severity.ERROR, "E0602", f"mesh '{src.uri}' of a {element} of link '{name}' "
+                        f"cannot be found: {src.unresolved}", span,
+                        hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH"))
+                elif src.path not in seen and not src.path.is_file():
+                    out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{src.path}' of a "
+                                          f"{element} of link '{name}' does not exist", span))
+                    seen.add(src.path)
+    return out

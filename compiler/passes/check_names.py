@@ -90,5 +90,11 @@ def _nearest_first(name: str, pool: frozenset[str], shown: int = 8) -> str | Non
 
 
 def check_names(program: Program, ctx: PassContext) -> Program:
-    symbolic(program, ctx)
+    names = symbolic(program, ctx)
+    # the exports' names, once the rest is right: on names every op could edit, and not after
+    # lowering reported an export's problem (it would be said twice)
+    if names is not None and not ctx.sink.has_errors() and ctx.later is Severity.WARNING:
+        from mpc.compiler.passes.check_exports import check_exports  # `mpc check` only
+
+        check_exports(program, names, ctx.sink)
     return program

@@ -1,10 +1,10 @@
 """AST of sensors, poses, submechanisms, exoskeletons, annotations and post_processing."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.base import Expr, Field, Node, OneOrMore, Vec3
+from pydantic import ConfigDict
+
+from mpc.compiler.schema.base import Expr, Field, Length, Node, OneOrMore, Vec3, one_of
 from mpc.compiler.schema.editing import ConstraintAxis
 
 SINGLE_LINK_SENSORS = ("Joint6DOF", "CameraSensor", "RotatingRaySensor", "IMU", "GPS")
@@ -24,6 +24,8 @@ class SensorDef(Node):
 
     SECTION: ClassVar[str] = "a sensor"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     type: SensorType | None = None
     name: str
     link: str | None = None
@@ -31,11 +33,11 @@ class SensorDef(Node):
     frame: str | None = None
     targets: OneOrMore | None = None
     position_offset: Vec3 | None = None
-    orientation_offset: Annotated[list[Expr], Field(min_length=3, max_length=4)] | None = None
+    orientation_offset: Annotated[list[Expr], Length(3, 4)] | None = None
 
 
 # The section is a list of sensors or a mapping type → sensor(s); validated as the form it has.
-SensorsSection = list[SensorDef] | dict[SensorType, SensorDef | list[SensorDef]]
+SensorsSection = one_of(list[SensorDef], dict[SensorType, one_of(SensorDef, list[SensorDef])])
 
 
 def sensor_entries(section: SensorsSection) -> list[tuple[str | None, SensorDef]]:
@@ -52,7 +54,8 @@ class PoseDef(Node):
     """A named joint configuration: joint → position; `$default` fills the other joints."""
 
     SECTION: ClassVar[str] = "a pose"
-    ENTRIES: ClassVar[Any] = Expr
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Expr] = Field(init=False)
     default: Expr | None = Field(None, alias="$default")
 
 
@@ -106,7 +109,7 @@ class PostProcessing(Node):
     """A command run after export: an argument list, or a string run by a shell when `shell`."""
 
     SECTION: ClassVar[str] = "a post_processing command"
-    cmd: str | Annotated[list[str], Field(min_length=1)]
+    cmd: one_of(str, Annotated[list[str], Length(1)])
     cwd: str | None = None
     shell: bool = False
     executable: str | None = None

@@ -1,10 +1,8 @@
 """AST of `input_models` and `assemble`: where models come from and how they are joined."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.base import Before, Expr, Field, JsonSchema, Node, OneOrMore, Vec3
+from mpc.compiler.schema.base import Before, Expr, JsonSchema, Length, Node, OneOrMore, Vec3
 
 JointTypeName = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar",
                         "ball", "universal", "screw", "revolute2"]
@@ -89,7 +87,8 @@ class Mirror(Node):
 
     SECTION: ClassVar[str] = "mirror"
     plane: Vec3 = [0, 1, 0]
-    flip_axis: Literal[0, 1, 2] = 1
+    # pydantic takes true for 1; the language does not
+    flip_axis: Annotated[Literal[0, 1, 2], Before(lambda v: str(v) if isinstance(v, bool) else v)] = 1
     exclude_meshes: OneOrMore = []
     name_replacements: Replacements | None = None
 
@@ -104,8 +103,7 @@ class AttachJoint(Node):
     type: JointTypeName = "fixed"
     xyz: Vec3 | None = None
     rpy: Vec3 | None = None
-    r2r_transform: Annotated[list[Annotated[list[Expr], Field(min_length=4, max_length=4)]],
-                             Field(min_length=4, max_length=4)] | None = None
+    r2r_transform: Annotated[list[Annotated[list[Expr], Length(4, 4)]], Length(4, 4)] | None = None
     axis: Vec3 | None = None
     min: Expr | None = None
     max: Expr | None = None
@@ -121,7 +119,7 @@ class AssemblyEntry(Node):
     remove_beyond: OneOrMore | None = None
     take_leaf: str | None = None
     mirror: Mirror | None = None
-    children: list[AssembleChild] = []
+    children: list["AssembleChild"] = []
 
 
 class AssembleChild(AssemblyEntry):

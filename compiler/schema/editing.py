@@ -4,14 +4,14 @@ Each section is keyed by the names it edits; `$keys` are section-wide settings.
 Entries keep undeclared keys as free annotations for SMURF.
 """
 
-from __future__ import annotations
+from typing import Annotated, Any, ClassVar, Literal
 
-from typing import Annotated, ClassVar, Literal
+from pydantic import ConfigDict
 
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
-from mpc.compiler.schema.base import Before, Expr, Field, Node, OneOrMore, Vec3, str_or_list
+from mpc.compiler.schema.base import Before, Expr, Field, Length, Node, OneOrMore, Vec3, one_of, str_or_list
 
-Color = Annotated[list[Expr], Field(min_length=3, max_length=4)]
+Color = Annotated[list[Expr], Length(3, 4)]
 
 
 class Transform(Node):
@@ -27,6 +27,8 @@ class MaterialDef(Node):
 
     SECTION: ClassVar[str] = "a material"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"diffuseColor": "diffuse", "ambientColor": "ambient",
                                          "specularColor": "specular", "emissionColor": "emissive",
                                          "diffuseTexture": "texture"}
@@ -57,6 +59,8 @@ class FrameDef(Node):
 
     SECTION: ClassVar[str] = "a frame"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"estimate_missing_com": "estimate_missing_coms"}
     transform_link: Transform | None = None
     transform_frame: Transform | None = None
@@ -76,12 +80,26 @@ class FrameDef(Node):
     type: JointTypeName | None = None
     mass: Expr | None = None
 
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        if self.joint is None and self.parent is None:
+            return []
+        out = [("W0253", key, f"'{key}' has no effect on a new frame, which has no "
+                f"{'visuals' if key == 'material' else 'collisions'} of its own")
+               for key in ("material", "estimate_missing_coms", "estimate_missing_inertia")
+               if getattr(self, key)]
+        if self.joint is not None:
+            out += [("W0257", key, f"'{key}' has no effect next to 'joint', which gives the new "
+                     "frame's joint") for key in ("parent", "jointname", "xyz", "rpy", "axis", "type")
+                    if key in self.given]
+        return out
+
 
 class FramesSection(Node):
     """`frames` (alias `links`): per-link operations, `$default` for every link."""
 
     SECTION: ClassVar[str] = "frames"
-    ENTRIES: ClassVar[type | None] = FrameDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, FrameDef] = Field(init=False)
     default: FrameDef | None = Field(None, alias="$default")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
 
@@ -101,6 +119,8 @@ class MotorDef(Node):
 
     SECTION: ClassVar[str] = "a motor"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     name: str | None = None
     type: str | None = None
     p: Expr | None = None
@@ -108,6 +128,9 @@ class MotorDef(Node):
     d: Expr | None = None
     maxEffort: Expr | None = None  # the language's spelling
     maxSpeed: Expr | None = None
+
+
+Active = one_of(bool, MotorDef)
 
 
 class ConstraintAxis(Node):
@@ -131,6 +154,8 @@ class JointDef(Node):
 
     SECTION: ClassVar[str] = "a joint"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     ALIASES: ClassVar[dict[str, str]] = {"lower": "min", "upper": "max", "effort": "eff",
                                          "velocity": "vel"}
     min: Expr | None = None
@@ -148,20 +173,39 @@ class JointDef(Node):
     parent: str | None = None
     child: str | None = None
     constraint_axes: list[ConstraintAxis] | None = None
-    move_joint_axis_to_intersection: Annotated[list[str], Field(min_length=2, max_length=2)] | None = None
+    move_joint_axis_to_intersection: Annotated[list[str], Length(2, 2)] | None = None
     mimic: MimicDef | None = None
     movement_depends_on: Annotated[list[MimicDef], Before(
         lambda v: [v] if isinstance(v, dict) else v)] | None = None
-    active: bool | MotorDef | None = None
+    active: Active | None = None
     motor: MotorDef | None = None
     name_editing: NameEditing | None = None
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        # what is set to false or nothing asks for nothing (`active: false` on a cut joint)
+        given = [k for k, n in self.declared().items() if n in self.given and getattr(self, n)]
+        given += list(self.entries)
+        if self.cut_joint:
+            return [("W0251", k, f"'{k}' has no effect on a cut joint, which takes only 'parent', "
+                     "'child', 'type', 'constraint_axes' and annotations")
+                    for k in given if k in self.declared() and k not in _CUT_JOINT_KEYS]
+        if self.remove:
+            return [("W0250", k, f"'{k}' has no effect: the joint is removed ('remove: true')")
+                    for k in given if k != "remove"]
+        return [("W0252", k, f"'{k}' has no effect without 'cut_joint: true' (a joint's links "
+                 "change with frames' reparent_to)") for k in ("parent", "child", "constraint_axes")
+                if k in self.given]
+
+
+_CUT_JOINT_KEYS = ("cut_joint", "parent", "child", "type", "constraint_axes", "remove")
 
 
 class JointsSection(Node):
     """`joints`: per-joint settings plus section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "joints"
-    ENTRIES: ClassVar[type | None] = JointDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, JointDef] = Field(init=False)
     default: JointDef | None = Field(None, alias="$default")
     replace_joint_types: dict[JointTypeName, JointTypeName] | None = Field(
         None, alias="$replace_joint_types")
@@ -169,10 +213,26 @@ class JointsSection(Node):
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
     backup: Limits | None = Field(None, alias="$backup")
 
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        if self.all and self.default is None:
+            return [("W0256", "$all", "'$all' has no effect without '$default', the values it "
+                     "applies to every joint")]
+        return []
 
-RemoveWhat = Annotated[bool | list[str], Before(
+
+def _exclude_without_default(section: Node) -> list[tuple[str, str, str]]:
+    if "exclude" in section.given and section.default is None:  # type: ignore[attr-defined]
+        return [("W0255", "$exclude", "'$exclude' has no effect without '$default': it names "
+                 "the links that '$default' leaves out")]
+    return []
+
+
+RemoveWhat = Annotated[one_of(bool, list[str]), Before(
     lambda v: str_or_list(v) if isinstance(v, str) else v)]
 ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
+
+
+Join = one_of(bool, Literal["union"])
 
 
 class CollisionDef(Node):
@@ -180,11 +240,13 @@ class CollisionDef(Node):
 
     SECTION: ClassVar[str] = "a collision entry"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     remove: RemoveWhat = False
     shape: ShapeName | None = None
     oriented: bool = True
     scale: Expr = 1
-    join: bool | Literal["union"] = False
+    join: Join = False
     bitmask: int | None = None
     ccfm: Expr | None = None
 
@@ -193,10 +255,14 @@ class CollisionsSection(Node):
     """`collisions`: per-link (or per-collision) entries, bitmasks, section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "collisions"
-    ENTRIES: ClassVar[type | None] = CollisionDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, CollisionDef] = Field(init=False)
     default: CollisionDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        return _exclude_without_default(self)
     auto_bitmask: bool = False
     apply_primitives: bool = False
     no_collision_between: dict[str, OneOrMore] = {}
@@ -208,6 +274,8 @@ class VisualDef(Node):
 
     SECTION: ClassVar[str] = "a visual entry"
     ANNOTATIONS: ClassVar[bool] = True
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, Any] = Field(init=False)
     remove: RemoveWhat = False
     material: str | None = None
 
@@ -216,7 +284,11 @@ class VisualsSection(Node):
     """`visuals`: per-link entries and section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "visuals"
-    ENTRIES: ClassVar[type | None] = VisualDef
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, VisualDef] = Field(init=False)
     default: VisualDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        return _exclude_without_default(self)

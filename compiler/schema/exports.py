@@ -1,10 +1,18 @@
 """AST of `export_config`: one entry per output, told apart by `type`."""
 
-from __future__ import annotations
-
 from typing import Annotated, ClassVar, Literal
 
-from mpc.compiler.schema.base import Before, Expr, FileName, FileSuffix, Node, OneOrMore, RelativeName
+from mpc.compiler.schema.base import (
+    Before,
+    Expr,
+    FileName,
+    FileSuffix,
+    Node,
+    OneOrMore,
+    RelativeName,
+    one_of,
+    tagged,
+)
 
 
 class _Export(Node):
@@ -19,7 +27,7 @@ class _Kinematic(_Export):
 
     ALIASES: ClassVar[dict[str, str]] = {"add_floatingbase": "add_floating_base"}
     mesh_format: MeshFormat = "input_type"
-    additional_meshes: list[MeshFormat] | MeshFormat | None = None
+    additional_meshes: one_of(list[MeshFormat], MeshFormat) | None = None
     link_in_smurf: bool = False
     include_cut_joints: bool = False
     filename_suffix: FileSuffix = ""
@@ -69,7 +77,7 @@ class RenderExport(_Export):
     geometry: Literal["visual", "collision", "both"] = "visual"
     poses: OneOrMore = ["all"]
     size: list[int] = [640, 480]
-    background: str | list[Expr] = "white"
+    background: one_of(str, list[Expr]) = "white"
 
 
 class JointLimitsExport(_Export):
@@ -97,7 +105,7 @@ class KccdExport(_Export):
     keep_urdf: bool = False
     dirname: str = "kccd"  # a folder inside the output: E0521 when lowering
     reduce_meshes: Expr | None = None
-    edit_collisions: dict[str, dict[str, int | str]] = {}
+    edit_collisions: dict[str, dict[str, one_of(int, str)]] = {}
     braking_model: BrakingModel | None = None
     simplify_swept_from: list[str] = []
     safety_distance: Expr = 0
@@ -125,9 +133,9 @@ class SubmodelExport(_Export):
     add_floating_base: bool = False
     filename: FileName | None = None
     only_urdf: bool = False
-    export_config: list[ExportEntry] | None = None
+    export_config: list["ExportEntry"] | None = None
 
 
-# Told apart by `type` (compiler/schema/base.py: TaggedType).
-ExportEntry = (UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | RenderExport
-               | JointLimitsExport | KccdExport | SubmodelExport)
+# Told apart by `type` (compiler/schema/base.py: tagged).
+ExportEntry = tagged(UrdfExport, SdfExport, MjcfExport, SmurfExport, PdfExport, RenderExport,
+                     JointLimitsExport, KccdExport, SubmodelExport)

@@ -1,10 +1,8 @@
 """AST of `test` and `deployment`: how a model is checked and where it goes."""
 
-from __future__ import annotations
-
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.base import After, Expr, Node, OneOrMore
+from mpc.compiler.schema.base import After, Expr, Node, OneOrMore, one_of
 from mpc.core.diagnostics import did_you_mean
 
 TESTS = frozenset({
@@ -41,7 +39,7 @@ def _test_item(item: Any) -> Any:
     return item
 
 
-TestList = list[Annotated[str | dict[str, Any], After(_test_item)]]
+TestList = list[Annotated[one_of(str, dict[str, Any]), After(_test_item)]]
 
 
 class Tolerances(Node):
