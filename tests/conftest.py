@@ -24,6 +24,14 @@ settings.register_profile("bounded", max_examples=100, deadline=None)
 settings.register_profile("long", max_examples=5000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "bounded"))
 
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The `long` tests first: the workers of `-n auto` take tests in this order, and a long
+    test that starts last would leave one core idle until it ends."""
+    items.sort(key=lambda item: item.get_closest_marker("long") is None)
+
+
 ERD_PACKAGE = PackageResolver().find("example-robot-data")
 assert ERD_PACKAGE is not None, "example-robot-data is not installed (bash scripts/setup.sh)"
 ERD = ERD_PACKAGE / "robots"

@@ -128,6 +128,7 @@ def _states(status: dict[str, Any]) -> dict[str, tuple[str, str, list[tuple[str,
     return out
 
 
+@pytest.mark.long
 def test_the_fleet_pipeline_runs_in_gitlab_ci_local(team: Path, reference: dict[str, Any]) -> None:
     expected = {f"build:{m}": "PASS" for m in MODELS} | {"summary": "PASS", "build:broken": "FAIL",
                                                         "build:broken_child": "FAIL"}

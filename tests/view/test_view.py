@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from tests.conftest import ERD, definition, write
@@ -60,6 +61,7 @@ def settled(browser: Browser, before: np.ndarray | None = None, seconds: float =
     raise AssertionError("the page's drawing did not settle")
 
 
+@pytest.mark.long
 def test_view_draws_the_robot_and_a_slider_moves_it(tmp_path: Path) -> None:
     text = definition(UR5, robotname="ur5") + "  poses:\n    up:\n      shoulder_lift_joint: -1.2\n"
     path = write(tmp_path / "ur5.yml", text)
