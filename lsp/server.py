@@ -11,7 +11,10 @@ Input models stay in one ModelCache for the server's life, re-read only when the
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import gc
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 from lsprotocol import types as lsp
@@ -25,6 +28,19 @@ from mpc.lsp import completion, hover, navigation
 from mpc.lsp.analysis import Analysis, analyse
 from mpc.lsp.diagnostics import convert
 from mpc.lsp.text import Lines
+
+
+@contextlib.contextmanager
+def _no_cycle_collection() -> Iterator[None]:
+    """A check allocates some hundred thousand objects and frees nearly all of them by reference
+    counting; the cyclic collector, run in between over everything the server holds (the
+    input models, the schema, mpc's modules), took 20 of a TALOS check's 50 ms. Its cycles are
+    collected after the diagnostics have gone out."""
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.enable()
 
 
 class MpcServer(LanguageServer):
@@ -53,7 +69,8 @@ class MpcServer(LanguageServer):
             handle.cancel()
         document = self.workspace.get_text_document(uri)
         path = self.path(uri)
-        analysis = analyse(path, document.source, self.open_texts(), self.options)
+        with _no_cycle_collection():
+            analysis = analyse(path, document.source, self.open_texts(), self.options)
         self.analyses[uri] = analysis
         if analysis.passed is not None:
             self.named[uri] = analysis
@@ -141,6 +158,7 @@ def server(packages: dict[str, Path] | None = None) -> MpcServer:
 def serve(packages: dict[str, Path] | None = None, debounce_ms: float | None = None) -> None:
     """Run the server on stdin and stdout until the client says exit."""
     ls = server(packages)
+    gc.freeze()  # mpc's modules and the schema live as long as the server: never scan them again
     if debounce_ms is not None:
         ls.debounce = debounce_ms / 1000
     ls.start_io()
