@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from tests.conftest import ERD, write
 from tests.mpc_command import mpc
 
@@ -21,10 +23,11 @@ def tree(folder: Path) -> dict[str, bytes]:
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
-def test_commands_run_in_order_in_the_output_folder(tmp_path: Path) -> None:
+def test_commands_run_in_order_in_the_output_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A string without shell is split (Phobos's check_urdf line runs, urdfdom's real tool);
     a shell line sees MPC_* and PHOBOS_CI_*; a cwd is relative to the definition; the ROS
     files come after the commands and list the folder they made."""
+    monkeypatch.delenv("MPC_CACHE_DIR", raising=False)  # the user's own MPC_* is not mpc's to set
     (tmp_path / "scripts").mkdir()
     spec = write(tmp_path / "m.yml", HEAD + """
   export_config: [{type: urdf, mesh_format: stl, ros_pathes: true}]
