@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from mpc.cli.output import print_diagnostics, resolver_of, sink_of, summary
@@ -34,10 +33,9 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
     if doc is None:
         return
     if isinstance(doc.data, dict) and "pipeline" in doc.data:
-        from mpc.pipeline.plan import check_pipeline
+        from mpc.pipeline.plan import check_pipeline_file
 
-        check_pipeline(path, sink, lambda model, defaults: driver.check_file(
-            model, sink, replace(options, defaults=defaults)))
+        check_pipeline_file(path, sink, options)
         return
     driver.check_file(path, sink, options, doc)
 

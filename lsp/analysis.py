@@ -119,7 +119,9 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
                 return analysis
             if isinstance(doc.data, dict) and "pipeline" in doc.data:
                 analysis.pipeline = True
-                _check_pipeline(path, sink, options)
+                from mpc.pipeline.plan import check_pipeline_file
+
+                check_pipeline_file(path, sink, options)
             else:
                 _check_definition(analysis, doc, sink, options)
         except OSError as e:
@@ -127,13 +129,6 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
         finally:
             analysis.depends = loaded - {str(path)}
     return analysis
-
-
-def _check_pipeline(path: Path, sink: Sink, options: Options) -> None:
-    from mpc.pipeline.plan import check_pipeline
-
-    check_pipeline(path, sink, lambda model, defaults: driver.check_file(
-        model, sink, replace(options, defaults=defaults)))
 
 
 def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, options: Options) -> None:

@@ -64,9 +64,7 @@ class MpcServer(LanguageServer):
 
     def check(self, uri: str, dependents: bool = True) -> Analysis:
         """Check the buffer now and publish its diagnostics (then those of the files using it)."""
-        handle = self.pending.pop(uri, None)
-        if handle is not None:
-            handle.cancel()
+        self.cancel(uri)
         document = self.workspace.get_text_document(uri)
         path = self.path(uri)
         with _no_cycle_collection():
@@ -83,11 +81,15 @@ class MpcServer(LanguageServer):
                     self.check(other, dependents=False)
         return analysis
 
-    def later(self, uri: str) -> None:
-        """Check the buffer once it has been quiet for the debounce time."""
+    def cancel(self, uri: str) -> None:
+        """Forget the check waiting for the buffer's quiet time, if any."""
         handle = self.pending.pop(uri, None)
         if handle is not None:
             handle.cancel()
+
+    def later(self, uri: str) -> None:
+        """Check the buffer once it has been quiet for the debounce time."""
+        self.cancel(uri)
         self.pending[uri] = asyncio.get_running_loop().call_later(self.debounce, self.check, uri)
 
     def current(self, uri: str) -> Analysis:
@@ -116,9 +118,7 @@ def server(packages: dict[str, Path] | None = None) -> MpcServer:
     @ls.feature(lsp.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(ls: MpcServer, params: lsp.DidCloseTextDocumentParams) -> None:
         uri = params.text_document.uri
-        handle = ls.pending.pop(uri, None)
-        if handle is not None:
-            handle.cancel()
+        ls.cancel(uri)
         ls.analyses.pop(uri, None)
         ls.named.pop(uri, None)
         ls.publish_diagnostics(uri, [])

@@ -12,7 +12,7 @@ import itertools
 import os
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +25,7 @@ from mpc.pipeline import dag
 from mpc.pipeline.defaults import PipelineDefaults
 
 if TYPE_CHECKING:
+    from mpc.compiler.inputs import Options
     from mpc.compiler.schema.definition import PipelineSection
 
 
@@ -136,6 +137,14 @@ def check_pipeline(path: Path, sink: Sink,
                 sink.report(d)
         if not any(d.code in ("E0601", "E0641") for d in model.diagnostics):
             check_definition(model.definition, plan.defaults)  # type: ignore[union-attr]
+
+
+def check_pipeline_file(path: Path, sink: Sink, options: Options) -> None:
+    """`mpc check pipeline.yml` with the driver: each definition under the pipeline's defaults."""
+    from mpc.compiler import driver
+
+    check_pipeline(path, sink, lambda model, defaults: driver.check_file(
+        model, sink, replace(options, defaults=defaults)))
 
 
 def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span: Span,

@@ -6,10 +6,11 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from tests.mpc_command import mpc_process
 
 ROOT = Path(__file__).resolve().parents[2]
 FLEET = ROOT / "examples" / "fleet"
@@ -40,8 +41,7 @@ def env(cache: Path) -> dict[str, str]:
 
 def mpc(*args: str | Path, cwd: Path | None = None,
         cache: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "mpc.cli.main", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, env=env(cache) if cache else None, timeout=600)
+    return mpc_process(*args, cwd=cwd, env=env(cache) if cache else None)
 
 
 def run_json(pipeline: Path, *args: str, cache: Path, cwd: Path | None = None) -> Run:
