@@ -66,8 +66,7 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
         return None if sink.has_errors() else program
     loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
-    for missing in loader.missing_meshes:                                 # check: mesh files
-        sink.report(missing)
+    loader.report_missing_meshes()                                        # check: mesh files
     return None if sink.has_errors() else program
 
 

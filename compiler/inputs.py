@@ -168,6 +168,12 @@ class InputLoader:
             return None
         return path
 
+    def report_missing_meshes(self) -> None:
+        """`mpc check`: the input models' mesh files that do not exist, reported after the
+        names are checked (which they do not hinder)."""
+        for missing in self.missing_meshes:
+            self.sink.report(missing)
+
     def names(self, inp: Input) -> Names | None:
         """The input's names, without applying any op that changes geometry."""
         key = self._key(inp)

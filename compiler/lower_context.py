@@ -58,7 +58,7 @@ class LowerContext:
         values = getattr(node, key)
         if values is None:
             return None
-        out = [evaluate(v, item_span(node, key, i), self.sink, what=f"{what}[{i}]")
+        out = [evaluate(v, node.value_span(key, i), self.sink, what=f"{what}[{i}]")
                for i, v in enumerate(values)]
         return None if None in out else tuple(out)  # type: ignore[return-value]
 
@@ -83,7 +83,7 @@ class LowerContext:
     def replacements(self, node: Node, key: str) -> tuple[tuple[str, str], ...]:
         """A list of `{pattern: replacement}` maps, the patterns checked (E0305)."""
         items = getattr(node, key) or []
-        pairs = [(pattern, str(replacement), item_span(node, key, i))
+        pairs = [(pattern, str(replacement), node.value_span(key, i))
                  for i, item in enumerate(items) for pattern, replacement in item.items()]
         kept = set(self.patterns((pattern, span) for pattern, _, span in pairs))
         return tuple((pattern, replacement) for pattern, replacement, _ in pairs if pattern in kept)
@@ -100,27 +100,18 @@ class LowerContext:
         return tuple(rules)
 
 
-def item_span(node: Node, key: str, i: int) -> Span:
-    """The span of item `i` of the list at `key`."""
-    assert node._doc is not None
-    return node._doc.value_span((*node._path, key, i))
-
-
 def items_span(node: Node, key: str, i: int) -> Span:
     """Item `i` of `key` when it is written as a list, else the whole value (a single name)."""
-    assert node._doc is not None
-    written_as_list = isinstance(node._doc.data_at((*node._path, key)), list)
-    return item_span(node, key, i) if written_as_list else node.value_span(key)
+    written_as_list = isinstance(node.data_at(key), list)
+    return node.value_span(key, i) if written_as_list else node.value_span(key)
 
 
 def pair_span(node: Node, key: str, a: str, b: str) -> Span:
     """The span of `b` in `key: {a: [..., b, ...]}` (or `{a: b}`)."""
-    assert node._doc is not None
-    path = (*node._path, key, a)
-    value = node._doc.data_at(path)
+    value = node.data_at(key, a)
     if isinstance(value, list) and b in value:
-        return node._doc.value_span((*path, value.index(b)))
-    return node._doc.value_span(path)
+        return node.value_span(key, a, value.index(b))
+    return node.value_span(key, a)
 
 
 def strings(value: str | list[str] | None) -> tuple[str, ...]:

@@ -13,7 +13,6 @@ from pathlib import PurePosixPath
 from mpc.compiler.schema.definition import ModelSection
 from mpc.compiler.schema.release import DeploymentSection
 from mpc.core.diagnostics import Sink
-from mpc.core.span import Span
 from mpc.ir.program import Deployment, DeployMirror, DeploySubmodule
 
 
@@ -34,12 +33,12 @@ def lower_deployment(section: DeploymentSection, sink: Sink) -> Deployment:
     keep = []
     for i, pattern in enumerate(section.keep_files):
         if not inside_repository(pattern):
-            sink.error(_item_span(section, "keep_files", i), "E0801",
+            sink.error(section.value_span("keep_files", i), "E0801",
                        f"keep_files entry '{pattern}' is outside the repository; write a path "
                        "relative to the repository's top folder")
             continue
         if not usable_glob(pattern):
-            sink.error(_item_span(section, "keep_files", i), "E0845",
+            sink.error(section.value_span("keep_files", i), "E0845",
                        f"keep_files entry '{pattern}' is not a glob: '**' stands only for whole "
                        "folders, as in 'a/**/*.lua'")
             continue
@@ -83,7 +82,3 @@ def lower_model_deployment(model: ModelSection, sink: Sink) -> Deployment | None
         deployment = replace(deployment, add_lfs_track=lfs)
     return deployment
 
-
-def _item_span(node: DeploymentSection, key: str, i: int) -> Span:
-    assert node._doc is not None
-    return node._doc.value_span((*node._path, key, i))

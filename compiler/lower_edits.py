@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from mpc.compiler.lower_context import LowerContext, item_span, items_span, pair_span
+from mpc.compiler.lower_context import LowerContext, items_span, pair_span
 from mpc.compiler.schema.annotations import MULTI_LINK_SENSORS, SINGLE_LINK_SENSORS, sensor_entries
 from mpc.compiler.schema.base import Node
 from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
@@ -292,7 +292,7 @@ def _joint_edits(ctx: LowerContext, name: str, d: JointDef) -> list[Op]:
         key = "move_joint_axis_to_intersection"
         out.append(ops.MoveJointAxisToIntersection(
             span=d.key_span(key), joint=name, a=a, b=b,
-            spans={"a": item_span(d, key, 0), "b": item_span(d, key, 1)}))
+            spans={"a": d.value_span(key, 0), "b": d.value_span(key, 1)}))
     return out
 
 

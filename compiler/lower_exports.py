@@ -162,12 +162,11 @@ class _Exports:
         keys = KEYS[entry.type]
         out = []
         for key, fmt in sorted(entry.float_fmt_dict.items()):
-            path = (*entry._path, "float_fmt_dict", key)
-            span = entry._doc.value_span(path)
+            span = entry.value_span("float_fmt_dict", key)
             if key != DEFAULT and key not in keys:
                 what = {"urdf": "attribute of a URDF", "sdf": "element of an SDF",
                         "mjcf": "attribute of an MJCF"}[entry.type]
-                self.ctx.sink.error(entry._doc.keys.get(path, span), "E0530",
+                self.ctx.sink.error(entry.key_span("float_fmt_dict", key), "E0530",
                                     f"float_fmt_dict: '{key}' is no number {what} file"
                                     f"{did_you_mean(key, set(keys) | {DEFAULT})}",
                                     hint="'default' formats every number; the others are "
@@ -202,7 +201,7 @@ class _Exports:
         moves = {}
         for joint, pair in entry.move_joint_axis_to_intersection.items():
             if len(pair) != 2:
-                span = entry._doc.value_span((*entry._path, "move_joint_axis_to_intersection", joint))
+                span = entry.value_span("move_joint_axis_to_intersection", joint)
                 count = f"{len(pair)} joint{'' if len(pair) == 1 else 's'}"
                 self.ctx.sink.error(span, "E0526", f"move_joint_axis_to_intersection of '{joint}' names "
                                     f"{count}; it takes the two whose axes meet")
@@ -292,7 +291,7 @@ class _Exports:
 
         # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
         submodels = {e.name for e in self.entries() if e.type == "submodel"}
-        as_string = isinstance(entry._doc.data_at((*entry._path, "joints")), str)
+        as_string = isinstance(entry.data_at("joints"), str)
         if len(joints) == 1 and as_string and joints[0] in submodels:
             return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
         if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:

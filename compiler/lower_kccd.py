@@ -50,7 +50,7 @@ def lower_kccd(low: LowerContext, entry: Any, written: dict[str, Export], submod
             elif key == "shape" and value in KCCD_SHAPES:
                 shapes[link] = str(value)
             else:
-                span = entry._doc.value_span((*entry._path, "edit_collisions", link, key))
+                span = entry.value_span("edit_collisions", link, key)
                 low.sink.error(span, "E0521", f"kccd edit_collisions of '{link}': '{key}: {value}' is "
                                "neither n_points (a whole number, 1 or more) nor shape "
                                f"({', '.join(KCCD_SHAPES)})")

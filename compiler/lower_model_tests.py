@@ -29,9 +29,7 @@ class _TestLowering:
         self.section, self.base_dir, self.sink = section, base_dir, sink
 
     def span(self, *path: str | int) -> Span:
-        node = self.section
-        assert node._doc is not None
-        return node._doc.value_span((*node._path, *path))
+        return self.section.value_span(*path)
 
     def number(self, value: Any, span: Span, what: str) -> float | None:
         return evaluate(value, span, self.sink, what=what)

@@ -19,8 +19,8 @@ def lower_render(entry: Any, sink: Sink, submodel: str = "") -> RenderExport | N
     ok = True
     views: list[str] = []
     for i, view in enumerate(entry.views):
-        span = entry._doc.value_span((*entry._path, "views", i)) if isinstance(
-            entry._doc.data_at((*entry._path, "views")), list) else entry.value_span("views")
+        span = entry.value_span("views", i) if isinstance(
+            entry.data_at("views"), list) else entry.value_span("views")
         if view not in RENDER_VIEWS:
             sink.error(span, "E0572", f"render view '{view}' is none of {', '.join(RENDER_VIEWS)}"
                        f"{did_you_mean(view, set(RENDER_VIEWS))}")
@@ -62,7 +62,7 @@ def _colour(value: object, entry: Any, sink: Sink) -> tuple[float, float, float]
         return None
     from mpc.compiler.expr import evaluate
 
-    rgb = [evaluate(c, entry._doc.value_span((*entry._path, "background", i)), sink, what="background")
+    rgb = [evaluate(c, entry.value_span("background", i), sink, what="background")
            for i, c in enumerate(value)]
     if any(c is None or not 0 <= c <= 1 for c in rgb):
         return None

@@ -343,6 +343,8 @@ def _fast_node(text: str, limits: Limits) -> Node | None:
         return None
     if _CParser is None:
         return None
+    if _within_limits(text, limits):
+        return _compose(text)
     events = _FastComposer(text)
     try:
         depth = aliases = 0
@@ -350,7 +352,7 @@ def _fast_node(text: str, limits: Limits) -> Node | None:
             event = events.get_event()
             if isinstance(event, yaml.CollectionStartEvent):
                 depth += 1
-                if depth > limits.depth:
+                if depth + 1 > limits.depth:  # the limit counts the values inside it too
                     return None
             elif isinstance(event, yaml.CollectionEndEvent):
                 depth -= 1
@@ -358,15 +360,36 @@ def _fast_node(text: str, limits: Limits) -> Node | None:
                 aliases += 1
                 if aliases > limits.aliases:
                     return None
-        loader = _FastComposer(text)
-        try:
-            return loader.get_single_node()
-        finally:
-            loader.dispose()
     except yaml.YAMLError:
         return None
     finally:
         events.dispose()
+    return _compose(text)
+
+
+def _compose(text: str) -> Node | None:
+    loader = _FastComposer(text)
+    try:
+        return loader.get_single_node()
+    except yaml.YAMLError:
+        return None
+    finally:
+        loader.dispose()
+
+
+_INDENT = re.compile(r"^[ -]+", re.M)  # a line's indentation, with the dashes of `- - item`
+
+
+def _within_limits(text: str, limits: Limits) -> bool:
+    """Whether the text is sure to stay within the depth and alias limits, judged from its
+    characters without parsing it. A block collection nested in another starts further right
+    (a list under a mapping's key may share its column: two levels per column), within a
+    line's indentation and dashes; a flow one opens a bracket (`{` never comes here); an alias
+    is written with a `*`."""
+    if text.count("*") > limits.aliases:
+        return False
+    indent = max((m.end() - m.start() for m in _INDENT.finditer(text)), default=0)
+    return 2 * (indent + 1) + text.count("[") + 1 <= limits.depth  # + 1: the innermost value
 
 
 def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS, fast: bool = False) -> Document | None:

@@ -9,6 +9,7 @@ model file. What this does not do: talk LSP (server.py), or build outputs.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -100,6 +101,13 @@ class Analysis:
         return nearest.before if nearest.op.span.line == line or nearest.op.span.col - 1 < indent \
             else nearest.after
 
+    def readers(self) -> dict[str, Span]:
+        """The span of this buffer that reads each input model file, by absolute path."""
+        if self.program is None:
+            return {}
+        return {os.path.abspath(inp.path): inp.span for inp in self.program.inputs.values()
+                if inp.path is not None and os.path.abspath(inp.span.file) == os.path.abspath(self.path)}
+
     def built(self) -> Robot | None:
         """The robot the definition describes (its ops applied), built once when asked."""
         if self._built is None and self.ran is not None and self.loader is not None:
@@ -143,7 +151,8 @@ def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, opti
     program = run_passes(lowered, PassContext(sink, loader.names, Severity.WARNING))
     analysis.passed = program
     if sink.error_count == errors:
-        analysis.ran = program
+        analysis.ran = program  # a missing mesh file (below) does not keep hover from the robot
+    loader.report_missing_meshes()
     for name, inp in lowered.inputs.items():
         if inp.kind != "derived_base":
             robot = loader.robot(inp) if inp.kind == "basefile" else None

@@ -1,7 +1,8 @@
 """mpc's Diagnostics → LSP diagnostics of one buffer: range, severity, code, hint, related notes.
 
-A diagnostic located in another file (a defaults file, a derived_base parent) is shown at
-the top of the buffer with the other file's place as related information. What this does
+A diagnostic located in another file is shown on the buffer's line that reads that file (an
+input model's `basefile` or `derived_base`), else at the top of the buffer (a defaults file),
+with the other file's place as related information. What this does
 not do: decide what is checked (analysis.py).
 """
 
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 
 from lsprotocol import types as lsp
@@ -42,8 +44,10 @@ class _OneLine(Lines):
         self.lines = [""] * (number - 1) + [text]
 
 
-def convert(diagnostics: list[Diagnostic], path: Path, lines: Lines) -> list[lsp.Diagnostic]:
-    """The LSP diagnostics of the buffer of `path`."""
+def convert(diagnostics: list[Diagnostic], path: Path, lines: Lines,
+            readers: Mapping[str, Span] | None = None) -> list[lsp.Diagnostic]:
+    """The LSP diagnostics of the buffer of `path`; `readers`: the buffer's span that reads each
+    other file (by absolute path), where that file's diagnostics are shown."""
     out = []
     here = os.path.abspath(path)
     for d in diagnostics:
@@ -57,7 +61,9 @@ def convert(diagnostics: list[Diagnostic], path: Path, lines: Lines) -> list[lsp
         else:
             related.insert(0, lsp.DiagnosticRelatedInformation(location=location(d.span), message=d.message))
             message = f"{os.path.basename(d.span.file)}:{d.span.line}: {message}"
-            where = lsp.Range(start=lsp.Position(line=0, character=0), end=lsp.Position(line=0, character=0))
+            reader = (readers or {}).get(os.path.abspath(d.span.file))
+            where = lines.range(reader) if reader is not None else lsp.Range(
+                start=lsp.Position(line=0, character=0), end=lsp.Position(line=0, character=0))
         out.append(lsp.Diagnostic(range=where, message=message, severity=_SEVERITY[d.severity], code=d.code,
                                   source="mpc", related_information=related or None))
     return out

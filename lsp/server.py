@@ -72,8 +72,8 @@ class MpcServer(LanguageServer):
         self.analyses[uri] = analysis
         if analysis.passed is not None:
             self.named[uri] = analysis
-        self.publish_diagnostics(uri, convert(analysis.diagnostics, path, Lines(analysis.text)),
-                                 version=document.version)
+        diagnostics = convert(analysis.diagnostics, path, Lines(analysis.text), analysis.readers())
+        self.publish_diagnostics(uri, diagnostics, version=document.version)
         if dependents:
             here = os.path.abspath(path)
             for other, known in list(self.analyses.items()):

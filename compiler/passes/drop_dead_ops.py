@@ -43,6 +43,9 @@ def _discarded(before: Names, after: Names, cut: Op, cut_before: Names, cut_afte
 
 
 def drop_dead_ops(program: Program, ctx: PassContext) -> Program:
+    cut_parts = [op.part for op in program.ops if op.phase() in CUTS]
+    if len(cut_parts) == len(set(cut_parts)):  # no part is cut twice: no cut can be dead
+        return program
     seen: list[tuple[Op, Names, Names]] = []
     symbolic(program, replace(ctx, sink=Sink()), lambda op, before, after: seen.append((op, before, after)))
     dead: dict[int, Op] = {}

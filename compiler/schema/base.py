@@ -385,20 +385,32 @@ class Node(BaseModel):
     def has_entries(cls) -> bool:
         return cls.model_config.get("extra") == "allow" and not cls.ANNOTATIONS
 
+    def _place(self) -> tuple[Document, Path_]:
+        """The document and path the node was read from. Read from pydantic's store of private
+        attributes directly: its `__getattr__` fallback took a third of lowering's time."""
+        private = self.__pydantic_private__
+        assert private is not None and private["_doc"] is not None
+        return private["_doc"], private["_path"]
+
     @property
     def span(self) -> Span:
         """Where this node was written (the key that introduces it)."""
-        assert self._doc is not None
-        return self._doc.span(self._path)
+        doc, path = self._place()
+        return doc.span(path)
 
-    def value_span(self, key: str | int) -> Span:
-        """Where the value of `key` was written (the node itself if the key is absent)."""
-        assert self._doc is not None
-        return self._doc.value_span((*self._path, key))
+    def value_span(self, *keys: str | int) -> Span:
+        """Where the value at `keys` below the node was written (the node itself if absent)."""
+        doc, path = self._place()
+        return doc.value_span((*path, *keys))
 
-    def key_span(self, key: str | int) -> Span:
-        assert self._doc is not None
-        return self._doc.span((*self._path, key))
+    def key_span(self, *keys: str | int) -> Span:
+        doc, path = self._place()
+        return doc.span((*path, *keys))
+
+    def data_at(self, *keys: str | int) -> Any:
+        """The document's data at `keys` below the node, as written."""
+        doc, path = self._place()
+        return doc.data_at((*path, *keys))
 
     @property
     def entries(self) -> dict[str, Any]:

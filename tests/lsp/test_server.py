@@ -87,6 +87,24 @@ def test_diagnostics_are_mpc_checks_at_their_range(server: Client, folder: Path)
     assert elbo["severity"] == 1 and elbo["source"] == "mpc"
 
 
+def test_a_missing_mesh_file_is_reported_as_mpc_check_reports_it(server: Client, tmp_path: Path) -> None:
+    alone = tmp_path  # the arm without its meshes folder
+    shutil.copy(EXAMPLES / "arm.urdf", alone / "arm.urdf")
+    path = alone / "arm.yml"
+    _, diagnostics = opened(server, path, DEFINITION.replace("elbo:", "elbow:"))
+    sink = Sink()
+    check_file(path, sink, Options())
+    message = f"mesh file '{alone / 'meshes/tetra.stl'}' of a visual of link 'base' does not exist"
+    assert [(d.code, d.message) for d in sink.diagnostics] == [("E0602", message)]
+    # the problem is in arm.urdf: shown on the line that reads it, with its own file and line
+    (diagnostic,) = diagnostics
+    assert (diagnostic["code"], diagnostic["message"]) == ("E0602", f"arm.urdf:10: {message}")
+    assert diagnostic["range"] == {"start": {"line": 5, "character": 16}, "end": {"line": 5, "character": 24}}
+    assert diagnostic["relatedInformation"] == [{"message": message, "location": {
+        "uri": (alone / "arm.urdf").as_uri(),
+        "range": {"start": {"line": 9, "character": 32}, "end": {"line": 9, "character": 48}}}}]
+
+
 def test_change_is_checked_again(server: Client, folder: Path) -> None:
     uri, diagnostics = opened(server, folder / "change.yml", DEFINITION)
     assert [d["code"] for d in diagnostics] == ["E0310"]

@@ -54,3 +54,24 @@ def test_libyaml_gives_what_the_python_loader_gives() -> None:
         if a is not None and b is not None:
             assert (a.data, a.values, a.keys) == (b.data, b.values, b.keys)
         assert slow.diagnostics == fast.diagnostics
+
+
+def test_the_fast_path_keeps_the_depth_and_alias_limits() -> None:
+    """Texts at both sides of the limits, nested every way YAML nests (indentation, a list
+    under a key in the same column, `- - item` on one line, brackets), and aliases: the same
+    diagnostics and data, whether libyaml composes them or the Python loader does."""
+    limits = yaml_source.Limits(depth=10, aliases=4)
+    texts = []
+    for n in range(7, 13):
+        texts.append("".join(f"{'  ' * i}k{i}:\n" for i in range(n)) + f"{'  ' * n}v\n")
+        texts.append("".join(f"{' ' * i}k{i}:\n{' ' * i}-\n" for i in range(n // 2)) + f"{' ' * n}v\n")
+        texts.append("- " * n + "v\n")
+        texts.append("a: " + "[" * n + "1" + "]" * n + "\n")
+        texts.append("a: &x 1\nb: [" + ", ".join(["*x"] * (n - 5)) + "]\n")
+    for text in texts:
+        slow, fast = Sink(), Sink()
+        a = yaml_source.loads(text, "f.yml", slow, limits)
+        b = yaml_source.loads(text, "f.yml", fast, limits, fast=True)
+        assert slow.diagnostics == fast.diagnostics, text
+        assert (a is None) == (b is None) and (a is None or (a.data, a.values) == (b.data, b.values)), text
+    assert sum(1 for text in texts if not yaml_source.loads(text, "f.yml", Sink(), limits)) >= 10
