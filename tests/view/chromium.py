@@ -39,14 +39,24 @@ class Browser:
         self.events: list[dict[str, Any]] = []
 
     def call(self, method: str, **params: Any) -> dict[str, Any]:
-        self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
+        return self.calls((method, params))[-1]
+
+    def calls(self, *commands: tuple[str, dict[str, Any]]) -> list[dict[str, Any]]:
+        """Send the commands at once (the page handles them in one go, not one per frame) and
+        return their results in order; the events that arrive meanwhile are kept."""
+        first = self.next_id + 1
+        for method, params in commands:
+            self.next_id += 1
+            self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+        results: dict[int, dict[str, Any]] = {}
+        while len(results) < len(commands):
             message = json.loads(self.ws.recv(timeout=60))
-            if message.get("id") == self.next_id:
+            if message.get("id", 0) >= first:
                 assert "error" not in message, message
-                return message.get("result", {})
-            self.events.append(message)
+                results[message["id"]] = message.get("result", {})
+            else:
+                self.events.append(message)
+        return [results[i] for i in sorted(results)]
 
     def evaluate(self, script: str) -> Any:
         return self.call("Runtime.evaluate", expression=script, returnByValue=True)["result"].get("value")
@@ -63,10 +73,11 @@ class Browser:
     def screenshot(self) -> bytes:
         return base64.b64decode(self.call("Page.captureScreenshot", format="png")["data"])
 
-    def press(self, key: str, code: str, key_code: int) -> None:
-        for kind in ("keyDown", "keyUp"):
-            self.call("Input.dispatchKeyEvent", type=kind, key=key, code=code,
-                      windowsVirtualKeyCode=key_code, nativeVirtualKeyCode=key_code)
+    def press(self, key: str, code: str, key_code: int, times: int = 1) -> None:
+        """Press and release a key `times` times."""
+        keys = {"key": key, "code": code, "windowsVirtualKeyCode": key_code, "nativeVirtualKeyCode": key_code}
+        self.calls(*(("Input.dispatchKeyEvent", {"type": kind, **keys})
+                     for _ in range(times) for kind in ("keyDown", "keyUp")))
 
     def close(self) -> None:
         try:

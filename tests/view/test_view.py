@@ -52,7 +52,7 @@ def settled(browser: Browser, before: np.ndarray | None = None, seconds: float =
     """A screenshot once the drawing stops changing (and differs from `before`, when given)."""
     deadline, last = time.monotonic() + seconds, None
     while time.monotonic() < deadline:
-        time.sleep(1.5)
+        time.sleep(0.5)
         now = viewport(browser.screenshot())
         if last is not None and np.array_equal(now, last) and robot_pixels(now) > 500 and (
                 before is None or not np.array_equal(now, before)):
@@ -83,8 +83,7 @@ def test_view_draws_the_robot_and_a_slider_moves_it(tmp_path: Path) -> None:
         # 16 times (a step is 1/200 of its range, UR5's ±2π: 0.063 rad).
         assert browser.evaluate("(() => { const s = document.querySelectorAll('[role=slider]')[1];"
                                 " s.focus(); return document.activeElement === s; })()")
-        for _ in range(16):
-            browser.press("ArrowRight", "ArrowRight", 39)
+        browser.press("ArrowRight", "ArrowRight", 39, times=16)
         value = browser.wait_for("(() => { const s = document.querySelectorAll('[role=slider]')[1];"
                                  " const v = Number(s.getAttribute('aria-valuenow'));"
                                  " return v > 0.9 && v; })()")
