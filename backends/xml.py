@@ -8,6 +8,7 @@ attribute really begins, so that diagnostics carry a line *and* a column.
 from __future__ import annotations
 
 import bisect
+import functools
 import math
 import re
 from dataclasses import dataclass, field
@@ -61,11 +62,16 @@ class XmlSource:
         src = cls(file, text, root)
         src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
         starts = [(m.start(), m.group(1)) for m in _TOKENS.finditer(text) if m.group(1)]
-        elements = [e for e in root.iter() if isinstance(e.tag, str)]
-        if len(starts) == len(elements):
-            for el, (offset, tag) in zip(elements, starts, strict=True):
-                if tag.rsplit(":", 1)[-1] == _localname(el):
-                    src._offsets[el] = offset
+        elements = list(root.iter(etree.Element))
+        if len(starts) != len(elements):
+            return src
+        tags = [tag for _, tag in starts]
+        if tags == [el.tag for el in elements] and ":" not in "".join(tags):  # no namespaces
+            src._offsets = dict(zip(elements, (offset for offset, _ in starts), strict=True))
+            return src
+        for el, (offset, tag) in zip(elements, starts, strict=True):
+            if tag.rsplit(":", 1)[-1] == _localname(el):
+                src._offsets[el] = offset
         return src
 
     def _pos(self, offset: int) -> tuple[int, int]:
@@ -80,9 +86,7 @@ class XmlSource:
             return Span(self.file, line, 1)
         end = self.text.find(">", offset)
         if attr is not None:
-            m = re.compile(rf"\s{re.escape(attr)}\s*=\s*([\"'])(.*?)\1", re.DOTALL).search(
-                self.text, offset, end + 1 if end >= 0 else len(self.text)
-            )
+            m = _attribute_pattern(attr).search(self.text, offset, end + 1 if end >= 0 else len(self.text))
             if m:
                 line, col = self._pos(m.start(2))
                 end_line, end_col = self._pos(m.end(2))
@@ -90,6 +94,12 @@ class XmlSource:
         line, col = self._pos(offset)
         tag_end = offset + 1 + len(_localname(el))
         return Span(self.file, line, col, line, col + (tag_end - offset))
+
+
+@functools.lru_cache(maxsize=256)
+def _attribute_pattern(attr: str) -> re.Pattern[str]:
+    """Where the value of attribute `attr` is in a start tag (group 2)."""
+    return re.compile(rf"\s{re.escape(attr)}\s*=\s*([\"'])(.*?)\1", re.DOTALL)
 
 
 def _localname(el: etree._Element) -> str:
