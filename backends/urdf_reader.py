@@ -20,6 +20,7 @@ from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, MeshSource, Sphere, mesh_source
 from mpc.ir.robot import (
     JOINT_TYPES,
+    ZERO,
     Calibration,
     Collision,
     Dynamics,
@@ -103,7 +104,7 @@ class _Reader:
         self.sink.error(self.src.span(el, attr), code, message, **kw)  # type: ignore[arg-type]
 
     def warn_unknown_attrs(self, el: etree._Element, known: tuple[str, ...], where: str) -> None:
-        for name in el.attrib:
+        for name in el.keys():  # noqa: SIM118 (an element is no dict: `in el` is its children)
             if name not in known:
                 self.sink.warning(
                     self.src.span(el, name), "W0401",
@@ -111,7 +112,7 @@ class _Reader:
                 )
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
-        return tuple((k, v) for k, v in el.attrib.items() if k not in known)
+        return tuple([item for item in el.items() if item[0] not in known])
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -126,7 +127,7 @@ class _Reader:
             self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
                        f"got '{text}'", attr)
             return None
-        return tuple(values)
+        return values
 
     def number(self, el: etree._Element, attr: str, where: str,
                required: bool = False) -> float | None:
@@ -139,8 +140,8 @@ class _Reader:
         self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
         xyz = self.floats(el, "xyz", 3, where)
         rpy = self.floats(el, "rpy", 3, where)
-        return Pose(xyz or (0.0, 0.0, 0.0), rpy or (0.0, 0.0, 0.0),  # type: ignore[arg-type]
-                    (el.get("xyz") is not None, el.get("rpy") is not None))
+        return Pose(xyz or ZERO, rpy or ZERO,  # type: ignore[arg-type]
+                    ("xyz" in el.attrib, "rpy" in el.attrib))
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")
@@ -209,6 +210,8 @@ class _Reader:
 
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
         """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
+        if next(el.iter(etree.Comment), None) is None:  # most elements hold none: one C-level walk
+            return ()
         out: list[str] = []
         for child in el:
             if child.tag is etree.Comment:

@@ -135,12 +135,12 @@ def fmt_floats(xs: tuple[float, ...] | list[float]) -> str:
     return " ".join(fmt_float(x) for x in xs)
 
 
-def parse_floats(text: str | None) -> list[float] | None:
+def parse_floats(text: str | None) -> tuple[float, ...] | None:
     """Whitespace-separated numbers, or None when any token is not a number."""
     if text is None or "_" in text:  # float() would accept "1_0"; URDF does not
         return None
     try:
-        return [float(token) for token in text.split()]
+        return tuple(map(float, text.split()))
     except ValueError:
         return None
 
