@@ -92,6 +92,7 @@ class _Reader:
         self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
         self.link_names: set[str] = set()
         self.joint_names: set[str] = set()
+        self.names: set[str] = set()  # both
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
         # What tostring adds to a fragment's start tag for the namespaces <robot> declares.
         self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
@@ -186,12 +187,10 @@ class _Reader:
         """Every attribute or text in the fragment that equals a link or joint name, in
         document order (each element's attributes, then its text)."""
         out: list[FragmentRef] = []
-        names = self.link_names | self.joint_names
-        for node in el.iter():
+        names = self.names
+        for node in el.iter(etree.Element):
             tag = node.tag
-            if not isinstance(tag, str):
-                continue
-            for attr, value in node.attrib.items():
+            for attr, value in node.items():
                 name = value.strip()
                 if name in names:
                     out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, tag + attr), name))
@@ -234,6 +233,7 @@ class _Reader:
         elements = self.children(root)
         self.link_names = {e.get("name", "") for e in elements if e.tag == "link"}
         self.joint_names = {e.get("name", "") for e in elements if e.tag == "joint"}
+        self.names = self.link_names | self.joint_names
 
         links: dict[str, Link] = {}
         joints: dict[str, Joint] = {}
