@@ -141,8 +141,8 @@ class _Reader:
         self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
         xyz = self.floats(el, "xyz", 3, where)
         rpy = self.floats(el, "rpy", 3, where)
-        return Pose(xyz or ZERO, rpy or ZERO,  # type: ignore[arg-type]
-                    ("xyz" in el.attrib, "rpy" in el.attrib))
+        keys = el.keys()
+        return Pose(xyz or ZERO, rpy or ZERO, ("xyz" in keys, "rpy" in keys))  # type: ignore[arg-type]
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import bisect
 import functools
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -19,9 +20,10 @@ from lxml import etree
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span, hardened_parser
 
-# Start tags outside comments, CDATA, processing instructions and doctype, in document order.
+# Comments, CDATA, processing instructions, doctype and start tags (`<` and the name), in
+# document order: the start tags among them are those outside the others.
 _TOKENS = re.compile(
-    r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE[^>]*>|<([A-Za-z_][\w:.\-]*)", re.DOTALL
+    r"(<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE[^>]*>|<[A-Za-z_][\w:.\-]*)", re.DOTALL
 )
 
 
@@ -61,7 +63,12 @@ class XmlSource:
         text = data.decode("utf-8", errors="replace")
         src = cls(file, text, root)
         src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
-        starts = [(m.start(), m.group(1)) for m in _TOKENS.finditer(text) if m.group(1)]
+        # split, not finditer: the offsets come from the parts' lengths without a match object
+        # per token (twice as fast on a large URDF); parts alternate text and token.
+        parts = _TOKENS.split(text)
+        offsets = itertools.accumulate(map(len, parts), initial=0)
+        starts = [(offset, token[1:]) for offset, token in zip(
+            itertools.islice(offsets, 1, None, 2), parts[1::2], strict=False) if token[1] not in "!?"]
         elements = list(root.iter(etree.Element))
         if len(starts) != len(elements):
             return src
@@ -84,16 +91,15 @@ class XmlSource:
         if offset is None:
             line = el.sourceline or 1
             return Span(self.file, line, 1)
-        end = self.text.find(">", offset)
         if attr is not None:
+            end = self.text.find(">", offset)
             m = _attribute_pattern(attr).search(self.text, offset, end + 1 if end >= 0 else len(self.text))
             if m:
                 line, col = self._pos(m.start(2))
                 end_line, end_col = self._pos(m.end(2))
                 return Span(self.file, line, col, end_line, end_col)
         line, col = self._pos(offset)
-        tag_end = offset + 1 + len(_localname(el))
-        return Span(self.file, line, col, line, col + (tag_end - offset))
+        return Span(self.file, line, col, line, col + 1 + len(_localname(el)))  # "<" and the name
 
 
 @functools.lru_cache(maxsize=256)
