@@ -17,9 +17,10 @@ from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
-from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere, mesh_source
+from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, MeshSource, Sphere, mesh_source
 from mpc.ir.robot import (
     JOINT_TYPES,
+    ZERO,
     Calibration,
     Collision,
     Dynamics,
@@ -75,12 +76,27 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
     return robot
 
 
+def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:
+    """The child indices (comments counted) from `root` down to its descendant `node`."""
+    path: list[int] = []
+    while node is not root:
+        parent = node.getparent()
+        path.append(parent.index(node))
+        node = parent
+    return tuple(reversed(path))
+
+
 class _Reader:
     def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
                  base_dir: Path) -> None:
         self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
         self.link_names: set[str] = set()
         self.joint_names: set[str] = set()
+        self.names: set[str] = set()  # both
+        self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
+        # What tostring adds to a fragment's start tag for the namespaces <robot> declares.
+        self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
+                                       for prefix, uri in src.root.nsmap.items()]
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -89,7 +105,7 @@ class _Reader:
         self.sink.error(self.src.span(el, attr), code, message, **kw)  # type: ignore[arg-type]
 
     def warn_unknown_attrs(self, el: etree._Element, known: tuple[str, ...], where: str) -> None:
-        for name in el.attrib:
+        for name in el.keys():  # noqa: SIM118 (an element is no dict: `in el` is its children)
             if name not in known:
                 self.sink.warning(
                     self.src.span(el, name), "W0401",
@@ -97,7 +113,7 @@ class _Reader:
                 )
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
-        return tuple((k, v) for k, v in el.attrib.items() if k not in known)
+        return tuple([item for item in el.items() if item[0] not in known])
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -112,7 +128,7 @@ class _Reader:
             self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
                        f"got '{text}'", attr)
             return None
-        return tuple(values)
+        return values
 
     def number(self, el: etree._Element, attr: str, where: str,
                required: bool = False) -> float | None:
@@ -125,8 +141,8 @@ class _Reader:
         self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
         xyz = self.floats(el, "xyz", 3, where)
         rpy = self.floats(el, "rpy", 3, where)
-        return Pose(xyz or (0.0, 0.0, 0.0), rpy or (0.0, 0.0, 0.0),  # type: ignore[arg-type]
-                    (el.get("xyz") is not None, el.get("rpy") is not None))
+        keys = el.keys()
+        return Pose(xyz or ZERO, rpy or ZERO, ("xyz" in keys, "rpy" in keys))  # type: ignore[arg-type]
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")
@@ -138,50 +154,63 @@ class _Reader:
     def children(self, el: etree._Element) -> list[etree._Element]:
         return [c for c in el if isinstance(c.tag, str)]
 
+    @staticmethod
+    def by_tag(el: etree._Element) -> tuple[list[etree._Element], dict[str, etree._Element]]:
+        """The element children of `el` in order, and the first of each tag: what `el.find(tag)`
+        gives for a plain tag, in one pass (each `find` call costs microseconds)."""
+        kids: list[etree._Element] = []
+        first: dict[str, etree._Element] = {}
+        for child in el:
+            tag = child.tag
+            if isinstance(tag, str):
+                kids.append(child)
+                if tag not in first:
+                    first[tag] = child
+        return kids, first
+
     def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
         span = self.src.span(el)
         xml = etree.tostring(el, encoding="unicode", with_tail=False)
         # tostring re-declares every namespace in scope; <robot> declares them already.
         head_end = xml.find(">")
         head = xml[:head_end]
-        for prefix, uri in self.src.root.nsmap.items():
-            head = head.replace(f' xmlns{":" + prefix if prefix else ""}="{uri}"', "", 1)
+        for declaration in self.namespace_declarations:
+            head = head.replace(declaration, "", 1)
         xml = head + xml[head_end:]
-        indent = " " * (span.col - 1)
-        lines = xml.split("\n")
-        xml = "\n".join([lines[0]] + [ln.removeprefix(indent) for ln in lines[1:]])
-        return Fragment(tag=str(el.tag), xml=xml, refs=tuple(self.refs(el)),
-                        comments=comments, span=span)
+        if "\n" in xml:
+            indent = " " * (span.col - 1)
+            lines = xml.split("\n")
+            xml = "\n".join([lines[0]] + [ln.removeprefix(indent) for ln in lines[1:]])
+        return Fragment(tag=str(el.tag), xml=xml, refs=self.refs(el), comments=comments, span=span)
 
-    def refs(self, el: etree._Element) -> list[FragmentRef]:
-        """Every attribute or text in the fragment that equals a link or joint name."""
+    def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
+        """Every attribute or text in the fragment that equals a link or joint name, in
+        document order (each element's attributes, then its text)."""
         out: list[FragmentRef] = []
+        names = self.names
+        for node in el.iter(etree.Element):
+            tag = node.tag
+            for attr, value in node.items():
+                name = value.strip()
+                if name in names:
+                    out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, tag + attr), name))
+            text = node.text
+            if text and (name := text.strip()) and name in names:
+                out.append(FragmentRef(_path(el, node), None, self.kind_of(name, tag), name))
+        return tuple(out)
 
-        def kind_of(value: str, hint: str) -> RefKind | None:
-            is_link, is_joint = value in self.link_names, value in self.joint_names
-            if is_link and is_joint:
-                return "joint" if "joint" in hint.lower() else "link"
-            return "link" if is_link else "joint" if is_joint else None
-
-        def walk(node: etree._Element, path: tuple[int, ...]) -> None:
-            tag = str(node.tag)
-            for attr, value in node.attrib.items():
-                kind = kind_of(value.strip(), tag + attr)
-                if kind:
-                    out.append(FragmentRef(path, attr, kind, value.strip()))
-            if node.text and node.text.strip():
-                kind = kind_of(node.text.strip(), tag)
-                if kind:
-                    out.append(FragmentRef(path, None, kind, node.text.strip()))
-            for i, child in enumerate(node):
-                if isinstance(child.tag, str):
-                    walk(child, (*path, i))
-
-        walk(el, ())
-        return out
+    def kind_of(self, name: str, hint: str) -> RefKind:
+        """Whether the known `name` is a link's or a joint's; `hint` (where it stands) decides
+        for a name that is both."""
+        is_link, is_joint = name in self.link_names, name in self.joint_names
+        if is_link and is_joint:
+            return "joint" if "joint" in hint.lower() else "link"
+        return "link" if is_link else "joint"
 
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
         """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
+        if next(el.iter(etree.Comment), None) is None:  # most elements hold none: one C-level walk
+            return ()
         out: list[str] = []
         for child in el:
             if child.tag is etree.Comment:
@@ -204,6 +233,7 @@ class _Reader:
         elements = self.children(root)
         self.link_names = {e.get("name", "") for e in elements if e.tag == "link"}
         self.joint_names = {e.get("name", "") for e in elements if e.tag == "joint"}
+        self.names = self.link_names | self.joint_names
 
         links: dict[str, Link] = {}
         joints: dict[str, Joint] = {}
@@ -285,7 +315,8 @@ class _Reader:
         )
 
     def inertial(self, el: etree._Element, where: str) -> Inertial | None:
-        mass_el, inertia_el = el.find("mass"), el.find("inertia")
+        kids, first = self.by_tag(el)
+        mass_el, inertia_el = first.get("mass"), first.get("inertia")
         mass = self.number(mass_el, "value", where, True) if mass_el is not None else None
         if mass_el is None:
             self.error(el, "E0403", f"<inertial> in {where} has no <mass>")
@@ -294,12 +325,11 @@ class _Reader:
             self.error(el, "E0403", f"<inertial> in {where} has no <inertia>")
         else:
             values = [self.number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
-        extras = tuple(self.fragment(c) for c in self.children(el)
-                       if c.tag not in ("origin", "mass", "inertia"))
+        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "mass", "inertia"))
         if mass is None or len(values) != 6 or None in values:
             return None
         return Inertial(mass=mass, inertia=Inertia(**dict(zip(_INERTIA_KEYS, values, strict=True))),
-                        origin=self.pose(el.find("origin"), where), extras=extras)
+                        origin=self.pose(first.get("origin"), where), extras=extras)
 
     def geometry(self, el: etree._Element | None, parent: etree._Element,
                  where: str) -> Geometry | None:
@@ -332,8 +362,12 @@ class _Reader:
                 self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
                 return None
             scale = self.floats(shape, "scale", 3, where)
-            source = mesh_source(self.resolver, uri, self.base_dir)
-            if source.path is not None and (why := self.resolver.refusal(source.path, self.base_dir)):
+            if uri not in self.mesh_sources:  # a file's visuals and collisions share meshes
+                source = mesh_source(self.resolver, uri, self.base_dir)
+                refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
+                self.mesh_sources[uri] = source, refusal
+            source, why = self.mesh_sources[uri]
+            if why:
                 self.error(shape, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
                 return None
             return Mesh(source=source,
@@ -344,36 +378,36 @@ class _Reader:
         return None
 
     def visual(self, el: etree._Element, where: str) -> Visual | None:
-        geometry_el = el.find("geometry")
+        kids, first = self.by_tag(el)
+        geometry_el = first.get("geometry")
         geometry = self.geometry(geometry_el, el, where)
         material, inline = None, None
-        material_el = el.find("material")
+        material_el = first.get("material")
         if material_el is not None:
             material = material_el.get("name")
             if material is None:
                 self.error(material_el, "E0403", f"<material> in {where} has no 'name' attribute")
             if len(material_el):
                 inline = self.material(material_el, (), where)
-        extras = tuple(self.fragment(c) for c in self.children(el)
-                       if c.tag not in ("origin", "geometry", "material"))
+        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry", "material"))
         if geometry is None:
             return None
         return Visual(
-            geometry=geometry, name=el.get("name"), origin=self.pose(el.find("origin"), where),
+            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
             material=material, inline_material=inline,
             geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
             extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
         )
 
     def collision(self, el: etree._Element, where: str) -> Collision | None:
-        geometry_el = el.find("geometry")
+        kids, first = self.by_tag(el)
+        geometry_el = first.get("geometry")
         geometry = self.geometry(geometry_el, el, where)
-        extras = tuple(self.fragment(c) for c in self.children(el)
-                       if c.tag not in ("origin", "geometry"))
+        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry"))
         if geometry is None:
             return None
         return Collision(
-            geometry=geometry, name=el.get("name"), origin=self.pose(el.find("origin"), where),
+            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
             geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
             extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
         )
@@ -383,7 +417,8 @@ class _Reader:
         if name is None:
             self.error(el, "E0403", f"<material> in {where} has no 'name' attribute")
             return None
-        color, texture = el.find("color"), el.find("texture")
+        _, first = self.by_tag(el)
+        color, texture = first.get("color"), first.get("texture")
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
         return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
                         texture=texture.get("filename", "") if texture is not None else None,
@@ -401,18 +436,19 @@ class _Reader:
             self.error(el, "E0422", f"{where} has unknown type '{jtype}'{hint}", "type",
                        hint="URDF joint types: " + ", ".join(JOINT_TYPES))
             ok = False
+        kids, first = self.by_tag(el)
         ends = {}
         for end in ("parent", "child"):
-            end_el = el.find(end)
+            end_el = first.get(end)
             if end_el is None or not end_el.get("link"):
                 self.error(end_el if end_el is not None else el, "E0403",
                            f"{where} has no <{end} link=…>")
                 ok = False
             else:
                 ends[end] = end_el.get("link")
-        axis_el = el.find("axis")
+        axis_el = first.get("axis")
         axis = self.floats(axis_el, "xyz", 3, where) if axis_el is not None else None
-        limit = self.limit(el.find("limit"), where)
+        limit = self.limit(first.get("limit"), where)
         if jtype in ("revolute", "prismatic") and (limit is None or limit.effort is None
                                                    or limit.velocity is None):
             self.error(el, "E0421", f"{where} is {jtype} but has no <limit> with effort and "
@@ -420,17 +456,18 @@ class _Reader:
             ok = False
         known = ("origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
                  "calibration", "safety_controller")
-        extras = tuple(self.fragment(c) for c in self.children(el) if c.tag not in known)
+        extras = tuple(self.fragment(c) for c in kids if c.tag not in known)
         if len(ends) < 2:
             return None
         if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
             jtype = "fixed"
         return Joint(
             name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
-            origin=self.pose(el.find("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
-            dynamics=self.dynamics(el.find("dynamics"), where), mimic=self.mimic(el.find("mimic"), where),
-            calibration=self.calibration(el.find("calibration"), where),
-            safety_controller=self.safety(el.find("safety_controller"), where),
+            origin=self.pose(first.get("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
+            dynamics=self.dynamics(first.get("dynamics"), where),
+            mimic=self.mimic(first.get("mimic"), where),
+            calibration=self.calibration(first.get("calibration"), where),
+            safety_controller=self.safety(first.get("safety_controller"), where),
             extra_attrs=self.extra_attrs(el, ("name", "type")), extras=extras,
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )

@@ -24,17 +24,32 @@ IND = "  "
 
 
 def _attrs(pairs: list[tuple[str, str | None]] | Attrs) -> str:
-    return "".join(f' {k}="{xml_escape.attribute(v)}"' for k, v in pairs if v is not None)
-
-
-def _num(x: float | None) -> str | None:
-    return None if x is None else fmt_float(x)
+    return "".join([f' {k}="{xml_escape.attribute(v)}"' for k, v in pairs if v is not None])
 
 
 class _Writer:
     def __init__(self, mesh_name: MeshNamer, formats: Formats | None = None) -> None:
         self.mesh_name, self.formats = mesh_name, formats
         self.out: list[str] = []
+        # The text of each number and tuple written so far: a robot repeats many of them.
+        self.texts: dict[float, str] = {}
+        self.tuple_texts: dict[tuple[float, ...], str] = {}
+
+    def num(self, x: float | None) -> str | None:
+        if x is None:
+            return None
+        text = self.texts.get(x)
+        if text is None:
+            text = self.texts[x] = fmt_float(x)
+        return text
+
+    def nums(self, xs: tuple[float, ...]) -> str:
+        if type(xs) is not tuple:  # a list: not hashable
+            return fmt_floats(xs)
+        text = self.tuple_texts.get(xs)
+        if text is None:
+            text = self.tuple_texts[xs] = fmt_floats(xs)
+        return text
 
     def line(self, depth: int, text: str) -> None:
         self.out.append(IND * depth + text)
@@ -58,8 +73,8 @@ class _Writer:
         if pose is None:
             return
         self.leaf(depth, "origin", [
-            ("xyz", fmt_floats(pose.xyz) if pose.written[0] else None),
-            ("rpy", fmt_floats(pose.rpy) if pose.written[1] else None),
+            ("xyz", self.nums(pose.xyz) if pose.written[0] else None),
+            ("rpy", self.nums(pose.rpy) if pose.written[1] else None),
         ])
 
     def geometry(self, depth: int, geometry: Geometry, attrs: Attrs) -> None:
@@ -67,16 +82,16 @@ class _Writer:
         d = depth + 1
         match geometry:
             case Box():
-                self.leaf(d, "box", [("size", fmt_floats(geometry.size)), *geometry.extra_attrs])
+                self.leaf(d, "box", [("size", self.nums(geometry.size)), *geometry.extra_attrs])
             case Cylinder():
-                self.leaf(d, "cylinder", [("radius", fmt_float(geometry.radius)),
-                                          ("length", fmt_float(geometry.length)),
+                self.leaf(d, "cylinder", [("radius", self.num(geometry.radius)),
+                                          ("length", self.num(geometry.length)),
                                           *geometry.extra_attrs])
             case Sphere():
-                self.leaf(d, "sphere", [("radius", fmt_float(geometry.radius)),
+                self.leaf(d, "sphere", [("radius", self.num(geometry.radius)),
                                         *geometry.extra_attrs])
             case Mesh():
-                scale = fmt_floats(geometry.scale) if geometry.scale is not None else None
+                scale = self.nums(geometry.scale) if geometry.scale is not None else None
                 self.leaf(d, "mesh", [("filename", self.mesh_name(geometry)), ("scale", scale),
                                       *geometry.extra_attrs])
         self.line(depth, "</geometry>")
@@ -89,7 +104,7 @@ class _Writer:
             return
         self.line(depth, head + ">")
         if material.rgba is not None:
-            self.leaf(depth + 1, "color", [("rgba", fmt_floats(material.rgba))])
+            self.leaf(depth + 1, "color", [("rgba", self.nums(material.rgba))])
         if material.texture is not None:
             self.leaf(depth + 1, "texture", [("filename", material.texture or None)])
         self.line(depth, "</material>")
@@ -98,9 +113,9 @@ class _Writer:
         self.line(depth, "<inertial>")
         d = depth + 1
         self.pose(d, inertial.origin)
-        self.leaf(d, "mass", [("value", fmt_float(inertial.mass))])
+        self.leaf(d, "mass", [("value", self.num(inertial.mass))])
         i = inertial.inertia
-        self.leaf(d, "inertia", [(k, fmt_float(getattr(i, k)))
+        self.leaf(d, "inertia", [(k, self.num(getattr(i, k)))
                                  for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")])
         for frag in inertial.extras:
             self.fragment(d, frag)
@@ -149,25 +164,25 @@ class _Writer:
         self.leaf(d, "parent", [("link", joint.parent)])
         self.leaf(d, "child", [("link", joint.child)])
         if joint.axis is not None:
-            self.leaf(d, "axis", [("xyz", fmt_floats(joint.axis))])
+            self.leaf(d, "axis", [("xyz", self.nums(joint.axis))])
         if (c := joint.calibration) is not None:
-            self.leaf(d, "calibration", [("rising", _num(c.rising)), ("falling", _num(c.falling)),
-                                         ("reference_position", _num(c.reference_position))])
+            self.leaf(d, "calibration", [("rising", self.num(c.rising)), ("falling", self.num(c.falling)),
+                                         ("reference_position", self.num(c.reference_position))])
         if (dyn := joint.dynamics) is not None:
-            self.leaf(d, "dynamics", [("damping", _num(dyn.damping)),
-                                      ("friction", _num(dyn.friction)), *dyn.extra_attrs])
+            self.leaf(d, "dynamics", [("damping", self.num(dyn.damping)),
+                                      ("friction", self.num(dyn.friction)), *dyn.extra_attrs])
         if (lim := joint.limit) is not None:
-            self.leaf(d, "limit", [("lower", _num(lim.lower)), ("upper", _num(lim.upper)),
-                                   ("effort", _num(lim.effort)), ("velocity", _num(lim.velocity)),
+            self.leaf(d, "limit", [("lower", self.num(lim.lower)), ("upper", self.num(lim.upper)),
+                                   ("effort", self.num(lim.effort)), ("velocity", self.num(lim.velocity)),
                                    *lim.extra_attrs])
         if (m := joint.mimic) is not None:
-            self.leaf(d, "mimic", [("joint", m.joint), ("multiplier", _num(m.multiplier)),
-                                   ("offset", _num(m.offset))])
+            self.leaf(d, "mimic", [("joint", m.joint), ("multiplier", self.num(m.multiplier)),
+                                   ("offset", self.num(m.offset))])
         if (s := joint.safety_controller) is not None:
             self.leaf(d, "safety_controller", [
-                ("soft_lower_limit", _num(s.soft_lower_limit)),
-                ("soft_upper_limit", _num(s.soft_upper_limit)),
-                ("k_position", _num(s.k_position)), ("k_velocity", _num(s.k_velocity))])
+                ("soft_lower_limit", self.num(s.soft_lower_limit)),
+                ("soft_upper_limit", self.num(s.soft_upper_limit)),
+                ("k_position", self.num(s.k_position)), ("k_velocity", self.num(s.k_velocity))])
         for frag in joint.extras:
             self.fragment(d, frag)
         self.line(depth, "</joint>")

@@ -7,6 +7,10 @@ the URDF writer) never uses. What it does not do: drop characters XML cannot hol
 
 from __future__ import annotations
 
+import re
+
+_ATTRIBUTE_SPECIAL = re.compile('[&<>"\n\r\t]')
+
 
 def text(value: str) -> str:
     """`value` as the text of an element: `&`, `<` and `>` escaped."""
@@ -16,5 +20,7 @@ def text(value: str) -> str:
 def attribute(value: str) -> str:
     """`value` inside a double-quoted attribute: also `"`, and the whitespace that a parser
     would turn into spaces (newline, carriage return, tab) as character references."""
+    if _ATTRIBUTE_SPECIAL.search(value) is None:  # most values (numbers, names): one scan
+        return value
     return (text(value).replace('"', "&quot;").replace("\n", "&#10;").replace("\r", "&#13;")
             .replace("\t", "&#9;"))

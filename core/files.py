@@ -101,9 +101,24 @@ def _realpath(path: Path, real_dirs: dict[str, str] | None) -> str:
     if real_dirs is None:
         return os.path.realpath(path)
     folder, name = os.path.split(os.path.abspath(path))
-    if folder not in real_dirs:
-        real_dirs[folder] = os.path.realpath(folder)
-    joined = os.path.join(real_dirs[folder], name)
+    return _resolved(os.path.join(_real_folder(folder, real_dirs), name))
+
+
+def _real_folder(folder: str, real_dirs: dict[str, str]) -> str:
+    """os.path.realpath of the absolute, normalized `folder`, one component at a time with
+    each resolved folder kept in `real_dirs`: a model's meshes lie in a few folders below one
+    long path, and realpath would look at each component of it again for every folder."""
+    real = real_dirs.get(folder)
+    if real is None:
+        parent, name = os.path.split(folder)
+        real = (os.path.realpath(folder) if not name  # the root: "//" is "/"
+                else _resolved(os.path.join(_real_folder(parent, real_dirs), name)))
+        real_dirs[folder] = real
+    return real
+
+
+def _resolved(joined: str) -> str:
+    """The path `joined`, whose folder is resolved already, with its last component resolved."""
     return os.path.realpath(joined) if os.path.islink(joined) else joined
 
 
