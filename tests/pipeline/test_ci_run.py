@@ -50,13 +50,24 @@ def _git(top: Path, *args: str) -> None:
                    check=True, capture_output=True)
 
 
+def _tracked_files(to: Path) -> Path:
+    """The checkout's tracked files copied to `to`: setuptools leaves build/ in the tree it builds."""
+    listed = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+    for name in filter(None, listed.decode().split("\0")):
+        if (ROOT / name).is_file():  # a file deleted but not yet staged is listed too
+            (to / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(ROOT / name, to / name)
+    return to
+
+
 @pytest.fixture(scope="module")
 def team(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A definitions repository that pins this mpc (a wheel built from this checkout)."""
     top = tmp_path_factory.mktemp("team")
     fleet(top / "fleet")
+    source = _tracked_files(top.parent / f"{top.name}-src")
     built = subprocess.run([str(UV), "build", "--wheel", "--quiet", "--out-dir", str(top / "wheels"),
-                            str(ROOT)], capture_output=True, text=True)
+                            str(source)], capture_output=True, text=True)
     assert built.returncode == 0, built.stderr
     (top / "wheels" / ".gitignore").unlink(missing_ok=True)  # uv build ignores its output folder
     [wheel] = (top / "wheels").glob("*.whl")
@@ -95,7 +106,10 @@ def _run_pipeline(top: Path) -> tuple[subprocess.CompletedProcess[str], dict[str
     if not (tools / "uv").exists():
         (tools / "uv").symlink_to(UV)  # uv alone: the jobs must install mpc themselves
     path = [p for p in os.environ["PATH"].split(os.pathsep) if p and not (Path(p) / "mpc").exists()]
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("VIRTUAL_ENV", "MPC_", "UV_", "GITLAB"))}
+    # a runner's environment: none of this machine's Python, mpc or uv settings (and Python
+    # writes bytecode, as it does by default, so a job's second mpc process starts sooner)
+    drop = ("VIRTUAL_ENV", "MPC_", "UV_", "GITLAB", "PYTHONDONTWRITEBYTECODE")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(drop)}
     env["PATH"] = os.pathsep.join([str(tools), *path])
     uv_cache = subprocess.run([str(UV), "cache", "dir"], capture_output=True, text=True,
                               check=True).stdout.strip()
