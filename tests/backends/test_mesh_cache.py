@@ -144,3 +144,61 @@ def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
     spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
     assert compile_file(spec, tmp_path / "two", Sink()).out is not None
     assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
+
+
+_OPENED: list[str] | None = None  # the files opened while a test listens (an audit hook cannot be removed)
+
+
+def _listen(event: str, args: tuple[object, ...]) -> None:
+    if _OPENED is not None and event == "open" and isinstance(args[0], str):
+        _OPENED.append(args[0])
+
+
+sys.addaudithook(_listen)
+
+
+def test_a_remembered_digest_is_given_only_for_the_same_file_status(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Source digests are remembered across processes by the file's status (core/cache.py): a
+    process that finds one opens the file (so `mpc run` sees the input) but does not hash it;
+    an edit that keeps the size and the modification time is still noticed."""
+    global _OPENED
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_SETTLED_NS", 0)  # remember files written a moment ago too
+    mesh = tetra_stl(tmp_path / "tetra.stl")
+    first = cache.file_digest(mesh)
+    assert first == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    assert len(list((tmp_path / "cache/digests").glob("*/*"))) == 1
+    monkeypatch.setattr(cache, "_digests", {})  # another process
+    monkeypatch.setattr(hashlib, "file_digest", None)  # hashing now fails the test
+    _OPENED = []
+    try:
+        assert cache.file_digest(mesh) == first
+        assert str(mesh) in _OPENED
+    finally:
+        _OPENED = None
+    monkeypatch.undo()
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_digests", {})
+    st = os.stat(mesh)
+    data = bytearray(mesh.read_bytes())
+    data[-1] ^= 1
+    while time.time_ns() < st.st_ctime_ns + 20_000_000:  # file times tick coarsely: let one pass
+        time.sleep(0.005)
+    mesh.write_bytes(bytes(data))
+    os.utime(mesh, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert (os.stat(mesh).st_size, os.stat(mesh).st_mtime_ns) == (st.st_size, st.st_mtime_ns)
+    assert cache.file_digest(mesh) == hashlib.sha256(bytes(data)).hexdigest() != first
+
+
+def test_a_file_written_a_moment_ago_is_hashed_every_time(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its times may not yet show an edit made in the same tick: it is not remembered."""
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    mesh = tetra_stl(tmp_path / "tetra.stl")
+    assert cache.file_digest(mesh) == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    assert not (tmp_path / "cache/digests").exists()
