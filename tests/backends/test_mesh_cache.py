@@ -202,3 +202,28 @@ def test_a_file_written_a_moment_ago_is_hashed_every_time(tmp_path: Path,
     mesh = tetra_stl(tmp_path / "tetra.stl")
     assert cache.file_digest(mesh) == hashlib.sha256(mesh.read_bytes()).hexdigest()
     assert not (tmp_path / "cache/digests").exists()
+
+
+@pytest.mark.parametrize("same_bytes", [True, False])
+def test_mesh_files_of_one_name_share_an_output_only_with_the_same_bytes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, same_bytes: bool) -> None:
+    """Two folders' `tetra.stl`: one output file when their bytes are equal (known by their
+    digests), else each named after its own content."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    tetra_stl(tmp_path / "model/meshes/tetra.stl")
+    other = tetra_stl(tmp_path / "model/other/tetra.stl")
+    if not same_bytes:
+        other.write_bytes(other.read_bytes()[:-1] + b"\1")
+    urdf = ARM_URDF.replace("<collision>\n      <geometry><box size=\"0.05 0.05 0.4\"/></geometry>",
+                            "<collision>\n      <geometry><mesh filename=\"other/tetra.stl\"/></geometry>")
+    write(tmp_path / "model/arm.urdf", urdf)
+    spec = write(tmp_path / "model/arm.yml", definition("arm.urdf", "stl", "arm"))
+    out = compile_file(spec, tmp_path / "out", Sink()).out
+    assert out is not None
+    names = sorted(p.name for p in (out / "meshes/stl").iterdir())
+    if same_bytes:
+        assert names == ["tetra.stl"]
+    else:
+        digests = [hashlib.sha256(p.read_bytes() + b"()").hexdigest()[:10]
+                   for p in (tmp_path / "model/meshes/tetra.stl", other)]
+        assert names == sorted(f"tetra_{d}.stl" for d in digests)
