@@ -146,10 +146,10 @@ def trace(event: str) -> None:
 # in `digests/` for the next ones, so a warm build does not read its meshes to find their
 # entries. A file changed since has another status, so another key (an edit that keeps the
 # size and the modification time still changes the change time, which no user can set). A
-# file modified in the last seconds is hashed every time: its times may not yet show a change
-# made in the same tick of the file system's clock. The file is opened all the same, without
-# being read: `mpc run` learns what a build depends on from the files it opens
-# (pipeline/fingerprint.py).
+# file modified in the last seconds is not remembered for the next processes: its times may
+# not yet show a change made in the same tick of the file system's clock. The file is opened
+# all the same, without being read: `mpc run` learns what a build depends on from the files
+# it opens (pipeline/fingerprint.py).
 _digests: dict[tuple[object, ...], str] = {}
 _SETTLED_NS = 2_000_000_000
 
@@ -169,8 +169,8 @@ def file_digest(path: Path) -> str:
                 _digests[identity] = known
                 return known
         digest = hashlib.file_digest(f, "sha256").hexdigest()
+    _digests[identity] = digest
     if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
-        _digests[identity] = digest
         from mpc.core.files import write_atomic
 
         with contextlib.suppress(OSError):

@@ -193,9 +193,9 @@ def test_a_remembered_digest_is_given_only_for_the_same_file_status(
     assert cache.file_digest(mesh) == hashlib.sha256(bytes(data)).hexdigest() != first
 
 
-def test_a_file_written_a_moment_ago_is_hashed_every_time(tmp_path: Path,
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
-    """Its times may not yet show an edit made in the same tick: it is not remembered."""
+def test_a_file_written_a_moment_ago_is_not_remembered_for_other_processes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its times may not yet show an edit made in the same tick: each build hashes it again."""
     from mpc.core import cache
 
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
