@@ -9,11 +9,11 @@ previous output stays as it was, since nothing is swapped into place.
 
 from __future__ import annotations
 
-import os
 import shlex
 import subprocess
 from pathlib import Path
 
+from mpc.core import blas
 from mpc.core.diagnostics import Sink
 from mpc.ir.program import CommandExport
 
@@ -22,7 +22,7 @@ _OUTPUT_LINES = 20  # the end of a failing command's output shown in the diagnos
 
 def environment(staging: Path, out: Path, definition_dir: Path) -> dict[str, str]:
     places = {"EXPORTDIR": staging, "TARGETDIR": out, "DEFINITIONDIR": definition_dir}
-    env = dict(os.environ)
+    env = blas.user_environment()
     for name, path in places.items():
         env[f"MPC_{name}"] = env[f"PHOBOS_CI_{name}"] = str(path.resolve())
     return env

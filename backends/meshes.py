@@ -10,7 +10,6 @@ another format, is computed with trimesh (DAE through pycollada, with its unit).
 
 from __future__ import annotations
 
-import filecmp
 import hashlib
 import os
 import shutil
@@ -125,6 +124,8 @@ def _suffix(ops: tuple[MeshOp, ...]) -> str:
 
 
 def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
+    from mpc.core.cache import file_digest
+
     by_name: dict[str, list[MeshKey]] = {}
     for k, name in wanted.items():
         by_name.setdefault(name, []).append(k)
@@ -134,8 +135,9 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
             continue
         paths = {p for p, _ in keys}
         first = keys[0][0]
+        # The same bytes: by their digests, which a warm build knows without reading the files.
         if len(set(ops for _, ops in keys)) == 1 and all(
-                filecmp.cmp(first, p, shallow=False) for p in paths):
+                file_digest(first) == file_digest(p) for p in paths):
             continue
         stem, ext = name.rsplit(".", 1)
         for k in keys:

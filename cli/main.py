@@ -169,6 +169,9 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from mpc.core import blas
+
+    blas.one_thread()  # before anything imports numpy
     args = _parser().parse_args(argv)
     try:
         with _without_cyclic_gc(args.command):

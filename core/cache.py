@@ -9,6 +9,7 @@ import contextlib
 import hashlib
 import os
 import shutil
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -139,18 +140,39 @@ def trace(event: str) -> None:
 
 
 # -- file digests ------------------------------------------------------------------------------
-# A build finds its mesh entries by the hash of each source file, for each export and format:
-# the hash is remembered for the process by the file's identity and status (path, device,
-# inode, size, modification and change times to the nanosecond), as git's index does. It is
-# not remembered across processes: `mpc run` learns what a build depends on from the files it
-# reads (pipeline/fingerprint.py), so every build reads its meshes once.
+# A build finds its mesh entries by the hash of each source file, for each export and format.
+# The hash is remembered by the file's identity and status (real path, device, inode, size,
+# modification and change times to the nanosecond), as git's index does: for the process, and
+# in `digests/` for the next ones, so a warm build does not read its meshes to find their
+# entries. A file changed since has another status, so another key (an edit that keeps the
+# size and the modification time still changes the change time, which no user can set). A
+# file modified in the last seconds is not remembered for the next processes: its times may
+# not yet show a change made in the same tick of the file system's clock. The file is opened
+# all the same, without being read: `mpc run` learns what a build depends on from the files
+# it opens (pipeline/fingerprint.py).
 _digests: dict[tuple[object, ...], str] = {}
+_SETTLED_NS = 2_000_000_000
 
 
 def file_digest(path: Path) -> str:
     """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
-    st = path.stat()
-    identity = (str(path.resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
-    if identity not in _digests:
-        _digests[identity] = hashlib.sha256(path.read_bytes()).hexdigest()
-    return _digests[identity]
+    with open(path, "rb") as f:
+        st = os.fstat(f.fileno())
+        identity = (os.path.realpath(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+        if identity in _digests:
+            return _digests[identity]
+        name = hashlib.sha256(repr(identity).encode()).hexdigest()
+        memo = cache_dir("digests") / name[:2] / name
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            known = memo.read_text(encoding="ascii").strip()
+            if len(known) == 64 and all(c in "0123456789abcdef" for c in known):
+                _digests[identity] = known
+                return known
+        digest = hashlib.file_digest(f, "sha256").hexdigest()
+    _digests[identity] = digest
+    if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
+        from mpc.core.files import write_atomic
+
+        with contextlib.suppress(OSError):
+            write_atomic(memo, digest + "\n")
+    return digest

@@ -60,20 +60,19 @@ def mpc_version() -> str:
     from mpc.core.version import mpc_version as installed_version
 
     ver = installed_version()
-    files = source_files()
-    # The digest of the same files (names, sizes, times) is kept in the cache: a run that
-    # changes nothing reads no source file.
+    files = _source_stats()
+    # The digest of the same files (names and status: size, inode, modification and change
+    # times) is kept in the cache: a run that changes nothing reads no source file.
     stats = hashlib.sha256(ver.encode())
-    for name, file in files:
-        st = file.stat()
-        stats.update(f"{name}\0{st.st_size}\0{st.st_mtime_ns}\0".encode())
+    for name, _, st in files:
+        stats.update(f"{name}\0{st.st_size}\0{st.st_ino}\0{st.st_mtime_ns}\0{st.st_ctime_ns}\0".encode())
     kept = cache_dir("version") / stats.hexdigest()
     with contextlib.suppress(OSError, UnicodeDecodeError):
         known = kept.read_text(encoding="utf-8")
         if re.fullmatch(r"[0-9a-f]{16}", known):
             return f"{ver}+{known}"
     h = hashlib.sha256(ver.encode())
-    for name, file in files:
+    for name, file, _ in files:
         h.update(name.encode())
         h.update(file.read_bytes())
     with contextlib.suppress(OSError):
@@ -83,27 +82,47 @@ def mpc_version() -> str:
 
 
 def source_files() -> list[tuple[str, Path]]:
-    """mpc's own source files (Python and grammars), each with its name inside `mpc`.
+    """mpc's own source files (Python and grammars), each with its name inside `mpc`."""
+    return [(name, file) for name, file, _ in _source_stats()]
+
+
+def _source_stats() -> list[tuple[str, Path, os.stat_result]]:
+    """mpc's own source files, each with its name inside `mpc` and its status, sorted by name.
 
     The packages are found through the `mpc` namespace, not as the folders next to
     `compiler/`: in a checkout those include tests/, which are not part of mpc.
     """
-    import importlib.util
-
     import mpc.compiler
 
-    top = Path(mpc.compiler.__file__).resolve().parent.parent
     out = []
-    for folder in sorted(top.iterdir()):
-        if not (folder.is_dir() and folder.name.isidentifier()):
-            continue
-        spec = importlib.util.find_spec(f"mpc.{folder.name}")
-        locations = spec.submodule_search_locations if spec is not None else None
-        if not locations or Path(next(iter(locations))).resolve() != folder:
-            continue
-        out += [(f"{folder.name}/{file.relative_to(folder).as_posix()}", file)
-                for file in sorted(folder.rglob("*"))
-                if file.suffix in (".py", ".lark") and "__pycache__" not in file.parts]
+    packages = _packages(Path(mpc.compiler.__file__).resolve().parent.parent)
+    for name in sorted(packages):
+        todo = [(packages[name], name)]
+        while todo:
+            folder, prefix = todo.pop()
+            with os.scandir(folder) as entries:
+                for entry in entries:
+                    if entry.is_dir(follow_symlinks=False):
+                        if entry.name != "__pycache__":
+                            todo.append((entry.path, f"{prefix}/{entry.name}"))
+                    elif entry.name.endswith((".py", ".lark")) and entry.is_file():
+                        out.append((f"{prefix}/{entry.name}", Path(entry.path), entry.stat()))
+    return sorted(out, key=lambda item: item[0])
+
+
+def _packages(top: Path) -> dict[str, str]:
+    """The subpackages of `mpc` in `top`: its folders that `import mpc.NAME` finds there."""
+    import importlib.util
+
+    out = {}
+    with os.scandir(top) as entries:
+        for entry in entries:
+            if not (entry.is_dir() and entry.name.isidentifier()):
+                continue
+            spec = importlib.util.find_spec(f"mpc.{entry.name}")
+            locations = spec.submodule_search_locations if spec is not None else None
+            if locations and Path(next(iter(locations))).resolve() == Path(entry.path).resolve():
+                out[entry.name] = entry.path
     return out
 
 

@@ -13,6 +13,7 @@ import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,7 +22,7 @@ from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document
-from mpc.pipeline import dag
+from mpc.pipeline import dag, verdicts
 from mpc.pipeline.defaults import PipelineDefaults
 
 if TYPE_CHECKING:
@@ -57,15 +58,22 @@ class PlannedModel:
 @dataclass
 class Plan:
     """A loaded pipeline file: its path, document, settings (the `pipeline` mapping as
-    written), the same validated (section), the workspace root and the models in the file's
-    order."""
+    written), the workspace root and the models in the file's order; `section`, the
+    settings validated, is made when first asked for (a run where all is cached never
+    imports the schema)."""
 
     file: Path
     doc: Document
     settings: dict[str, Any]
     root: Path
     models: dict[str, PlannedModel]
-    section: PipelineSection | None = None
+
+    @cached_property
+    def section(self) -> PipelineSection | None:
+        from mpc.compiler import schema
+
+        pipeline = schema.validate_pipeline(self.doc, Sink())  # valid: load_plan checked it
+        return pipeline.pipeline if pipeline is not None else None
 
     @property
     def defaults(self) -> PipelineDefaults:
@@ -78,11 +86,8 @@ class Plan:
 def load_plan(path: Path, sink: Sink) -> Plan | None:
     """The plan of the pipeline file at `path`; None (errors in `sink`) when the file itself
     is unusable. Problems of single models stay with those models."""
-    from mpc.compiler import schema
-
     doc = source.load(path, sink)
-    pipeline = schema.validate_pipeline(doc, sink) if doc is not None else None
-    if doc is None or pipeline is None:
+    if doc is None or not verdicts.valid_pipeline(doc, sink):
         return None
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
@@ -116,7 +121,7 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
         _check_name(model, models)
         models.setdefault(model.name, model)
     _break_cycles(models)
-    return Plan(path, doc, settings, root, models, pipeline.pipeline)
+    return Plan(path, doc, settings, root, models)
 
 
 # What `mpc check pipeline.yml` reports of planning; checking each definition reports the

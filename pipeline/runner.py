@@ -12,7 +12,6 @@ build leaves the previous output as it was.
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import os
 import shutil
 import signal
@@ -22,8 +21,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
-from multiprocessing.connection import Connection, wait
-from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -46,6 +43,9 @@ from mpc.pipeline.status import (
 from mpc.pipeline.store import Store
 
 if TYPE_CHECKING:
+    from multiprocessing.connection import Connection
+    from multiprocessing.process import BaseProcess
+
     from mpc.compiler.driver import Options
 
 
@@ -245,6 +245,8 @@ class Runner:
         run = [s for s in self.opts.stages if s not in cached]
         sys.stdout.flush()  # a forked worker must not write out what the runner had buffered
         sys.stderr.flush()
+        import multiprocessing  # here: a run where all is cached starts no process
+
         ctx = multiprocessing.get_context("fork")
         receive, send = ctx.Pipe(duplex=False)
         ignore = [self.store.build.resolve(), cache_dir("x").parent]
@@ -258,6 +260,8 @@ class Runner:
         self.reporter.started(name, process.pid or 0)
 
     def _wait(self) -> None:
+        from multiprocessing.connection import wait
+
         handles: dict[Any, _Running] = {}
         for r in self.running.values():
             handles[r.conn] = r

@@ -12,7 +12,6 @@ can use the worker. Pure functions; the runner reads the inputs.
 
 from __future__ import annotations
 
-import statistics
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -22,10 +21,16 @@ from mpc.pipeline import dag
 UNKNOWN_SECONDS = 1.0  # a model's expected time when no model of the pipeline was ever built
 
 
+def _median(ordered: Sequence[float]) -> float:
+    """The median of sorted numbers (not `statistics`: its imports cost a run where all is cached)."""
+    mid = len(ordered) // 2
+    return ordered[mid] if len(ordered) % 2 else (ordered[mid - 1] + ordered[mid]) / 2
+
+
 def expected_seconds(models: Iterable[str], known: Mapping[str, float]) -> dict[str, float]:
     """Each model's expected build time: its known time, or the median of the known ones."""
-    times = [t for t in known.values() if t > 0]
-    default = statistics.median(times) if times else UNKNOWN_SECONDS
+    times = sorted(t for t in known.values() if t > 0)
+    default = _median(times) if times else UNKNOWN_SECONDS
     return {n: known[n] if known.get(n, 0) > 0 else default for n in models}
 
 

@@ -25,9 +25,11 @@ def tree(folder: Path) -> dict[str, bytes]:
 
 def test_commands_run_in_order_in_the_output_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A string without shell is split (Phobos's check_urdf line runs, urdfdom's real tool);
-    a shell line sees MPC_* and PHOBOS_CI_*; a cwd is relative to the definition; the ROS
-    files come after the commands and list the folder they made."""
+    a shell line sees MPC_* and PHOBOS_CI_* (and not mpc's own OPENBLAS_NUM_THREADS); a cwd is
+    relative to the definition; the ROS files come after the commands and list the folder they
+    made."""
     monkeypatch.delenv("MPC_CACHE_DIR", raising=False)  # the user's own MPC_* is not mpc's to set
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)  # mpc's own setting is not the command's
     (tmp_path / "scripts").mkdir()
     spec = write(tmp_path / "m.yml", HEAD + """
   export_config: [{type: urdf, mesh_format: stl, ros_pathes: true}]
@@ -36,7 +38,7 @@ def test_commands_run_in_order_in_the_output_folder(tmp_path: Path, monkeypatch:
     - cmd: 'mkdir -p doc && check_urdf urdf/arm.urdf > doc/tree.txt && pwd > doc/ran_in.txt'
       shell: true
     - cmd: [sh, -c, 'env | grep -E "^(MPC|PHOBOS_CI)_" | sort > "$MPC_EXPORTDIR/env.txt";
-                     pwd > "$MPC_EXPORTDIR/cwd.txt"']
+                     pwd > "$MPC_EXPORTDIR/cwd.txt"; echo "${OPENBLAS_NUM_THREADS-unset}" > blas.txt']
       cwd: scripts
 """)
     done = mpc("compile", spec, "-o", tmp_path / "out")
@@ -50,6 +52,7 @@ def test_commands_run_in_order_in_the_output_folder(tmp_path: Path, monkeypatch:
                    "MPC_TARGETDIR": str(out), "PHOBOS_CI_DEFINITIONDIR": str(tmp_path),
                    "PHOBOS_CI_EXPORTDIR": str(staging), "PHOBOS_CI_TARGETDIR": str(out)}
     assert (out / "cwd.txt").read_text().strip() == str(tmp_path / "scripts")
+    assert (tmp_path / "scripts/blas.txt").read_text() == "unset\n"
     assert "  doc\n  meshes\n  smurf\n  urdf\n" in (out / "CMakeLists.txt").read_text()
 
 

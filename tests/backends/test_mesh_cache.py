@@ -144,3 +144,86 @@ def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
     spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
     assert compile_file(spec, tmp_path / "two", Sink()).out is not None
     assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
+
+
+_OPENED: list[str] | None = None  # the files opened while a test listens (an audit hook cannot be removed)
+
+
+def _listen(event: str, args: tuple[object, ...]) -> None:
+    if _OPENED is not None and event == "open" and isinstance(args[0], str):
+        _OPENED.append(args[0])
+
+
+sys.addaudithook(_listen)
+
+
+def test_a_remembered_digest_is_given_only_for_the_same_file_status(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Source digests are remembered across processes by the file's status (core/cache.py): a
+    process that finds one opens the file (so `mpc run` sees the input) but does not hash it;
+    an edit that keeps the size and the modification time is still noticed."""
+    global _OPENED
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_SETTLED_NS", 0)  # remember files written a moment ago too
+    mesh = tetra_stl(tmp_path / "tetra.stl")
+    first = cache.file_digest(mesh)
+    assert first == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    assert len(list((tmp_path / "cache/digests").glob("*/*"))) == 1
+    monkeypatch.setattr(cache, "_digests", {})  # another process
+    monkeypatch.setattr(hashlib, "file_digest", None)  # hashing now fails the test
+    _OPENED = []
+    try:
+        assert cache.file_digest(mesh) == first
+        assert str(mesh) in _OPENED
+    finally:
+        _OPENED = None
+    monkeypatch.undo()
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_digests", {})
+    st = os.stat(mesh)
+    data = bytearray(mesh.read_bytes())
+    data[-1] ^= 1
+    while time.time_ns() < st.st_ctime_ns + 20_000_000:  # file times tick coarsely: let one pass
+        time.sleep(0.005)
+    mesh.write_bytes(bytes(data))
+    os.utime(mesh, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert (os.stat(mesh).st_size, os.stat(mesh).st_mtime_ns) == (st.st_size, st.st_mtime_ns)
+    assert cache.file_digest(mesh) == hashlib.sha256(bytes(data)).hexdigest() != first
+
+
+def test_a_file_written_a_moment_ago_is_not_remembered_for_other_processes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Its times may not yet show an edit made in the same tick: each build hashes it again."""
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    mesh = tetra_stl(tmp_path / "tetra.stl")
+    assert cache.file_digest(mesh) == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    assert not (tmp_path / "cache/digests").exists()
+
+
+@pytest.mark.parametrize("same_bytes", [True, False])
+def test_mesh_files_of_one_name_share_an_output_only_with_the_same_bytes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, same_bytes: bool) -> None:
+    """Two folders' `tetra.stl`: one output file when their bytes are equal (known by their
+    digests), else each named after its own content."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    tetra_stl(tmp_path / "model/meshes/tetra.stl")
+    other = tetra_stl(tmp_path / "model/other/tetra.stl")
+    if not same_bytes:
+        other.write_bytes(other.read_bytes()[:-1] + b"\1")
+    urdf = ARM_URDF.replace("<collision>\n      <geometry><box size=\"0.05 0.05 0.4\"/></geometry>",
+                            "<collision>\n      <geometry><mesh filename=\"other/tetra.stl\"/></geometry>")
+    write(tmp_path / "model/arm.urdf", urdf)
+    spec = write(tmp_path / "model/arm.yml", definition("arm.urdf", "stl", "arm"))
+    out = compile_file(spec, tmp_path / "out", Sink()).out
+    assert out is not None
+    names = sorted(p.name for p in (out / "meshes/stl").iterdir())
+    if same_bytes:
+        assert names == ["tetra.stl"]
+    else:
+        digests = [hashlib.sha256(p.read_bytes() + b"()").hexdigest()[:10]
+                   for p in (tmp_path / "model/meshes/tetra.stl", other)]
+        assert names == sorted(f"tetra_{d}.stl" for d in digests)
