@@ -248,7 +248,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     order = sorted(range(len(jobs)), key=lambda i: (firsts.setdefault(jobs[i][0], len(firsts))
                                                    if jobs[i][0] not in firsts else len(jobs) + i))
     jobs = [jobs[i] for i in order]
-    workers = min(len(jobs), os.cpu_count() or 1)
+    workers = min(len(jobs), mesh_workers())
     if workers < 2 or len(jobs) < 3:
         results = [_materialise(*job) for job in jobs]
     else:
@@ -256,10 +256,37 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
         from concurrent.futures import ProcessPoolExecutor
 
         context = multiprocessing.get_context(_start_method())
+        if context.get_start_method() == "forkserver":  # its workers fork from one that has trimesh
+            context.set_forkserver_preload(["mpc.ir.mesh_props"])
         with ProcessPoolExecutor(workers, mp_context=context, initializer=_environment,
                                  initargs=(dict(os.environ),)) as pool:
             results = list(pool.map(_materialise, *zip(*jobs, strict=True)))
     return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
+
+
+WORKERS = "MPC_MESH_WORKERS"
+_share: int | None = None  # the cores of one of `mpc run`'s builds side by side (share_cores)
+
+
+def mesh_workers() -> int:
+    """How many processes compute one build's meshes: MPC_MESH_WORKERS when it is a positive
+    number, else the build's share of the cores (`mpc run -jN`), else every core this process
+    may run on."""
+    given = os.environ.get(WORKERS, "")
+    if given.isdigit() and int(given) > 0:
+        return int(given)
+    return _share or _cores()
+
+
+def share_cores(builds: int) -> None:
+    """`builds` builds run side by side (`mpc run -jN`): each computes its meshes on its share
+    of the cores, not on all of them (N pools of every core only fight over them)."""
+    global _share
+    _share = max(1, _cores() // max(1, builds))
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 def _start_method() -> str:

@@ -132,8 +132,11 @@ class Runner:
                     while queue and len(self.running) < max(1, self.opts.jobs):
                         name = schedule.next_model(list(queue), priority,
                                                    (self.sources[r] for r in self.running), self.sources)
+                        # the builds that will run side by side (those waiting count: most build)
+                        side_by_side = min(max(1, self.opts.jobs),
+                                           len(self.running) + len(queue) + len(waiting))
                         with _uninterrupted():  # a started worker is always in self.running
-                            self._start(*queue.pop(name))
+                            self._start(*queue.pop(name), side_by_side)
                         progressed = True
                     if self.running:
                         self._wait()
@@ -219,11 +222,13 @@ class Runner:
         return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
                        defaults=self.plan.defaults)
 
-    def _start(self, name: str, pre: str, cached: list[str]) -> None:
+    def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:
+        from mpc.backends.meshes import share_cores
         from mpc.core.cache import cache_dir
         from mpc.pipeline import worker
 
         _preload()
+        share_cores(side_by_side)  # the worker forks with its share of the cores for its meshes
         model = self.plan.models[name]
         try:
             shutil.rmtree(self.store.staging(name), ignore_errors=True)

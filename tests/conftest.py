@@ -24,6 +24,10 @@ settings.register_profile("bounded", max_examples=100, deadline=None)
 settings.register_profile("long", max_examples=5000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "bounded"))
 
+# The suite's tests already run side by side on every core: a build computes its meshes in
+# this process (tests/backends/test_mesh_pool.py checks the pool of processes that a build
+# uses alone; every build in a pytest worker would fork that big process to make one).
+os.environ.setdefault("MPC_MESH_WORKERS", "1")
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -28,7 +28,8 @@ def test_commands_run_in_order_in_the_output_folder(tmp_path: Path, monkeypatch:
     a shell line sees MPC_* and PHOBOS_CI_* (and not mpc's own OPENBLAS_NUM_THREADS); a cwd is
     relative to the definition; the ROS files come after the commands and list the folder they
     made."""
-    monkeypatch.delenv("MPC_CACHE_DIR", raising=False)  # the user's own MPC_* is not mpc's to set
+    for own in ("MPC_CACHE_DIR", "MPC_MESH_WORKERS"):  # the user's own MPC_* is not mpc's to set
+        monkeypatch.delenv(own, raising=False)
     monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)  # mpc's own setting is not the command's
     (tmp_path / "scripts").mkdir()
     spec = write(tmp_path / "m.yml", HEAD + """
