@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
 from mpc.core.numbers import zero_small
 from mpc.core.span import Span
@@ -275,18 +276,14 @@ def mesh_workers() -> int:
     given = os.environ.get(WORKERS, "")
     if given.isdigit() and int(given) > 0:
         return int(given)
-    return _share or _cores()
+    return _share or usable_cores()
 
 
 def share_cores(builds: int) -> None:
     """`builds` builds run side by side (`mpc run -jN`): each computes its meshes on its share
     of the cores, not on all of them (N pools of every core only fight over them)."""
     global _share
-    _share = max(1, _cores() // max(1, builds))
-
-
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    _share = max(1, usable_cores() // max(1, builds))
 
 
 def _start_method() -> str:

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.core import render
+from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Severity, Sink, did_you_mean
 from mpc.pipeline.plan import Plan, load_plan
 
@@ -79,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         stages = parse_stages(args.stages)
         only = select(plan, args.only)
-        jobs = args.jobs if args.jobs is not None else os.cpu_count() or 1
+        jobs = args.jobs if args.jobs is not None else usable_cores()
         if jobs < 1:
             raise UsageError("-j needs at least 1")
     except UsageError as e:

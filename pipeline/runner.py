@@ -24,6 +24,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Diagnostic, Severity
 from mpc.core.files import describe
 from mpc.core.span import Span
@@ -58,7 +59,7 @@ class RunOptions:
 
     stages: tuple[str, ...] = ("compile",)
     only: tuple[str, ...] = ()
-    jobs: int = field(default_factory=lambda: os.cpu_count() or 1)
+    jobs: int = field(default_factory=usable_cores)
     force: bool = False
     build: Path | None = None
     package_map: dict[str, Path] = field(default_factory=dict)
