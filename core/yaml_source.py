@@ -110,12 +110,15 @@ class Document:
 
     values[path]: the span of the value at `path` (keys and list indices from the top).
     keys[path]: the span of the key that introduces the value at `path`.
+    numbers[path]: the text of a value YAML read as a number (`commit: 8e99999999` is a float),
+    for the hint to quote it where a string was meant.
     """
 
     file: str
     data: Any
     values: dict[Path_, Span] = field(default_factory=dict)
     keys: dict[Path_, Span] = field(default_factory=dict)
+    numbers: dict[Path_, str] = field(default_factory=dict)
 
     def span(self, path: Path_) -> Span:
         """The key at `path` if it has one, else its value; else the nearest enclosing part."""
@@ -172,6 +175,7 @@ class _Builder:
         if tag == "tag:yaml.org,2002:bool":
             return v.lower() == "true"
         if tag == "tag:yaml.org,2002:int":
+            self.doc.numbers[path] = v
             if len(v.lstrip("+-")) > self.limits.digits:
                 self.sink.error(_span(self.doc.file, node), "E0112", f"an integer of {len(v)} "
                                 f"digits; at most {self.limits.digits} are read")
@@ -179,6 +183,7 @@ class _Builder:
                 return None
             return int(v, 0) if v[:2] in ("0o", "0x") else int(v, 10)
         if tag == "tag:yaml.org,2002:float":
+            self.doc.numbers[path] = v
             low = v.lower().lstrip("+")
             return float(low.replace(".inf", "inf").replace(".nan", "nan"))
         self.sink.error(_span(self.doc.file, node), "E0105", f"unsupported YAML tag '{tag}'")

@@ -570,7 +570,11 @@ class Walk:
             span = doc.value_span(at) if ctx["at"] == "value" else doc.span(at)
             self.sink.error(span, ctx["code"], ctx["text"].replace(KEY, _key(where)), hint=ctx["hint"])
             return
-        self.sink.error(doc.value_span(where), "E0203", self._message(err, where))
+        hint = None
+        wants_text = kind == "string_type" or (kind == "mpc_union" and "a string" in err["msg"])
+        if wants_text and (text := doc.numbers.get(where)) is not None:
+            hint = f"YAML reads {text} as a number; quote it to keep it as written: '{text}'"
+        self.sink.error(doc.value_span(where), "E0203", self._message(err, where), hint=hint)
 
     @staticmethod
     def _message(err: Any, where: Path_) -> str:
@@ -592,7 +596,8 @@ class Walk:
     def _rekey(self, old: Path_, new: Path_) -> None:
         """An alias's spans are filed under the declared key's path."""
         n = len(old)
-        for table in (self.doc.values, self.doc.keys):
+        tables: tuple[dict[Path_, Any], ...] = (self.doc.values, self.doc.keys, self.doc.numbers)
+        for table in tables:
             for p in [p for p in table if p[:n] == old]:
                 table[(*new, *p[n:])] = table[p]
 

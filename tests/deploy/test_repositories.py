@@ -37,7 +37,7 @@ def test_submodules_are_pinned_to_their_branch_or_commit(model: Model, server: S
         target: lua
       - repo: ../arm-lua.git
         target: old/lua
-        commit: {first[:10]}
+        commit: "{first[:10]}"
 """))
     result = deploy_model(model.compile(), model.built, _plain(model, server), Sink())
     assert result.ok, result
