@@ -8,6 +8,7 @@ tuples, Optional, Mapping, frozenset, Literal, Path, Span and untyped values.
 
 from __future__ import annotations
 
+import functools
 import math
 import types
 from collections import abc
@@ -160,8 +161,10 @@ def _field(cls: type, name: str, hint: Any) -> st.SearchStrategy[Any]:
     return values if default is MISSING else st.just(default) | values
 
 
+@functools.cache
 def programs() -> st.SearchStrategy[Program]:
-    """Programs with random inputs, ops drawn from OPS and exports."""
+    """Programs with random inputs, ops drawn from OPS and exports (one strategy: hypothesis
+    validates a strategy when it is first drawn from, which costs more than drawing)."""
     reg = registry()
     rest = {name: _field(Program, name, h) for name, h in field_hints(Program).items()
             if name not in ("inputs", "ops", "exports")}
@@ -209,8 +212,7 @@ def test_the_text_has_one_record_a_line_in_order(talos: Program) -> None:
     assert f'op set_robot_name name="talos" @ {TALOS}:' in dump(talos)
 
 
-# A third of the profile's examples (tests/conftest.py): each program is large.
-@settings(max_examples=settings().max_examples // 3, suppress_health_check=[HealthCheck.too_slow])
+@settings(suppress_health_check=[HealthCheck.too_slow])  # each program is large
 @given(st.data())
 def test_round_trip_of_generated_programs(data: st.DataObject) -> None:
     program = data.draw(programs())
