@@ -25,7 +25,8 @@ ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity
 
 def apply_program(program: Program, sink: Sink) -> Robot | None:
     """The robot the program describes (its inputs read, its ops run), or None."""
-    from mpc.compiler.driver import Options, apply, input_loader
+    from mpc.compiler.driver import Options
+    from mpc.compiler.front_end import apply, input_loader
 
     loader = input_loader(sink, Options(), (Path(program.span.file).resolve(),))
     return apply(program, sink, loader)

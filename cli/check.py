@@ -11,8 +11,8 @@ import sys
 from pathlib import Path
 
 from mpc.cli.output import print_diagnostics, resolver_of, sink_of, summary
-from mpc.compiler import driver
-from mpc.compiler.inputs import Options
+from mpc.compiler import front_end
+from mpc.compiler.options import Options
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink
 from mpc.core.files import describe
@@ -21,9 +21,9 @@ from mpc.core.span import Span
 
 def check_file(path: Path, sink: Sink, options: Options) -> None:
     """Everything `mpc check` does for one file: a pipeline file through check_pipeline, with
-    each of its definitions under the pipeline's defaults; anything else through the driver."""
+    each of its definitions under the pipeline's defaults; anything else through the front end."""
     if path.suffix == ".ir":
-        driver.check_file(path, sink, options)
+        front_end.check_file(path, sink, options)
         return
     try:
         doc = source.load(path, sink)
@@ -37,7 +37,7 @@ def check_file(path: Path, sink: Sink, options: Options) -> None:
 
         check_pipeline_file(path, sink, options)
         return
-    driver.check_file(path, sink, options, doc)
+    front_end.check_file(path, sink, options, doc)
 
 
 def run(args: argparse.Namespace) -> int:

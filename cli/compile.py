@@ -15,7 +15,7 @@ def run(args: argparse.Namespace) -> int:
     sink = sink_of(args)
     options = Options(out=args.out, resolver=resolver_of(args))
     if args.emit in ("ir", "ir-lowered"):
-        from mpc.compiler.driver import load_program
+        from mpc.compiler.front_end import load_program
         from mpc.ir.text import dump
 
         program = load_program(args.definition, sink, options, passes=args.emit == "ir")

@@ -44,7 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from mpc.compiler.driver import Options, load_program
+    from mpc.compiler.driver import Options
+    from mpc.compiler.front_end import load_program
     from mpc.core.diagnostics import Severity, Sink
     from mpc.core.render import print_diagnostics
     from mpc.deploy.model import deploy_model

@@ -14,7 +14,8 @@ from mpc.cli.output import print_diagnostics, resolver_of, sink_of, summary
 def run(args: argparse.Namespace) -> int:
     """1 when a test failed and was not waived, or nothing could be tested."""
     from mpc.checks import run_model_tests
-    from mpc.compiler.driver import Options, apply, compile_model, input_loader, load_program
+    from mpc.compiler.driver import Options, compile_model
+    from mpc.compiler.front_end import apply, input_loader, load_program
 
     sink = sink_of(args)
     options = Options(out=args.out, resolver=resolver_of(args))

@@ -36,7 +36,8 @@ def load_model(path: Path, sink: Sink, package: dict[str, Path] | None = None) -
         sink.error(Span.of_file(str(path)), "E0690", f"'{path}' is neither a model definition nor a "
                    "built folder")
         return None
-    from mpc.compiler.driver import InputLoader, Options, apply, load_program
+    from mpc.compiler.driver import Options
+    from mpc.compiler.front_end import InputLoader, apply, load_program
     from mpc.core.packages import PackageResolver
 
     options = Options(resolver=PackageResolver(package_map=dict(package or {})))

@@ -16,8 +16,7 @@ from typing import TYPE_CHECKING
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.record import record
-from mpc.core.span import Span
-from mpc.core.yaml_source import source_line
+from mpc.core.span import Span, source_line
 
 if TYPE_CHECKING:
     from lark import Lark

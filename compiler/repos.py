@@ -19,6 +19,7 @@ from mpc.core.cache import cache_dir
 from mpc.core.diagnostics import Sink
 from mpc.core.files import describe
 from mpc.core.gitrun import GitFailed, git, scrub, without_credentials
+from mpc.core.reads import note_volatile
 from mpc.core.span import Span
 from mpc.ir.program import RepoRef
 
@@ -35,6 +36,8 @@ def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path 
     """
     ref = repo.commit or repo.branch or "HEAD"
     slot = _slot(repo.git)
+    if not repo.commit:  # what a branch holds changes without any file here changing
+        note_volatile(f"the branch '{ref}' of repository '{scrub(repo.git)}'")
     try:
         if repo.commit and (slot / repo.commit).is_dir():
             return slot / repo.commit

@@ -20,9 +20,11 @@ import sysconfig
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from mpc.core.reads import note_package
+
 
 @functools.cache
-def _interpreter_sites() -> tuple[str, str]:
+def interpreter_sites() -> tuple[str, str]:
     """The interpreter's purelib and platlib folders (sysconfig works them out anew on each
     call, 0.2 ms, and every PackageResolver asks)."""
     paths = sysconfig.get_paths()
@@ -31,7 +33,7 @@ def _interpreter_sites() -> tuple[str, str]:
 
 def _environment_share_dirs() -> list[Path]:
     # A virtualenv made with --system-site-packages also sees the base installation's packages.
-    sites = [*_interpreter_sites(),
+    sites = [*interpreter_sites(),
              *(p for p in sys.path if p.endswith("-packages"))]
     dirs = [Path(folder) / "cmeel.prefix" / "share" for folder in sites]
     dirs.append(Path(sys.prefix) / "share")
@@ -73,7 +75,13 @@ class PackageResolver:
                     self.add_root(install.parent)
 
     def find(self, package: str, near: Path | None = None) -> Path | None:
-        """The folder of `package`, or None."""
+        """The folder of `package`, or None (noted for what records the build's inputs:
+        core/reads.py)."""
+        found = self._find(package, near)
+        note_package(package, near, found)
+        return found
+
+    def _find(self, package: str, near: Path | None) -> Path | None:
         if package in self.package_map:
             return self.package_map[package]
         if package not in self._cache:

@@ -7,6 +7,8 @@ cold). A record lets dataclass generate only `__init__` and the frozen `__setatt
 and `__delattr__`; the three methods below behave as dataclass's own would (fields in
 order, the class's qualified name, equal only to the same class, tuple hash), so
 `dataclasses.fields`, `replace` and `asdict` and every repr-based digest are unchanged.
+A record with slots also pickles its fields as a tuple, in order, as dataclass's own
+`__getstate__` does, without looking the fields up for each object.
 """
 
 from __future__ import annotations
@@ -47,6 +49,22 @@ def _hash(self: Any) -> int:
     return hash(_values(self))
 
 
+_NAMES: dict[type, tuple[str, ...]] = {}
+
+
+def _getstate(self: Any) -> tuple[Any, ...]:
+    return _values(self)
+
+
+def _setstate(self: Any, state: tuple[Any, ...]) -> None:
+    cls = type(self)
+    names = _NAMES.get(cls)
+    if names is None:
+        names = _NAMES[cls] = tuple(f.name for f in fields(self))
+    for name, value in zip(names, state, strict=True):
+        object.__setattr__(self, name, value)
+
+
 @overload
 def record(cls: T, /) -> T: ...
 @overload
@@ -59,7 +77,10 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) ->
 
     def wrap(c: T) -> T:
         out = dataclass(c, frozen=True, repr=False, eq=False, slots=slots, kw_only=kw_only)
-        for name, method in (("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)):
+        methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
+        if slots:  # dataclass's own look each field up anew for every object pickled (build cache)
+            methods += [("__getstate__", _getstate), ("__setstate__", _setstate)]
+        for name, method in methods:
             if name not in c.__dict__:
                 setattr(out, name, method)
         return out

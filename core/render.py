@@ -11,8 +11,7 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager, redirect_stdout
 
 from mpc.core.diagnostics import Diagnostic, Severity
-from mpc.core.span import Span
-from mpc.core.yaml_source import source_line
+from mpc.core.span import Span, source_line
 
 MAX_SHOWN = 50
 

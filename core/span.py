@@ -6,6 +6,9 @@ found at any stage points at the user's text.
 
 from __future__ import annotations
 
+import os
+from functools import lru_cache
+from pathlib import Path
 from typing import Any
 
 from mpc.core.record import record
@@ -48,3 +51,21 @@ def hardened_parser(huge: bool = False) -> Any:
 
     return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=huge,
                            remove_blank_text=False)
+
+
+def source_line(file: str, line: int) -> str | None:
+    """Line `line` (1-based) of `file` as it is now, or None; for diagnostics and columns.
+
+    Files are read once per (modification time, size), so an edited file is read again.
+    """
+    try:
+        stat = os.stat(file)
+        lines = _source_lines(file, (stat.st_mtime_ns, stat.st_size))
+    except (OSError, UnicodeDecodeError):
+        return None
+    return lines[line - 1] if 0 < line <= len(lines) else None
+
+
+@lru_cache(maxsize=16)
+def _source_lines(file: str, stamp: tuple[int, int]) -> tuple[str, ...]:
+    return tuple(Path(file).read_text(encoding="utf-8").split("\n"))

@@ -18,7 +18,6 @@ import stat
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -452,21 +451,3 @@ def _position(text: str, offset: int) -> tuple[int, int]:
     """1-based line and column of character `offset` of `text`."""
     line = text.count("\n", 0, offset) + 1
     return line, offset - (text.rfind("\n", 0, offset) + 1) + 1
-
-
-def source_line(file: str, line: int) -> str | None:
-    """Line `line` (1-based) of `file` as it is now, or None; for diagnostics and columns.
-
-    Files are read once per (modification time, size), so an edited file is read again.
-    """
-    try:
-        stat = os.stat(file)
-        lines = _source_lines(file, (stat.st_mtime_ns, stat.st_size))
-    except (OSError, UnicodeDecodeError):
-        return None
-    return lines[line - 1] if 0 < line <= len(lines) else None
-
-
-@lru_cache(maxsize=16)
-def _source_lines(file: str, stamp: tuple[int, int]) -> tuple[str, ...]:
-    return tuple(Path(file).read_text(encoding="utf-8").split("\n"))

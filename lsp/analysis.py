@@ -1,7 +1,7 @@
 """One buffer of a definition or pipeline file → `mpc check`'s diagnostics, and what the editor
 features ask about it: the names before each op, where names are written, the input robots.
 
-The check is `mpc check`'s (compiler/driver.py's front end and passes, pipeline/plan.py's
+The check is `mpc check`'s (compiler/front_end.py's front end and passes, pipeline/plan.py's
 check_pipeline), run on the editor's text of every open file (core/yaml_source.py `overlay`),
 with input models from the server's ModelCache (compiler/inputs.py): a keystroke re-reads no
 model file. What this does not do: talk LSP (server.py), or build outputs.
@@ -13,8 +13,9 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from mpc.compiler import driver
-from mpc.compiler.inputs import InputLoader, Options
+from mpc.compiler import front_end
+from mpc.compiler.inputs import InputLoader
+from mpc.compiler.options import Options
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
@@ -112,7 +113,7 @@ class Analysis:
         """The robot the definition describes (its ops applied), built once when asked."""
         if self._built is None and self.ran is not None and self.loader is not None:
             sink = Sink()
-            self._built = driver.apply(self.ran, sink, replace(self.loader, sink=sink))
+            self._built = front_end.apply(self.ran, sink, replace(self.loader, sink=sink))
         return self._built
 
 
@@ -140,10 +141,10 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
 
 
 def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, options: Options) -> None:
-    """The front end and passes of driver.front_end, keeping the program and the names per op."""
+    """The front end and passes of front_end.front_end, keeping the program and the names per op."""
     path = analysis.path
-    loader = driver.input_loader(sink, options, (path.resolve(),), symbolic=True)
-    lowered = driver.front_end(path, sink, options, Severity.WARNING, loader, doc=doc, passes=False)
+    loader = front_end.input_loader(sink, options, (path.resolve(),), symbolic=True)
+    lowered = front_end.front_end(path, sink, options, Severity.WARNING, loader, doc=doc, passes=False)
     if lowered is None:
         return
     analysis.program, analysis.loader = lowered, loader

@@ -16,8 +16,7 @@ from pathlib import Path
 from lsprotocol import types as lsp
 
 from mpc.core.diagnostics import Diagnostic, Severity
-from mpc.core.span import Span
-from mpc.core.yaml_source import source_line
+from mpc.core.span import Span, source_line
 from mpc.lsp.text import Lines
 
 _SEVERITY = {Severity.ERROR: lsp.DiagnosticSeverity.Error, Severity.WARNING: lsp.DiagnosticSeverity.Warning,

@@ -21,7 +21,7 @@ from lsprotocol import types as lsp
 from pygls.server import LanguageServer
 from pygls.uris import to_fs_path
 
-from mpc.compiler.inputs import ModelCache, Options
+from mpc.compiler.options import ModelCache, Options
 from mpc.core.packages import PackageResolver
 from mpc.core.version import mpc_version
 from mpc.lsp import completion, hover, navigation

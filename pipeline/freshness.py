@@ -12,7 +12,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from mpc.pipeline.fingerprint import data_digest, dep_name, deps_current, digest, mpc_version
+from mpc.core.version import source_version
+from mpc.pipeline.fingerprint import data_digest, dep_name, deps_current, digest
 from mpc.pipeline.plan import Plan, PlannedModel
 from mpc.pipeline.store import Store
 
@@ -27,7 +28,7 @@ class Freshness:
         self.plan, self.store, self.stages, self.force = plan, store, stages, force
         # Package folders inside the root are named relative to it, as the files a build read.
         packages = repr(sorted((k, dep_name(v, plan.root)) for k, v in package_map.items()))
-        self.options = digest(mpc_version(), packages, str(werror))
+        self.options = digest(source_version(), packages, str(werror))
 
     def before_build(self, model: PlannedModel, this_run: Mapping[str, str | None]) -> str:
         """What is known before building: mpc and the options, the definition as planned,

@@ -26,7 +26,7 @@ from mpc.pipeline import dag, verdicts
 from mpc.pipeline.defaults import PipelineDefaults
 
 if TYPE_CHECKING:
-    from mpc.compiler.inputs import Options
+    from mpc.compiler.options import Options
     from mpc.compiler.schema.definition import PipelineSection
 
 
@@ -146,9 +146,9 @@ def check_pipeline(path: Path, sink: Sink,
 
 def check_pipeline_file(path: Path, sink: Sink, options: Options) -> None:
     """`mpc check pipeline.yml` with the driver: each definition under the pipeline's defaults."""
-    from mpc.compiler import driver
+    from mpc.compiler import front_end
 
-    check_pipeline(path, sink, lambda model, defaults: driver.check_file(
+    check_pipeline(path, sink, lambda model, defaults: front_end.check_file(
         model, sink, replace(options, defaults=defaults)))
 
 

@@ -28,8 +28,9 @@ from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Diagnostic, Severity
 from mpc.core.files import describe
 from mpc.core.span import Span
+from mpc.core.version import source_version
 from mpc.pipeline import schedule
-from mpc.pipeline.fingerprint import mpc_version, with_deps
+from mpc.pipeline.fingerprint import with_deps
 from mpc.pipeline.freshness import Freshness
 from mpc.pipeline.plan import Plan, PlannedModel
 from mpc.pipeline.stages import StageJob, StageOutcome, first_error
@@ -343,7 +344,7 @@ class Runner:
             replace_folder(self.store.staging(name) / "out", self.store.output(name))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
-                     "mpc": mpc_version(), "stages": {}}
+                     "mpc": source_version(), "stages": {}}
         fp = state.get("fingerprint") if (compiled or "compile" in r.cached) else None
         self.fingerprints[name] = fp
         stages = dict(state.get("stages", {}))
@@ -445,6 +446,6 @@ def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
 def _preload() -> None:
     """Import what every build uses before forking, so workers share it instead of importing it."""
     from mpc.backends import BACKENDS
-    from mpc.compiler import driver  # noqa: F401
+    from mpc.compiler import driver, front_end  # noqa: F401
 
     BACKENDS["urdf"]()

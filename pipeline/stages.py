@@ -126,7 +126,7 @@ def ensure_program(job: StageJob) -> bool:
     """Give a job whose compile was cached its program (the front end only); False on errors."""
     if job.program is not None:
         return True
-    from mpc.compiler.driver import load_program
+    from mpc.compiler.front_end import load_program
 
     job.program = load_program(job.definition, job.sink, job.options)
     job.built = job.out if job.program is not None else None

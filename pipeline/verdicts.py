@@ -15,13 +15,14 @@ import contextlib
 
 from mpc.core.cache import cache_dir
 from mpc.core.diagnostics import Sink
+from mpc.core.version import source_version
 from mpc.core.yaml_source import Document
-from mpc.pipeline.fingerprint import data_digest, mpc_version
+from mpc.pipeline.fingerprint import data_digest
 
 
 def valid_pipeline(doc: Document, sink: Sink) -> bool:
     """Whether the schema accepts the pipeline file `doc` (its diagnostics go to `sink`)."""
-    key = data_digest(["pipeline file", mpc_version(), doc.data])
+    key = data_digest(["pipeline file", source_version(), doc.data])
     marker = cache_dir("verdicts") / key[:2] / key
     if marker.is_file():
         return True

@@ -17,8 +17,9 @@ from pathlib import Path
 from typing import Any
 
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.reads import ReadRecorder
 from mpc.core.span import Span
-from mpc.pipeline.fingerprint import ReadRecorder, dep_entry
+from mpc.pipeline.fingerprint import dep_entry
 from mpc.pipeline.stages import STAGES, StageJob, StageOutcome, ensure_program, first_error
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from mpc.cli.check import check_file
-from mpc.compiler.inputs import Options
+from mpc.compiler.options import Options
 from tests.conftest import Diags, compile_file
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.yml"))

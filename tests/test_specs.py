@@ -25,7 +25,8 @@ from pathlib import Path
 import pytest
 
 from mpc.cli.check import check_file
-from mpc.compiler.driver import Options, compile_model, load_program
+from mpc.compiler.driver import Options, compile_model
+from mpc.compiler.front_end import load_program
 from mpc.core import render
 from mpc.core.diagnostics import Severity, Sink
 from mpc.ir.text import dump

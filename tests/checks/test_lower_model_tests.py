@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.driver import Options, load_program
+from mpc.compiler.driver import Options
+from mpc.compiler.front_end import load_program
 from mpc.ir.program import CompareTarget, ModelTest, Tolerances
 from mpc.ir.text import dump, parse
 from tests.conftest import Diags, definition, write

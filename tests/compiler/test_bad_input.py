@@ -238,7 +238,8 @@ def test_unknown_package(tmp_path: Path, diags: Diags) -> None:
 
 def test_mesh_format_that_cannot_be_written(tmp_path: Path, diags: Diags) -> None:
     """The language only names formats mpc writes; an IR file can name any."""
-    from mpc.compiler.driver import Options, load_program
+    from mpc.compiler.driver import Options
+    from mpc.compiler.front_end import load_program
     from mpc.ir.text import dump
 
     arm(tmp_path)

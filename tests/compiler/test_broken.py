@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 
 from mpc.cli.check import check_file
-from mpc.compiler.inputs import Options
+from mpc.compiler.options import Options
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 
 BROKEN = (Path(__file__).parent / "broken").resolve()

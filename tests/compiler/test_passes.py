@@ -200,7 +200,7 @@ def _arm_definition(folder: Path, assemble: str) -> Path:
 def test_one_clash_of_many_names_is_one_report(tmp_path: Path) -> None:
     """Attaching a model to itself unrenamed: one E0304 per kind of name, not one per name."""
     from mpc.cli.check import check_file
-    from mpc.compiler.inputs import Options
+    from mpc.compiler.options import Options
 
     definition = _arm_definition(tmp_path, "  assemble:\n    model: arm\n    children:\n"
                                  "      - model: arm\n        joint: {parent: lower, name: wrist}\n")

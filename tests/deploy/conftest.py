@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.driver import Options, compile_model, load_program
+from mpc.compiler.driver import Options, compile_model
+from mpc.compiler.front_end import load_program
 from mpc.core.diagnostics import Sink
 from mpc.deploy import DeploySettings
 from mpc.ir.program import Program

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.compiler.driver import Options, load_program
+from mpc.compiler.driver import Options
+from mpc.compiler.front_end import load_program
 from mpc.core.span import Span
 from mpc.deploy.gitcmd import scrub
 from mpc.deploy.github import repository_slug

@@ -21,7 +21,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mpc.compiler.driver import Options, front_end
+from mpc.compiler.driver import Options
+from mpc.compiler.front_end import front_end
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir.ops import OPS, Op

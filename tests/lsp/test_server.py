@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from mpc.cli.check import check_file
-from mpc.compiler.inputs import Options
+from mpc.compiler.options import Options
 from mpc.core.diagnostics import Sink
 from tests.lsp.client import Client
 from tests.lsp.definitions import EXPORT, HEAD

@@ -178,7 +178,7 @@ def test_a_new_mpc_version_rebuilds_everything(project: Path, monkeypatch: pytes
         return {name: m.stages["compile"].state for name, m in status.models.items()}
 
     assert _rebuilt(states()) == set()
-    monkeypatch.setattr(freshness, "mpc_version", lambda: "99.0+0123456789abcdef")
+    monkeypatch.setattr(freshness, "source_version", lambda: "99.0+0123456789abcdef")
     assert _rebuilt(states()) == ALL
     assert _rebuilt(states()) == set()
 
@@ -195,7 +195,7 @@ def test_the_installed_package_is_named_absolutely(project: Path) -> None:
 
 def test_mpc_version_hashes_the_sources_of_mpc_and_nothing_else() -> None:
     """In a checkout, tests/ lies next to compiler/: editing a test must not rebuild models."""
-    from mpc.pipeline.fingerprint import source_files
+    from mpc.core.version import source_files
 
     names = {name for name, _ in source_files()}
     assert {"compiler/driver.py", "pipeline/runner.py", "grammar/expr.lark", "ir/robot.py",

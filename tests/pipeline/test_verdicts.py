@@ -1,7 +1,7 @@
 """What a run where all is cached skips, and what it must still notice: a pipeline file the
 schema accepted is remembered (pipeline/verdicts.py), mpc's version is read without
 importlib.metadata (core/version.py), and mpc's sources are known by their status
-(pipeline/fingerprint.py). Each remembered answer is given again only for the same input."""
+(core/version.py). Each remembered answer is given again only for the same input."""
 
 from __future__ import annotations
 
@@ -13,10 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from mpc.core import yaml_source
+from mpc.core import version, yaml_source
 from mpc.core.diagnostics import Sink
 from mpc.core.version import mpc_version as installed_version
-from mpc.pipeline import fingerprint
 from mpc.pipeline.plan import load_plan
 from mpc.pipeline.verdicts import valid_pipeline
 from tests.conftest import write
@@ -62,7 +61,7 @@ def test_a_verdict_of_another_mpc_is_not_used(tmp_path: Path, cache: Path,
                                               monkeypatch: pytest.MonkeyPatch) -> None:
     pipeline = write(tmp_path / "pipeline.yml", GOOD)
     assert _verdict(pipeline) == (True, [])
-    monkeypatch.setattr("mpc.pipeline.verdicts.mpc_version", lambda: "0.0.0+another")
+    monkeypatch.setattr("mpc.pipeline.verdicts.source_version", lambda: "0.0.0+another")
     assert _verdict(pipeline) == (True, [])
     assert len(list((cache / "verdicts").glob("*/*"))) == 2
 
@@ -86,18 +85,18 @@ def test_the_version_is_the_installed_distributions(tmp_path: Path, monkeypatch:
 def test_an_edit_of_mpcs_sources_is_noticed_with_the_same_size_and_time(
         tmp_path: Path, cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     source = write(tmp_path / "compiler" / "lower.py", "x = 1\n")
-    monkeypatch.setattr(fingerprint, "_source_stats",
+    monkeypatch.setattr(version, "_source_stats",
                         lambda: [("compiler/lower.py", source, os.stat(source))])
-    fingerprint.mpc_version.cache_clear()
+    version.source_version.cache_clear()
     try:
-        before = fingerprint.mpc_version()
-        assert fingerprint.mpc_version.__wrapped__() == before  # known again from the status alone
+        before = version.source_version()
+        assert version.source_version.__wrapped__() == before  # known again from the status alone
         st = os.stat(source)
         while time.time_ns() < st.st_ctime_ns + 20_000_000:  # file times tick coarsely: let one pass
             time.sleep(0.005)
         source.write_text("x = 2\n")
         os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))
         assert os.stat(source).st_size == st.st_size and os.stat(source).st_mtime_ns == st.st_mtime_ns
-        assert fingerprint.mpc_version.__wrapped__() != before
+        assert version.source_version.__wrapped__() != before
     finally:
-        fingerprint.mpc_version.cache_clear()
+        version.source_version.cache_clear()

@@ -1,0 +1,265 @@
+"""A second `mpc compile` of an unchanged definition writes its kept outputs (compiler/
+build_cache.py); anything the build depends on that changed makes it build again.
+
+Each test compiles in a cache of its own and counts what the cache did through MPC_CACHE_TRACE:
+`keep build` when a build is kept, `reuse build` when its program and robot are taken, `… with
+its outputs` when its outputs are.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mpc.compiler import front_end
+from mpc.compiler.driver import Options, Result, compile_model
+from mpc.core.diagnostics import Severity, Sink
+from tests.conftest import write
+from tests.fixtures import ARM_URDF, arm, tetra_stl
+
+SPEC = """
+    model:
+      robotname: arm
+      modelname: arm-model
+      input_models:
+        arm: {{basefile: arm.urdf}}
+      assemble: {{model: arm}}
+      export_config:
+        - {{type: urdf, mesh_format: stl}}
+        - {{type: sdf, mesh_format: stl}}
+        - {{type: smurf}}
+        {more}
+    """
+# An attribute URDF does not have: W0401 on every build, kept builds included.
+ODD_URDF = ARM_URDF.replace('<origin xyz="0 0 0.4"/>', '<origin xyz="0 0 0.4" scale="2"/>')
+
+
+@pytest.fixture
+def trace(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
+    return tmp_path / "trace"
+
+
+def _model(folder: Path, urdf: str = ODD_URDF, more: str = "") -> Path:
+    arm(folder, urdf)
+    spec = write(folder / "arm.yml", SPEC.format(more=more))
+    _settle()
+    return spec
+
+
+def _settle() -> None:
+    """Let the file system's clock pass the files just written: a file changed as a build
+    starts may change after it was read, and such a build is not kept."""
+    time.sleep(0.05)
+
+
+def _build(spec: Path, out: Path, trace: Path, sink: Sink | None = None) -> tuple[Result, Sink, list[str]]:
+    sink = sink or Sink()
+    before = len(_events(trace))
+    result = compile_model(spec, sink, Options(out=out))
+    return result, sink, _events(trace)[before:]
+
+
+def _events(trace: Path) -> list[str]:
+    lines = trace.read_text().splitlines() if trace.exists() else []
+    return [" ".join(line.split()[1:3]) + (" with its outputs" if line.endswith("outputs") else "")
+            for line in lines if " build " in line]
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _said(sink: Sink) -> list[tuple[str, str, str, int, int]]:
+    return [(d.severity.value, d.code, d.message, d.span.line, d.span.col) for d in sink.diagnostics]
+
+
+def test_an_unchanged_definition_writes_its_kept_outputs_and_diagnostics_without_building(
+        tmp_path: Path, trace: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = _model(tmp_path / "model")
+    first, said, events = _build(spec, tmp_path / "out1", trace)
+    assert first.out is not None and events == ["keep build"]
+    assert [(d[1], d[3]) for d in _said(said)] == [("W0401", 31)]
+
+    def no_front_end(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the front end ran")
+
+    monkeypatch.setattr(front_end, "load_program", no_front_end)
+    second, again, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs"]
+    assert second.out == tmp_path / "out2"
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+    assert _said(again) == _said(said)
+    assert second.program == first.program and second.robot == first.robot  # read when asked
+
+
+def test_a_warm_compile_in_a_new_process_imports_no_schema_yaml_xml_or_numpy(tmp_path: Path,
+                                                                             trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    assert _build(spec, tmp_path / "out1", trace)[2] == ["keep build"]
+    code = ("import sys; from mpc.cli.main import main; code = main(['compile', sys.argv[1], '-o', "
+            "sys.argv[2]]); print(sorted({m.split('.')[0] for m in sys.modules} & {'pydantic', 'yaml', "
+            "'lxml', 'numpy', 'trimesh'}), 'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
+    done = subprocess.run([sys.executable, "-c", code, str(spec), str(tmp_path / "out2")],
+                          capture_output=True, text=True, env=os.environ, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "[] False"
+    assert _events(trace)[-1] == "reuse build with its outputs"
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+
+
+def test_an_edited_input_model_builds_again(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    urdf = tmp_path / "model/arm.urdf"
+    stat = urdf.stat()
+    urdf.write_text(ODD_URDF.replace('<mass value="2"/>', '<mass value="3"/>'))  # the same size
+    os.utime(urdf, ns=(stat.st_atime_ns, stat.st_mtime_ns))  # and modification time
+    _settle()
+    result, _, events = _build(spec, tmp_path / "out", trace)
+    assert events == ["keep build"]
+    assert result.out is not None and '<mass value="3"/>' in (result.out / "urdf/arm.urdf").read_text()
+
+
+def test_an_edited_definition_builds_again(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    spec.write_text(spec.read_text().replace("robotname: arm", "robotname: limb"))
+    _settle()
+    result, _, events = _build(spec, tmp_path / "out", trace)
+    assert events == ["keep build"]
+    assert result.out is not None and (result.out / "urdf/limb.urdf").is_file()
+
+
+def test_a_changed_mesh_is_written_anew_from_the_kept_model(tmp_path: Path, trace: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    mesh = tetra_stl(tmp_path / "model/meshes/tetra.stl")
+    mesh.write_bytes(mesh.read_bytes().replace(b"mpc test tetrahedron", b"mpc test tetrahedra!"))
+    _settle()
+    monkeypatch.setattr(front_end, "load_program", lambda *a, **k: pytest.fail("the front end ran"))
+    result, _, events = _build(spec, tmp_path / "out", trace)
+    assert events == ["reuse build", "keep build"]
+    assert result.out is not None and (result.out / "meshes/stl/tetra.stl").read_bytes() == mesh.read_bytes()
+
+
+def test_a_mesh_swapped_for_a_link_out_of_the_model_is_refused_again(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    assert _build(spec, tmp_path / "out", trace)[0].out is not None
+    mesh = tmp_path / "model/meshes/tetra.stl"
+    secret = tmp_path / "elsewhere/secret.stl"
+    secret.parent.mkdir()
+    secret.write_bytes(mesh.read_bytes())  # the same bytes: only where it lies changed
+    mesh.unlink()
+    mesh.symlink_to(secret)
+    result, sink, events = _build(spec, tmp_path / "out2", trace)
+    assert result.out is None and not (tmp_path / "out2").exists()
+    assert "reuse build" not in " ".join(events)
+    refused = [d for d in sink.diagnostics if d.code == "E0650"]
+    assert len(refused) == 1
+    assert refused[0].message.startswith("mesh 'meshes/tetra.stl' in link 'base' is not read")
+
+
+def test_werror_fails_a_kept_build_that_had_warnings(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    assert _build(spec, tmp_path / "out", trace)[0].out is not None
+    before = _files(tmp_path / "out")
+    result, sink, _ = _build(spec, tmp_path / "out", trace, Sink(werror=True))
+    assert result.out is None and _files(tmp_path / "out") == before
+    assert [(d.severity, d.code) for d in sink.diagnostics] == [(Severity.ERROR, "W0401")]
+
+
+def test_a_damaged_kept_output_is_noticed_and_written_anew(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out1", trace)
+    built = _files(tmp_path / "out1")
+    kept = next((tmp_path / "cache/builds").glob("*/*/outputs-*/urdf/arm.urdf"))
+    kept.write_text(kept.read_text().replace("arm", "mra"))  # or the output it is a link of
+    result, _, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs", "keep build"]
+    assert result.out is not None and _files(tmp_path / "out2") == built
+
+
+def test_another_environment_builds_again(tmp_path: Path, trace: Path,
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
+    assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
+    monkeypatch.setenv("OLDPWD", str(tmp_path))  # a shell's own variable: the same build
+    assert _build(spec, tmp_path / "out", trace)[2] == ["reuse build with its outputs"]
+
+
+def test_a_package_that_appears_earlier_on_the_search_path_builds_again(
+        tmp_path: Path, trace: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """ROS_PACKAGE_PATH stays the same; the folders on it do not."""
+    first, second = tmp_path / "first", tmp_path / "second"
+    monkeypatch.setenv("ROS_PACKAGE_PATH", f"{first}:{second}")
+    arm(tmp_path / "model", ODD_URDF.replace("meshes/tetra.stl", "package://arm_meshes/tetra.stl"))
+    tetra_stl(second / "arm_meshes/tetra.stl")
+    spec = write(tmp_path / "model/arm.yml", SPEC.format(more=""))
+    _settle()
+    assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
+    nearer = tetra_stl(first / "arm_meshes/tetra.stl")
+    nearer.write_bytes(nearer.read_bytes().replace(b"tetrahedron", b"nearer one!"))
+    _settle()
+    result, _, events = _build(spec, tmp_path / "out", trace)
+    assert events == ["keep build"]
+    assert result.out is not None
+    assert (result.out / "meshes/stl/tetra.stl").read_bytes() == nearer.read_bytes()
+
+
+def test_outputs_of_other_programs_are_not_kept(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model", more="- {type: pdf}")
+    first, _, events = _build(spec, tmp_path / "out1", trace)
+    assert first.out is not None and events == ["keep build"]
+    second, _, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build", "keep build"]  # its program and robot, not Graphviz's PDF
+    assert second.out is not None and _files(second.out) == _files(first.out)
+
+
+def test_a_build_that_failed_is_not_kept(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model", ODD_URDF.replace('<child link="lower"/>', '<child link="lowr"/>'))
+    for out in ("out1", "out2"):
+        result, sink, events = _build(spec, tmp_path / out, trace)
+        assert result.out is None and events == []
+        assert [d.code for d in sink.diagnostics if d.severity is Severity.ERROR] == ["E0411"]
+
+
+def test_a_branch_of_a_repository_is_fetched_on_every_build(tmp_path: Path, trace: Path) -> None:
+    repo = tmp_path / "models"
+    arm(repo)
+    for args in (["init", "-q", "-b", "main"], ["add", "-A"], ["commit", "-q", "-m", "arm"]):
+        subprocess.run(["git", *args], cwd=repo, check=True, capture_output=True,
+                       env={**os.environ, "GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t",
+                            "GIT_COMMITTER_NAME": "t", "GIT_COMMITTER_EMAIL": "t@t"})
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: arm
+          modelname: arm-from-git
+          input_models:
+            arm: {{repo: {{git: "file://{repo}", branch: main, model_in_repo: arm.urdf}}}}
+          assemble: {{model: arm}}
+        """)
+    _settle()
+    for out in ("out1", "out2"):
+        result, _, events = _build(spec, tmp_path / out, trace)
+        assert result.out is not None and events == []
+
+
+def test_a_build_whose_files_changed_as_it_started_is_not_kept(tmp_path: Path, trace: Path) -> None:
+    """Written just before the build: they may have changed after it read them, within one tick
+    of the file system's clock."""
+    arm(tmp_path / "model", ODD_URDF)
+    spec = write(tmp_path / "model/arm.yml", SPEC.format(more=""))
+    result, _, events = _build(spec, tmp_path / "out", trace)
+    assert result.out is not None and events == []
+    _settle()
+    assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
