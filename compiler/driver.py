@@ -26,6 +26,7 @@ from mpc.core.profile import stage
 from mpc.core.span import Span
 
 if TYPE_CHECKING:  # a build that writes its kept outputs reads no model (compiler/build_cache.py)
+    from mpc.compiler.build_cache import KeptBuild
     from mpc.ir.program import Export, Program
     from mpc.ir.robot import Robot
 
@@ -212,17 +213,9 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     with stage("lower"):
         kept = KeptBuild.open(path, options)                   # the last build, if it still holds
     if kept is not None and kept.outputs_hold and not sink.werror:
-        out = options.out or Path("build") / kept.modelname
-        own = Sink()
-        with stage("write"):
-            written = into_place(out, own, kept.span, kept.write_outputs)  # its outputs, as they were
-        if written or own.diagnostics:
-            if written:
-                kept.replay_outputs(sink)
-            for diagnostic in own.diagnostics:
-                sink.report(diagnostic)
-            return Result(out=out if written else None, model=kept.model if written else None)
-        kept.drop_outputs()                                    # damaged: written anew below
+        done = _write_kept(kept, sink, options)                 # its outputs, as they were
+        if done is not None:
+            return done
     before = len(sink.diagnostics)
     with kept.recording() if kept is not None else contextlib.nullcontext():
         with stage("lower"):
@@ -245,9 +238,26 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     if not written:
         return Result(program, robot)
     if kept is not None:
-        with stage("keep"):
+        with stage("keep"):                                    # for the next build
             kept.keep(program, robot, sink.diagnostics[before:model_end], out, sink.diagnostics[model_end:])
     return Result(program, robot, out)
+
+
+def _write_kept(kept: KeptBuild, sink: Sink, options: Options) -> Result | None:
+    """The kept outputs written into place, their diagnostics said again; None (nothing said)
+    when one of them is damaged: the build runs."""
+    out = options.out or Path("build") / kept.modelname
+    own = Sink()
+    with stage("write"):
+        written = into_place(out, own, kept.span, kept.write_outputs)
+    if not written and not own.diagnostics:
+        kept.drop_outputs()
+        return None
+    if written:
+        kept.replay_outputs(sink)
+    for diagnostic in own.diagnostics:  # E0660: the output folder cannot be written
+        sink.report(diagnostic)
+    return Result(out=out, model=kept.model) if written else Result()
 
 
 def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Program | None, Robot | None]:

@@ -263,3 +263,15 @@ def test_a_build_whose_files_changed_as_it_started_is_not_kept(tmp_path: Path, t
     assert result.out is not None and events == []
     _settle()
     assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
+
+
+def test_an_output_folder_that_cannot_be_written_is_said_with_the_kept_build_too(tmp_path: Path,
+                                                                                trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
+    (tmp_path / "taken").write_text("a file where the output's folder should be\n")
+    result, sink, events = _build(spec, tmp_path / "taken/out", trace)
+    assert result.out is None and events == ["reuse build with its outputs"]
+    (error,) = [d for d in sink.diagnostics if d.severity is Severity.ERROR]
+    assert error.code == "E0660" and error.message.startswith("cannot make the output's folder")
+    assert error.message.endswith("; the previous output is unchanged")
