@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "4"  # changes when the way meshes are computed changes, so old cache entries go unused
+ENGINE = "5"  # changes when the way meshes are computed changes, so old cache entries go unused (5: stable DAE)
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
@@ -342,6 +342,10 @@ def _derive(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] |
         data: bytes | str = bobj.dumps(mesh)
     else:
         data = mesh.export(file_type=dest.suffix[1:])  # `x.mars.obj` is written as OBJ
+        if dest.suffix == ".dae":
+            from mpc.core.collada import stable
+
+            data = stable(data if isinstance(data, bytes) else data.encode())
     if ignored:  # written before the entry, so that an entry never lacks its record
         write_atomic(notes_file(dest), "".join(f"{line}\n" for line in sorted(set(ignored))))
     store_entry(dest, data if isinstance(data, bytes) else data.encode())

@@ -5,6 +5,9 @@ missing (a texture that was never shipped with the model, as in example-robot-da
 foot), and trimesh then finds no triangles at all. The triangles themselves are intact, so such
 a file is read once more without its material bindings, and what was broken is reported. A
 file whose references all resolve is read as trimesh reads it. Nothing here writes files.
+
+What trimesh writes as COLLADA (through pycollada) is stamped with the time of writing and
+random ids; `stable` makes it the same bytes for the same mesh (mpc's outputs are).
 """
 
 from __future__ import annotations
@@ -99,3 +102,21 @@ def _unit(data: bytes) -> float:
     """Metres per unit of a COLLADA file (its <unit meter=…>), 1 when it has none."""
     m = re.search(rb"<unit\b[^>]*\bmeter=\"([0-9.eE+-]+)\"", data[:4096])
     return float(m.group(1)) if m else 1.0
+
+
+_STAMP = re.compile(rb"<(created|modified)>[^<]*</(created|modified)>")
+_RANDOM_ID = re.compile(rb'="(#?)([0-9a-f]{32})"')  # uuid4().hex, as pycollada names what it writes
+
+
+def stable(data: bytes) -> bytes:
+    """trimesh's COLLADA export, byte for byte the same for the same mesh: the asset's dates
+    become the epoch (a mesh is kept in the cache across builds, so no build's
+    SOURCE_DATE_EPOCH is its own) and the random ids `id0`, `id1`, … in order of appearance."""
+    data = _STAMP.sub(lambda m: b"<%s>1970-01-01T00:00:00</%s>" % (m[1], m[1]), data)
+    names: dict[bytes, bytes] = {}
+
+    def rename(m: re.Match[bytes]) -> bytes:
+        new = names.setdefault(m[2], b"id%d" % len(names))
+        return b'="' + m[1] + new + b'"'
+
+    return _RANDOM_ID.sub(rename, data)

@@ -29,26 +29,31 @@ def _files(folder: Path) -> dict[str, bytes]:
             if p.is_file() and ".mpc" not in p.relative_to(folder).parts}
 
 
-def test_two_builds_of_the_bundled_examples_are_byte_identical(tmp_path: Path) -> None:
-    """Every output file, the PDFs of the kinematic trees included (cairo stamps the time of
-    rendering into them), is the same in two builds a second apart, the second from the cache."""
+def test_two_builds_of_the_bundled_examples_are_byte_identical(tmp_path: Path,
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every output file, the PDFs of the kinematic trees (cairo stamps the time of rendering
+    into them) and the COLLADA meshes mpc writes (pycollada stamps the time and random ids)
+    included, is the same in two builds a second apart on two caches (two machines), and
+    in a third on the first's cache (its kept builds and meshes)."""
     import shutil
     import time
 
     from tests.pipeline.helpers import mpc
 
-    for n, build in enumerate(("first", "second")):
+    for n, (build, cache) in enumerate((("first", "a"), ("second", "b"), ("third", "a"))):
         if n:
-            time.sleep(1.1)  # a PDF stamped with the time would now differ
+            time.sleep(1.1)  # a file stamped with the time would now differ
+        monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / cache))
         for example in EXAMPLES:
             out = tmp_path / build / example.stem
             assert compile_file(example, out, Diags()).out is not None
         fleet = tmp_path / build / "fleet"
         shutil.copytree(EXAMPLES[0].parent / "fleet", fleet)
-        # Cold, then warm: what a build with the cache writes is what one without it wrote.
-        run = mpc("run", fleet / "pipeline.yml", cache=tmp_path / "cache")
+        run = mpc("run", fleet / "pipeline.yml", cache=tmp_path / cache)
         assert run.returncode == 1, run.stderr  # broken.yml fails on purpose
-    first, second = _files(tmp_path / "first"), _files(tmp_path / "second")
-    assert sorted(first) == sorted(second)
-    assert [f for f in first if f.endswith(".pdf")]
-    assert [f for f in first if first[f] != second[f]] == []
+    first = _files(tmp_path / "first")
+    assert [f for f in first if f.endswith(".pdf")] and [f for f in first if f.endswith(".dae")]
+    for other in ("second", "third"):
+        files = _files(tmp_path / other)
+        assert sorted(files) == sorted(first)
+        assert [f for f in first if first[f] != files[f]] == [], other
