@@ -39,7 +39,8 @@ if TYPE_CHECKING:
     from mpc.ir.program import MjcfExport, SdfExport, UrdfExport
 
 KEEP_FORMAT = "input_type"
-ENGINE = "5"  # changes when the way meshes are computed changes, so old cache entries go unused (5: stable DAE)
+# Changes when the way meshes are computed changes, so old cache entries go unused (5: stable DAE).
+ENGINE = "5"
 WRITABLE = ("stl", "obj", "dae", "ply", "bobj")  # formats mpc writes, for meshes with ops
 MeshKey = tuple[Path, tuple[MeshOp, ...]]
 

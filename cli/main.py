@@ -58,6 +58,9 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--emit", choices=("files", "ir", "ir-lowered"), default="files",
                       help="what to produce: the model files (default), or the IR as text on stdout: "
                            "after the passes (ir) or as lowered, before them (ir-lowered)")
+    comp.add_argument("--force", action="store_true",
+                      help="build anew even when nothing the last build read has changed (its kept "
+                           "outputs are not used; the mesh cache is)")
     check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")

@@ -115,7 +115,8 @@ class KeptBuild:
         name = hashlib.sha256(json.dumps(where).encode()).hexdigest()
         kept = cls(cache.cache_dir("builds") / name[:2] / name, hashlib.sha256(key.encode()).hexdigest(),
                    options)
-        kept._load()
+        if not options.force:
+            kept._load()
         return kept
 
     # -- what is kept ----------------------------------------------------------------------------

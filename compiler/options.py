@@ -31,6 +31,9 @@ class Options:
     # A long-lived process (`mpc lsp`): input models kept across compilations until their file
     # changes. None: each compilation reads its inputs once.
     models: ModelCache | None = None
+    # Build anew: the kept build of the definition (compiler/build_cache.py) is not used, and
+    # this build is kept in its place.
+    force: bool = False
 
 
 @dataclass

@@ -254,15 +254,26 @@ def test_a_branch_of_a_repository_is_fetched_on_every_build(tmp_path: Path, trac
         assert result.out is not None and events == []
 
 
-def test_a_build_whose_files_changed_as_it_started_is_not_kept(tmp_path: Path, trace: Path) -> None:
-    """Written just before the build: they may have changed after it read them, within one tick
-    of the file system's clock."""
-    arm(tmp_path / "model", ODD_URDF)
-    spec = write(tmp_path / "model/arm.yml", SPEC.format(more=""))
+def test_a_build_whose_files_changed_as_it_ran_is_not_kept(tmp_path: Path, trace: Path) -> None:
+    """The file system's clock cannot tell a file changed after the build read it, within the
+    same tick, from one changed before: a file dated at the build's start or later is such."""
+    spec = _model(tmp_path / "model")
+    soon = time.time_ns() + 1_000_000_000
+    os.utime(tmp_path / "model/arm.urdf", ns=(soon, soon))
     result, _, events = _build(spec, tmp_path / "out", trace)
     assert result.out is not None and events == []
+    os.utime(tmp_path / "model/arm.urdf", ns=(soon - 2_000_000_000, soon - 2_000_000_000))
     _settle()
     assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
+
+
+def test_force_builds_anew_and_keeps_that_build(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out1", trace)
+    sink = Sink()
+    result = compile_model(spec, sink, Options(out=tmp_path / "out2", force=True))
+    assert result.out is not None and _events(trace)[1:] == ["keep build"]
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
 
 
 def test_an_output_folder_that_cannot_be_written_is_said_with_the_kept_build_too(tmp_path: Path,
