@@ -48,7 +48,7 @@ import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path, PosixPath, PurePath
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mpc.core import cache
 from mpc.core.blas import user_environment
@@ -56,6 +56,11 @@ from mpc.core.diagnostics import Diagnostic, Sink
 from mpc.core.packages import interpreter_sites
 from mpc.core.reads import ReadRecorder, recording
 from mpc.core.span import Span
+
+if TYPE_CHECKING:  # the program and robot are pickled and unpickled, never imported here
+    from mpc.compiler.options import Options
+    from mpc.ir.program import Program
+    from mpc.ir.robot import Robot
 
 # Variables that a shell or a terminal sets by itself, or that change how mpc runs but not what
 # it builds.
@@ -86,7 +91,7 @@ class KeptBuild:
     """One compilation's use of the build cache: the build kept for its definition (when all it
     depends on is as it was), and the recording of what this compilation reads."""
 
-    def __init__(self, folder: Path, key: str, options: Any) -> None:
+    def __init__(self, folder: Path, key: str, options: Options) -> None:
         self.folder, self.key, self.options = folder, key, options
         self.entry = folder / "entry"
         self.header: dict[str, Any] | None = None  # the kept build, its model's dependencies hold
@@ -97,7 +102,7 @@ class KeptBuild:
         self.started = time.time_ns()
 
     @classmethod
-    def open(cls, path: Path, options: Any) -> KeptBuild | None:
+    def open(cls, path: Path, options: Options) -> KeptBuild | None:
         """The cache of the definition at `path`, or None for builds that are not kept (pipeline
         defaults, a server's kept models)."""
         if options.defaults is not None or options.models is not None:
@@ -131,12 +136,12 @@ class KeptBuild:
         assert self.header is not None
         return self.header["span"]
 
-    def model(self) -> tuple[Any, Any]:
+    def model(self) -> tuple[Program, Robot]:
         """The kept program and robot."""
         assert self.header is not None
         return pickle.loads(self.header["model"])
 
-    def replay_model(self, sink: Sink) -> tuple[Any, Any]:
+    def replay_model(self, sink: Sink) -> tuple[Program, Robot] | tuple[None, None]:
         """The kept program and robot, their diagnostics reported into `sink` again;
         (None, None) when `sink` makes one of them an error (--werror)."""
         assert self.header is not None
@@ -186,7 +191,7 @@ class KeptBuild:
         """What was opened so far is what the program and the robot depend on."""
         self.front_reads = len(self.recorder.read)
 
-    def keep(self, program: Any, robot: Any, model_diagnostics: list[Diagnostic],
+    def keep(self, program: Program, robot: Robot, model_diagnostics: list[Diagnostic],
              out: Path | None, output_diagnostics: list[Diagnostic]) -> None:
         """Keep this build: its program and robot, and (`out`: the folder it wrote, when every
         export is one whose files can be kept) its outputs."""
