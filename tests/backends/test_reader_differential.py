@@ -37,6 +37,10 @@ HOSTILE = {
     "entity.urdf": b'<!DOCTYPE robot [<!ENTITY e "x">]><robot name="r"><link name="&e;"/></robot>',
     "external.urdf": b'<!DOCTYPE robot SYSTEM "file:///etc/passwd"><robot name="r"><link name="a"/></robot>',
     "billion.urdf": b'<!DOCTYPE r [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]><robot name="&b;"/>',
+    "subset.urdf": b'<!DOCTYPE robot [<!ELEMENT robot ANY><!ENTITY e "<link name=\'e\'/>">]>\n'
+                   b'<robot name="r">\n <link name="a"/>\n <link name="a"/>\n</robot>',
+    "utf7.urdf": b'<?xml version="1.0" encoding="UTF-7"?>\n<robot name="r">\n +ADw-link name="a"/+AD4-\n'
+                 b' <link name="a"/>\n</robot>',
     "not_xml.urdf": b"this is not XML",
     "empty.urdf": b"",
     "bom.urdf": b'\xef\xbb\xbf<robot name="r">\n  <link name="a"/>\n</robot>\n',

@@ -182,7 +182,9 @@ def _prolog(rng: random.Random, data: bytes) -> bytes:
         b'<!DOCTYPE robot>\n', b'<!DOCTYPE robot [<!ENTITY e "<link name=\'e\'/>">]>\n',
         b'<!DOCTYPE robot SYSTEM "http://example.com/x.dtd">\n', b"<!-- head -->\n",
         b'<?xml version="1.0" encoding="utf-16"?>\n', b'<?xml version="1.1"?>\n',
-        b'<!DOCTYPE robot [<!ENTITY big "aaaaaaaaaa"><!ELEMENT robot ANY>]>\n'])
+        b'<!DOCTYPE robot [<!ENTITY big "aaaaaaaaaa"><!ELEMENT robot ANY>]>\n',
+        b'<!DOCTYPE robot [<!ELEMENT robot ANY><!ENTITY tag "<link name=\'e\'/>">]>\n',
+        b'<?xml version="1.0" encoding="UTF-7"?>\n'])
     data = head + body
     if b"ENTITY" in head and rng.random() < 0.7:
         data = _chunk(rng, data).replace(b"&amp;", b"&e;").replace(b"&#10;", b"&big;")
