@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import os
 import random
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -22,7 +22,7 @@ from mpc.backends import sdf, urdf_reader
 from mpc.backends.xml import XmlError, XmlSource
 from mpc.core.diagnostics import Diagnostic, Sink
 from mpc.core.packages import PackageResolver
-from tests.backends import urdf_reader_before, xml_source_before
+from tests.backends import refusal_before, urdf_reader_before, xml_source_before
 from tests.backends.urdf_mutations import mutate
 from tests.conftest import ERD
 
@@ -155,6 +155,46 @@ def test_hostile_inputs_read_the_same(name: str, tmp_path: Path) -> None:
     for variant in (data, data.replace(b"m.stl", b"link.stl")):
         assert compare_urdf(variant, name, tmp_path) is None
         assert compare_spans(variant, name) is None
+
+
+def _outcome(refuse: Callable[..., str | None], *args: object) -> str | None:
+    try:
+        return refuse(*args)
+    except OSError as e:  # Path.exists raises on some errors (ENAMETOOLONG), then and now
+        return f"raised {type(e).__name__}: {e}"
+
+
+def test_refusals_are_the_same(tmp_path: Path) -> None:
+    """PackageResolver.refusal against its frozen copy, for files, folders, links in and out
+    of the package, special files and paths written every way."""
+    pkg, outside = tmp_path / "pkg", tmp_path / "outside"
+    meshes = pkg / "meshes"
+    (meshes / "dir").mkdir(parents=True)
+    outside.mkdir()
+    for file in (meshes / "a.stl", meshes / ".hidden.stl", outside / "x.stl"):
+        file.write_bytes(b"solid\nendsolid\n")
+    links = {"in.stl": "a.stl", "out.stl": str(outside / "x.stl"), "proc": "/proc/self/environ",
+             "dangling": "/nonexistent/x", "loop": "loop", "devnull": "/dev/null", "up": "../meshes/a.stl"}
+    for name, target in links.items():
+        (meshes / name).symlink_to(target)
+    (pkg / "linked_out").symlink_to(outside)
+    (pkg / "linked_in").symlink_to(meshes)
+    os.mkfifo(meshes / "fifo")
+    names = ["a.stl", ".hidden.stl", "dir", "missing.stl", "fifo", *links, "a.stl/x", "x" * 300]
+    paths = [meshes / n for n in names] + [
+        pkg / "linked_out/x.stl", pkg / "linked_in/a.stl", pkg / "linked_in/out.stl",
+        pkg / "linked_out/missing", meshes / "../meshes/a.stl", meshes / "dir/../a.stl",
+        Path(f"{meshes}/./a.stl"), Path(f"{meshes}//a.stl"), Path(f"{meshes}/"), Path("meshes/a.stl"),
+        Path("/dev/null"), Path("/proc/self/environ"), Path("/proc"), Path("/"), Path("/etc/hostname"),
+        Path("/nonexistent/x"), outside / "x.stl", Path(str(tmp_path) + "/pkg/../outside/x.stl"),
+        pkg / "linked_out/../pkg/meshes/a.stl", Path("//etc/hostname"), Path(f"/{meshes}/a.stl")]
+    for order in range(3):
+        shuffled = random.Random(order).sample(paths, len(paths))
+        for base in (pkg, None):
+            old, new = PackageResolver(), PackageResolver()
+            for path in shuffled + shuffled:  # and again, from the resolvers' caches
+                before = _outcome(refusal_before.refusal, old, path, base)
+                assert _outcome(new.refusal, path, base) == before, (path, base)
 
 
 @pytest.mark.parametrize("chunk", range(CHUNKS))

@@ -41,6 +41,7 @@ from mpc.ir.robot import (
     Visual,
 )
 from mpc.ir.tree import check_tree
+from tests.backends.refusal_before import refusal as refusal_before
 from tests.backends.xml_source_before import XmlError, XmlSource, load, parse_floats
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -369,7 +370,7 @@ class _Reader:
             scale = self.floats(shape, "scale", 3, where)
             if uri not in self.mesh_sources:  # a file's visuals and collisions share meshes
                 source = mesh_source(self.resolver, uri, self.base_dir)
-                refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
+                refusal = refusal_before(self.resolver, source.path, self.base_dir) if source.path else None
                 self.mesh_sources[uri] = source, refusal
             source, why = self.mesh_sources[uri]
             if why:
