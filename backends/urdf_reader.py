@@ -39,6 +39,13 @@ from mpc.ir.robot import (
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_UNREAD = object()  # _Reader.numbers: a text not read yet
+_NAME, _NAME_TYPE, _POSE, _MESH = ("name",), ("name", "type"), ("xyz", "rpy"), ("filename", "scale")
+_LIMIT, _DYNAMICS = ("lower", "upper", "effort", "velocity"), ("damping", "friction")
+# The children of an inertial and a joint that are no fragments.
+_INERTIAL_CHILDREN = frozenset({"origin", "mass", "inertia"})
+_JOINT_CHILDREN = frozenset({"origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
+                             "calibration", "safety_controller"})
 # Elements inside links and joints that become IR values (anything else is a fragment).
 _MODELLED = frozenset({
     "inertial", "visual", "collision", "origin", "geometry", "material", "mass", "inertia",
@@ -94,9 +101,16 @@ class _Reader:
         self.joint_names: set[str] = set()
         self.names: set[str] = set()  # both
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
-        # What tostring adds to a fragment's start tag for the namespaces <robot> declares.
+        # The numbers of each attribute text read so far (parse_floats): a URDF repeats many.
+        self.numbers: dict[str, tuple[float, ...] | None] = {}
+        # The elements that hold a comment somewhere inside (most hold none).
+        self.commented = {parent for comment in src.root.iter(etree.Comment)
+                          for parent in comment.iterancestors()}
+        # What tostring adds to a fragment's start tag for the namespaces <robot> declares,
+        # each and (as it writes them, right after the tag's name) all together.
         self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
                                        for prefix, uri in src.root.nsmap.items()]
+        self.declared = "".join(self.namespace_declarations)
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -113,7 +127,8 @@ class _Reader:
                 )
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
-        return tuple([item for item in el.items() if item[0] not in known])
+        items = el.items()
+        return tuple([item for item in items if item[0] not in known]) if items else ()
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -122,27 +137,44 @@ class _Reader:
             if required:
                 self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
             return None
-        values = parse_floats(text)
+        values = self.numbers.get(text, _UNREAD)
+        if values is _UNREAD:
+            values = self.numbers[text] = parse_floats(text)
         if values is None or len(values) != n:
-            what = "a number" if n == 1 else f"{n} numbers"
-            self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
-                       f"got '{text}'", attr)
+            self.not_numbers(el, attr, n, where, text)
             return None
         return values
 
     def number(self, el: etree._Element, attr: str, where: str,
                required: bool = False) -> float | None:
-        values = self.floats(el, attr, 1, where, required)
-        return values[0] if values else None
+        """floats(…, 1, …)[0], without the tuple for the caller (most numbers are read here)."""
+        text = el.get(attr)
+        if text is None:
+            if required:
+                self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
+            return None
+        values = self.numbers.get(text, _UNREAD)
+        if values is _UNREAD:
+            values = self.numbers[text] = parse_floats(text)
+        if values is None or len(values) != 1:
+            self.not_numbers(el, attr, 1, where, text)
+            return None
+        return values[0]
+
+    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str) -> None:
+        what = "a number" if n == 1 else f"{n} numbers"
+        self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr)
 
     def pose(self, el: etree._Element | None, where: str) -> Pose | None:
         if el is None:
             return None
-        self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
-        xyz = self.floats(el, "xyz", 3, where)
-        rpy = self.floats(el, "rpy", 3, where)
         keys = el.keys()
-        return Pose(xyz or ZERO, rpy or ZERO, ("xyz" in keys, "rpy" in keys))  # type: ignore[arg-type]
+        has_xyz, has_rpy = "xyz" in keys, "rpy" in keys
+        if len(keys) > has_xyz + has_rpy:
+            self.warn_unknown_attrs(el, _POSE, where)
+        xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
+        rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
+        return Pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")
@@ -152,36 +184,41 @@ class _Reader:
         return name
 
     def children(self, el: etree._Element) -> list[etree._Element]:
-        return [c for c in el if isinstance(c.tag, str)]
+        return [c for c in el if c.tag.__class__ is str]
 
-    @staticmethod
-    def by_tag(el: etree._Element) -> tuple[list[etree._Element], dict[str, etree._Element]]:
-        """The element children of `el` in order, and the first of each tag: what `el.find(tag)`
-        gives for a plain tag, in one pass (each `find` call costs microseconds)."""
-        kids: list[etree._Element] = []
+    def sort_children(self, el: etree._Element, known: frozenset[str]
+                      ) -> tuple[dict[str, etree._Element], tuple[Fragment, ...]]:
+        """The first element child of each tag (what `el.find(tag)` gives for a plain tag), and
+        the children whose tags are not `known` as fragments, in one pass (each `find` call
+        costs microseconds; a fragment reports nothing, so it may be made first)."""
         first: dict[str, etree._Element] = {}
+        extras: list[Fragment] = []
         for child in el:
             tag = child.tag
-            if isinstance(tag, str):
-                kids.append(child)
+            if tag.__class__ is str:
                 if tag not in first:
                     first[tag] = child
-        return kids, first
+                if tag not in known:
+                    extras.append(self.fragment(child))
+        return first, tuple(extras)
 
     def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
         span = self.src.span(el)
         xml = etree.tostring(el, encoding="unicode", with_tail=False)
-        # tostring re-declares every namespace in scope; <robot> declares them already.
-        head_end = xml.find(">")
-        head = xml[:head_end]
-        for declaration in self.namespace_declarations:
-            head = head.replace(declaration, "", 1)
-        xml = head + xml[head_end:]
-        if "\n" in xml:
-            indent = " " * (span.col - 1)
-            lines = xml.split("\n")
-            xml = "\n".join([lines[0]] + [ln.removeprefix(indent) for ln in lines[1:]])
-        return Fragment(tag=str(el.tag), xml=xml, refs=self.refs(el), comments=comments, span=span)
+        if self.declared:
+            # tostring re-declares every namespace in scope; <robot> declares them already.
+            cut = len(el.tag) + 1 if el.tag[0] != "{" else xml.find(" ")
+            if xml.startswith(self.declared, cut) and xml.find(">", 0, cut) < 0:
+                xml = xml[:cut] + xml[cut + len(self.declared):]
+            else:  # declared in another order, or among declarations of its own
+                head_end = xml.find(">")
+                head = xml[:head_end]
+                for declaration in self.namespace_declarations:
+                    head = head.replace(declaration, "", 1)
+                xml = head + xml[head_end:]
+        if span.col > 1:  # its lines less the indentation of its first
+            xml = xml.replace("\n" + " " * (span.col - 1), "\n")
+        return Fragment(tag=el.tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
 
     def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
         """Every attribute or text in the fragment that equals a link or joint name, in
@@ -189,14 +226,12 @@ class _Reader:
         out: list[FragmentRef] = []
         names = self.names
         for node in el.iter(etree.Element):
-            tag = node.tag
             for attr, value in node.items():
-                name = value.strip()
-                if name in names:
-                    out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, tag + attr), name))
+                if (name := value.strip()) in names:
+                    out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, node.tag + attr), name))
             text = node.text
             if text and (name := text.strip()) and name in names:
-                out.append(FragmentRef(_path(el, node), None, self.kind_of(name, tag), name))
+                out.append(FragmentRef(_path(el, node), None, self.kind_of(name, node.tag), name))
         return tuple(out)
 
     def kind_of(self, name: str, hint: str) -> RefKind:
@@ -209,7 +244,7 @@ class _Reader:
 
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
         """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
-        if next(el.iter(etree.Comment), None) is None:  # most elements hold none: one C-level walk
+        if el not in self.commented:
             return ()
         out: list[str] = []
         for child in el:
@@ -295,27 +330,28 @@ class _Reader:
             return None
         where = f"link '{name}'"
         inertial, visuals, collisions, extras = None, [], [], []
-        for child in self.children(el):
-            if child.tag == "inertial":
+        for child in el:
+            tag = child.tag
+            if tag == "visual":
+                if (visual := self.visual(child, where)) is not None:
+                    visuals.append(visual)
+            elif tag == "collision":
+                if (collision := self.collision(child, where)) is not None:
+                    collisions.append(collision)
+            elif tag == "inertial":
                 if inertial is not None:
                     self.error(child, "E0406", f"{where} has more than one <inertial>")
                 inertial = self.inertial(child, where)
-            elif child.tag == "visual":
-                visuals.append(self.visual(child, where))
-            elif child.tag == "collision":
-                collisions.append(self.collision(child, where))
-            else:
+            elif tag.__class__ is str:
                 extras.append(self.fragment(child))
         return Link(
-            name=name, inertial=inertial,
-            visuals=tuple(v for v in visuals if v is not None),
-            collisions=tuple(c for c in collisions if c is not None),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=tuple(extras),
+            name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
+            extra_attrs=self.extra_attrs(el, _NAME), extras=tuple(extras),
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )
 
     def inertial(self, el: etree._Element, where: str) -> Inertial | None:
-        kids, first = self.by_tag(el)
+        first, extras = self.sort_children(el, _INERTIAL_CHILDREN)
         mass_el, inertia_el = first.get("mass"), first.get("inertia")
         mass = self.number(mass_el, "value", where, True) if mass_el is not None else None
         if mass_el is None:
@@ -325,10 +361,10 @@ class _Reader:
             self.error(el, "E0403", f"<inertial> in {where} has no <inertia>")
         else:
             values = [self.number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "mass", "inertia"))
         if mass is None or len(values) != 6 or None in values:
             return None
-        return Inertial(mass=mass, inertia=Inertia(**dict(zip(_INERTIA_KEYS, values, strict=True))),
+        ixx, ixy, ixz, iyy, iyz, izz = values
+        return Inertial(mass=mass, inertia=Inertia(ixx=ixx, ixy=ixy, ixz=ixz, iyy=iyy, iyz=iyz, izz=izz),  # type: ignore[arg-type]
                         origin=self.pose(first.get("origin"), where), extras=extras)
 
     def geometry(self, el: etree._Element | None, parent: etree._Element,
@@ -342,6 +378,8 @@ class _Reader:
                        f"found {len(shapes)}")
             return None
         shape = shapes[0]
+        if shape.tag == "mesh":
+            return self.mesh(shape, where)
         if shape.tag == "box":
             size = self.floats(shape, "size", 3, where, True)
             return Box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
@@ -356,60 +394,77 @@ class _Reader:
             if r is None:
                 return None
             return Sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
-        if shape.tag == "mesh":
-            uri = shape.get("filename")
-            if not uri:
-                self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
-                return None
-            scale = self.floats(shape, "scale", 3, where)
-            if uri not in self.mesh_sources:  # a file's visuals and collisions share meshes
-                source = mesh_source(self.resolver, uri, self.base_dir)
-                refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
-                self.mesh_sources[uri] = source, refusal
-            source, why = self.mesh_sources[uri]
-            if why:
-                self.error(shape, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
-                return None
-            return Mesh(source=source,
-                        scale=scale, span=self.src.span(shape, "filename"),  # type: ignore[arg-type]
-                        extra_attrs=self.extra_attrs(shape, ("filename", "scale")))
         self.error(shape, "E0405", f"unsupported geometry <{shape.tag}> in {where}; URDF has "
                    "box, cylinder, sphere and mesh")
         return None
 
+    def mesh(self, el: etree._Element, where: str) -> Mesh | None:
+        uri = el.get("filename")
+        if not uri:
+            self.error(el, "E0403", f"<mesh> in {where} has no 'filename' attribute")
+            return None
+        scale = self.floats(el, "scale", 3, where)
+        found = self.mesh_sources.get(uri)
+        if found is None:  # a file's visuals and collisions share meshes
+            source = mesh_source(self.resolver, uri, self.base_dir)
+            refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
+            found = self.mesh_sources[uri] = source, refusal
+        source, why = found
+        if why:
+            self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
+            return None
+        return Mesh(source=source, scale=scale, span=self.src.span(el, "filename"),  # type: ignore[arg-type]
+                    extra_attrs=self.extra_attrs(el, _MESH))
+
+    def shape_children(self, el: etree._Element, visual: bool) -> tuple[
+            etree._Element | None, etree._Element | None, etree._Element | None, tuple[Fragment, ...]]:
+        """The first <origin>, <geometry> and (of a visual) <material> of a visual or collision,
+        and the other children as fragments: sort_children without a dict for the commonest
+        elements."""
+        origin = geometry = material = None
+        extras: list[Fragment] = []
+        for child in el:
+            tag = child.tag
+            if tag == "geometry":
+                if geometry is None:
+                    geometry = child
+            elif tag == "origin":
+                if origin is None:
+                    origin = child
+            elif tag == "material" and visual:
+                if material is None:
+                    material = child
+            elif tag.__class__ is str:
+                extras.append(self.fragment(child))
+        return origin, geometry, material, tuple(extras) if extras else ()
+
     def visual(self, el: etree._Element, where: str) -> Visual | None:
-        kids, first = self.by_tag(el)
-        geometry_el = first.get("geometry")
+        origin_el, geometry_el, material_el, extras = self.shape_children(el, True)
         geometry = self.geometry(geometry_el, el, where)
         material, inline = None, None
-        material_el = first.get("material")
         if material_el is not None:
             material = material_el.get("name")
             if material is None:
                 self.error(material_el, "E0403", f"<material> in {where} has no 'name' attribute")
             if len(material_el):
                 inline = self.material(material_el, (), where)
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry", "material"))
         if geometry is None:
             return None
         return Visual(
-            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
-            material=material, inline_material=inline,
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+            geometry=geometry, name=el.get("name"), origin=self.pose(origin_el, where),
+            material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            extra_attrs=self.extra_attrs(el, _NAME), extras=extras, span=self.src.span(el),
         )
 
     def collision(self, el: etree._Element, where: str) -> Collision | None:
-        kids, first = self.by_tag(el)
-        geometry_el = first.get("geometry")
+        origin_el, geometry_el, _, extras = self.shape_children(el, False)
         geometry = self.geometry(geometry_el, el, where)
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry"))
         if geometry is None:
             return None
         return Collision(
-            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+            geometry=geometry, name=el.get("name"), origin=self.pose(origin_el, where),
+            geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            extra_attrs=self.extra_attrs(el, _NAME), extras=extras, span=self.src.span(el),
         )
 
     def material(self, el: etree._Element, comments: tuple[str, ...], where: str) -> Material | None:
@@ -417,8 +472,12 @@ class _Reader:
         if name is None:
             self.error(el, "E0403", f"<material> in {where} has no 'name' attribute")
             return None
-        _, first = self.by_tag(el)
-        color, texture = first.get("color"), first.get("texture")
+        color = texture = None
+        for child in el:  # the first of each, as el.find would give (each call costs microseconds)
+            if child.tag == "color" and color is None:
+                color = child
+            elif child.tag == "texture" and texture is None:
+                texture = child
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
         return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
                         texture=texture.get("filename", "") if texture is not None else None,
@@ -436,7 +495,7 @@ class _Reader:
             self.error(el, "E0422", f"{where} has unknown type '{jtype}'{hint}", "type",
                        hint="URDF joint types: " + ", ".join(JOINT_TYPES))
             ok = False
-        kids, first = self.by_tag(el)
+        first, extras = self.sort_children(el, _JOINT_CHILDREN)
         ends = {}
         for end in ("parent", "child"):
             end_el = first.get(end)
@@ -454,9 +513,6 @@ class _Reader:
             self.error(el, "E0421", f"{where} is {jtype} but has no <limit> with effort and "
                        "velocity", "name")
             ok = False
-        known = ("origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
-                 "calibration", "safety_controller")
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in known)
         if len(ends) < 2:
             return None
         if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
@@ -468,23 +524,23 @@ class _Reader:
             mimic=self.mimic(first.get("mimic"), where),
             calibration=self.calibration(first.get("calibration"), where),
             safety_controller=self.safety(first.get("safety_controller"), where),
-            extra_attrs=self.extra_attrs(el, ("name", "type")), extras=extras,
+            extra_attrs=self.extra_attrs(el, _NAME_TYPE), extras=extras,
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )
 
     def limit(self, el: etree._Element | None, where: str) -> Limit | None:
         if el is None:
             return None
-        keys = ("lower", "upper", "effort", "velocity")
-        return Limit(**{k: self.number(el, k, where) for k in keys},
-                     extra_attrs=self.extra_attrs(el, keys))
+        return Limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
+                     effort=self.number(el, "effort", where),
+                     velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
 
     def dynamics(self, el: etree._Element | None, where: str) -> Dynamics | None:
         if el is None:
             return None
-        keys = ("damping", "friction")
-        return Dynamics(**{k: self.number(el, k, where) for k in keys},
-                        extra_attrs=self.extra_attrs(el, keys))
+        return Dynamics(damping=self.number(el, "damping", where),
+                        friction=self.number(el, "friction", where),
+                        extra_attrs=self.extra_attrs(el, _DYNAMICS))
 
     def mimic(self, el: etree._Element | None, where: str) -> Mimic | None:
         if el is None:

@@ -129,8 +129,13 @@ class XmlSource:
         else:
             written = tag
         needle = "<" + written
+        start = line.find(needle)
+        if start >= 0 and line.find(needle, start + 1) < 0:  # most tags: alone on one line
+            end = start + len(needle)
+            if (end == len(line) or line[end] in _DELIMITERS) and line.find(">", 0, line.find("<")) < 0:
+                return number, line, start
         here = _starts(line, needle)
-        if len(here) == 1 and line.find(">", 0, line.find("<")) < 0:  # most tags: one line
+        if len(here) == 1 and line.find(">", 0, line.find("<")) < 0:
             where = number, line, here[0]
         elif len(here) > 1:
             return None
