@@ -18,6 +18,8 @@ from pathlib import Path
 
 NAME_BYTES = 255  # the longest file name of Linux's file systems (NAME_MAX), in bytes
 SPECIAL_ROOTS = (Path("/proc"), Path("/sys"), Path("/dev"))
+_SPECIAL = tuple(map(str, SPECIAL_ROOTS))  # as _within compares them: the roots and what is below
+_SPECIAL_BELOW = tuple(f"{root}/" for root in _SPECIAL)
 
 
 class OutsideOutput(ValueError):
@@ -89,7 +91,7 @@ def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] |
     else:
         real = _realpath(path, real_dirs)
         normal = ""
-    if any(_within(real, str(s)) for s in SPECIAL_ROOTS):
+    if real in _SPECIAL or real.startswith(_SPECIAL_BELOW):
         return f"it is '{real}', a special file of the system"
     if found is None:
         try:
@@ -120,7 +122,8 @@ def plain_stat(path: Path, real_dirs: dict[str, str]) -> tuple[str, int] | bool:
     if (not folder or text[0] != "/" or name in ("", ".", "..") or "/./" in text or "/../" in text
             or "//" in text):
         return True
-    joined = os.path.join(_real_folder(folder, real_dirs), name)
+    real_folder = _real_folder(folder, real_dirs)
+    joined = f"{real_folder}/{name}" if real_folder != "/" else f"/{name}"  # os.path.join
     try:
         mode = os.lstat(joined).st_mode
     except (FileNotFoundError, NotADirectoryError):
