@@ -101,8 +101,12 @@ class _Reader:
         self.joint_names: set[str] = set()
         self.names: set[str] = set()  # both
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
-        # The numbers of each attribute text read so far (parse_floats): a URDF repeats many.
+        # The numbers of each attribute text read so far (parse_floats), and the values of
+        # <origin>, <limit> and <dynamics> by their attributes: a URDF repeats many. A value
+        # is kept only when reading it reported nothing.
         self.numbers: dict[str, tuple[float, ...] | None] = {}
+        self.poses: dict[tuple[tuple[str, str], ...], Pose] = {}
+        self.limits: dict[tuple[tuple[str, str], ...], Limit | Dynamics] = {}
         # The elements that hold a comment somewhere inside (most hold none).
         self.commented = {parent for comment in src.root.iter(etree.Comment)
                           for parent in comment.iterancestors()}
@@ -128,7 +132,10 @@ class _Reader:
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
         items = el.items()
-        return tuple([item for item in items if item[0] not in known]) if items else ()
+        for item in items:
+            if item[0] not in known:
+                return tuple([item for item in items if item[0] not in known])
+        return ()
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -168,13 +175,20 @@ class _Reader:
     def pose(self, el: etree._Element | None, where: str) -> Pose | None:
         if el is None:
             return None
-        keys = el.keys()
+        items = tuple(el.items())
+        pose = self.poses.get(items)
+        if pose is not None:
+            return pose
+        keys = [key for key, _ in items]
         has_xyz, has_rpy = "xyz" in keys, "rpy" in keys
         if len(keys) > has_xyz + has_rpy:
             self.warn_unknown_attrs(el, _POSE, where)
         xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
         rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
-        return Pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
+        pose = Pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
+        if len(keys) == has_xyz + has_rpy and (xyz or not has_xyz) and (rpy or not has_rpy):
+            self.poses[items] = pose
+        return pose
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")
@@ -531,16 +545,32 @@ class _Reader:
     def limit(self, el: etree._Element | None, where: str) -> Limit | None:
         if el is None:
             return None
-        return Limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
-                     effort=self.number(el, "effort", where),
-                     velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
+        items = tuple(el.items())
+        limit = self.limits.get(items)
+        if limit is not None:
+            return limit  # type: ignore[return-value]
+        errors = self.sink.error_count
+        limit = Limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
+                      effort=self.number(el, "effort", where),
+                      velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
+        if self.sink.error_count == errors:
+            self.limits[items] = limit
+        return limit
 
     def dynamics(self, el: etree._Element | None, where: str) -> Dynamics | None:
         if el is None:
             return None
-        return Dynamics(damping=self.number(el, "damping", where),
-                        friction=self.number(el, "friction", where),
-                        extra_attrs=self.extra_attrs(el, _DYNAMICS))
+        items = ("dynamics", *el.items())
+        dynamics = self.limits.get(items)
+        if dynamics is not None:
+            return dynamics  # type: ignore[return-value]
+        errors = self.sink.error_count
+        dynamics = Dynamics(damping=self.number(el, "damping", where),
+                            friction=self.number(el, "friction", where),
+                            extra_attrs=self.extra_attrs(el, _DYNAMICS))
+        if self.sink.error_count == errors:
+            self.limits[items] = dynamics
+        return dynamics
 
     def mimic(self, el: etree._Element | None, where: str) -> Mimic | None:
         if el is None:

@@ -93,9 +93,9 @@ class XmlSource:
         where = self._on_lines(el) if self._quick else None
         if where is None:
             where = self._scanned(el)
-        if where is None:
-            return Span(self.file, el.sourceline or 1, 1)
-        number, chunk, start = where
+            if where is None:
+                return Span(self.file, el.sourceline or 1, 1)
+        number, chunk, start, name = where
         if attr is not None:
             end = chunk.find(">", start)
             m = _attribute_pattern(attr).search(chunk, start, end + 1 if end >= 0 else len(chunk))
@@ -103,12 +103,13 @@ class XmlSource:
                 line, col = _position(chunk, number, m.start(2))
                 end_line, end_col = _position(chunk, number, m.end(2))
                 return Span(self.file, line, col, end_line, end_col)
-        return Span(self.file, number, start + 1, number, start + 2 + len(_localname(el)))  # "<" and the name
+        return Span(self.file, number, start + 1, number, start + 2 + name)  # "<" and the name
 
-    def _on_lines(self, el: etree._Element) -> tuple[int, str, int] | None:
+    def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int] | None:
         """Where `el`'s start tag begins, read from the line where it ends (lxml's sourceline)
         and the lines above: (the number of the line it begins on, the text from there to the
-        line where it ends, the index of its `<` in that text), or None when they do not tell.
+        line where it ends, the index of its `<` in that text, the length of its local name),
+        or None when they do not tell.
 
         Why the lines tell: a tag that begins on an earlier line leaves on its last line only
         the end of its attributes (which hold no `<`) and its `>`, before any `<`, and began
@@ -127,13 +128,13 @@ class XmlSource:
         elif ":" in tag:  # a QName libxml2 2.12 refuses and older ones keep whole: the scan decides
             return None
         else:
-            written = tag
+            local = written = tag
         needle = "<" + written
         start = line.find(needle)
         if start >= 0 and line.find(needle, start + 1) < 0:  # most tags: alone on one line
             end = start + len(needle)
             if (end == len(line) or line[end] in _DELIMITERS) and line.find(">", 0, line.find("<")) < 0:
-                return number, line, start
+                return number, line, start, len(local)
         here = _starts(line, needle)
         if len(here) == 1 and line.find(">", 0, line.find("<")) < 0:
             where = number, line, here[0]
@@ -152,7 +153,7 @@ class XmlSource:
                 where = first, chunk, start
             else:
                 return None
-        return where
+        return (*where, len(local))
 
     def _above(self, number: int) -> tuple[int, int] | None:
         """(line number, index) of the last `<` above line `number`, when one of the few lines
@@ -164,7 +165,7 @@ class XmlSource:
                 return k + 1, i
         return None
 
-    def _scanned(self, el: etree._Element) -> tuple[int, str, int] | None:
+    def _scanned(self, el: etree._Element) -> tuple[int, str, int, int] | None:
         """Where the scan found `el`'s start tag (as `_on_lines` says it), or None."""
         if self._offsets is None:
             self._scan()
@@ -174,7 +175,8 @@ class XmlSource:
         number = bisect.bisect_right(self._line_starts, offset)
         line_start = self._line_starts[number - 1]
         end = self.text.find(">", offset)
-        return number, self.text[line_start:end + 1 if end >= 0 else len(self.text)], offset - line_start
+        return (number, self.text[line_start:end + 1 if end >= 0 else len(self.text)], offset - line_start,
+                len(_localname(el)))
 
     def _scan(self) -> None:
         """The offset of every element's start tag, from one pass over the whole text."""

@@ -13,17 +13,30 @@ reads back exactly. Attributes the source did not write are not written.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from mpc.backends import xml_escape
 from mpc.backends.float_formats import Formats
-from mpc.backends.xml import fmt_float, fmt_floats
 from mpc.ir.fragments import Fragment
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Material, Pose, Robot, Visual
 from mpc.ir.tree import depth_first
 
 MeshNamer = Callable[[Mesh], str]
+
+
+def fmt_float(x: float) -> str:
+    """backends/xml.py's fmt_float before (frozen too)."""
+    if x == 0.0:
+        return "0"
+    if math.isfinite(x) and x.is_integer() and abs(x) < 1e16:
+        return str(int(x))
+    return repr(x)
+
+
+def fmt_floats(xs: tuple[float, ...] | list[float]) -> str:
+    return " ".join(fmt_float(x) for x in xs)
 IND = "  "
 
 
