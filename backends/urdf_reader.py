@@ -42,8 +42,7 @@ _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 _UNREAD = object()  # _Reader.numbers: a text not read yet
 _NAME, _NAME_TYPE, _POSE, _MESH = ("name",), ("name", "type"), ("xyz", "rpy"), ("filename", "scale")
 _LIMIT, _DYNAMICS = ("lower", "upper", "effort", "velocity"), ("damping", "friction")
-# The children of an inertial and a joint that are no fragments.
-_INERTIAL_CHILDREN = frozenset({"origin", "mass", "inertia"})
+# The children of a joint that are no fragments.
 _JOINT_CHILDREN = frozenset({"origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
                              "calibration", "safety_controller"})
 # Elements inside links and joints that become IR values (anything else is a fragment).
@@ -365,8 +364,21 @@ class _Reader:
         )
 
     def inertial(self, el: etree._Element, where: str) -> Inertial | None:
-        first, extras = self.sort_children(el, _INERTIAL_CHILDREN)
-        mass_el, inertia_el = first.get("mass"), first.get("inertia")
+        origin_el = mass_el = inertia_el = None
+        extras: list[Fragment] = []
+        for child in el:  # sort_children without a dict, for one of the commonest elements
+            tag = child.tag
+            if tag == "mass":
+                if mass_el is None:
+                    mass_el = child
+            elif tag == "inertia":
+                if inertia_el is None:
+                    inertia_el = child
+            elif tag == "origin":
+                if origin_el is None:
+                    origin_el = child
+            elif tag.__class__ is str:
+                extras.append(self.fragment(child))
         mass = self.number(mass_el, "value", where, True) if mass_el is not None else None
         if mass_el is None:
             self.error(el, "E0403", f"<inertial> in {where} has no <mass>")
@@ -374,12 +386,13 @@ class _Reader:
         if inertia_el is None:
             self.error(el, "E0403", f"<inertial> in {where} has no <inertia>")
         else:
-            values = [self.number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
+            number = self.number
+            values = [number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
         if mass is None or len(values) != 6 or None in values:
             return None
         ixx, ixy, ixz, iyy, iyz, izz = values
         return Inertial(mass=mass, inertia=Inertia(ixx=ixx, ixy=ixy, ixz=ixz, iyy=iyy, iyz=iyz, izz=izz),  # type: ignore[arg-type]
-                        origin=self.pose(first.get("origin"), where), extras=extras)
+                        origin=self.pose(origin_el, where), extras=tuple(extras) if extras else ())
 
     def geometry(self, el: etree._Element | None, parent: etree._Element,
                  where: str) -> Geometry | None:
