@@ -21,13 +21,16 @@ from mpc.ir.tree import depth_first
 
 MeshNamer = Callable[[Mesh], str]
 IND = "  "
-_INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-Pairs = list[tuple[str, str | None]] | Attrs
 
 
 class _Writer:
-    """The lines of one URDF text. A number's text needs no escaping, so elements of numbers
-    alone are written without `attrs` when no float formats apply (`numbers`): most lines."""
+    """The lines of one URDF text.
+
+    Each element is written as one f-string: a number's text needs no escaping and goes in
+    as it is (in the float format of its attribute, when float formats apply), a name is
+    escaped once for the whole text. The attributes a source wrote beyond URDF's go through
+    `attrs`, formatted as they always were (by their own names).
+    """
 
     def __init__(self, mesh_name: MeshNamer, formats: Formats | None = None) -> None:
         self.mesh_name, self.formats = mesh_name, formats
@@ -38,21 +41,31 @@ class _Writer:
         self.tuple_texts: dict[tuple[float, ...], str] = {}
         self.escaped: dict[str, str] = {}
 
-    def num(self, x: float | None) -> str | None:
-        if x is None:
-            return None
+    def text(self, x: float) -> str:
         text = self.texts.get(x)
         if text is None:
             text = self.texts[x] = fmt_float(x)
         return text
 
-    def nums(self, xs: tuple[float, ...]) -> str:
+    def nums(self, xs: tuple[float, ...], key: str) -> str:
+        """The text of the numbers `xs` of attribute `key`."""
         if type(xs) is not tuple:  # a list: not hashable
-            return fmt_floats(xs)
-        text = self.tuple_texts.get(xs)
+            text = fmt_floats(xs)
+        else:
+            text = self.tuple_texts.get(xs)  # type: ignore[assignment]
+            if text is None:
+                text = self.tuple_texts[xs] = " ".join(map(self.text, xs))
+        return text if self.formats is None else self.formats(key, text)  # type: ignore[return-value]
+
+    def number(self, key: str, x: float | None) -> str:
+        """` key="x"` (x in the float format of `key`, when float formats apply), or nothing
+        for None."""
+        if x is None:
+            return ""
+        text = self.texts.get(x)
         if text is None:
-            text = self.tuple_texts[xs] = fmt_floats(xs)
-        return text
+            text = self.texts[x] = fmt_float(x)
+        return f' {key}="{text}"' if self.formats is None else f' {key}="{self.formats(key, text)}"'
 
     def escape(self, value: str) -> str:
         safe = self.escaped.get(value)
@@ -60,41 +73,24 @@ class _Writer:
             safe = self.escaped[value] = xml_escape.attribute(value)
         return safe
 
-    def attrs(self, pairs: Pairs) -> str:
-        """` key="value"` for each pair whose value is not None, the value escaped."""
-        escaped = self.escaped
+    def attrs(self, pairs: list[tuple[str, str | None]] | Attrs, formatted: bool = False) -> str:
+        """` key="value"` for each pair whose value is not None, escaped; `formatted`: the values
+        in the float formats of their keys (a leaf's attributes, as URDF_KEYS name them)."""
+        if formatted and self.formats is not None:
+            pairs = [(k, self.formats(k, v)) for k, v in pairs]
         text = ""
         for key, value in pairs:
             if value is not None:
-                safe = escaped.get(value)
-                if safe is None:
-                    safe = escaped[value] = xml_escape.attribute(value)
-                text += f' {key}="{safe}"'
+                text += f' {key}="{self.escape(value)}"'
         return text
 
     def comments(self, ind: str, comments: tuple[str, ...]) -> None:
         for c in comments:
             self.out.append(f"{ind}<!--{c}-->")
 
-    def leaf(self, ind: str, tag: str, pairs: Pairs) -> None:
-        if self.formats is not None:  # float_fmt_dict (backends/float_formats.py)
-            pairs = [(k, self.formats(k, v)) for k, v in pairs]
-        self.out.append(f"{ind}<{tag}{self.attrs(pairs)}/>")
-
-    def numbers(self, ind: str, tag: str, keys: tuple[str, ...], values: tuple[float | None, ...],
-                extra: Attrs = ()) -> None:
-        """A leaf of the numbers `values` (None: not written) and then the attributes `extra`."""
-        if self.formats is not None or extra:
-            self.leaf(ind, tag, [*zip(keys, map(self.num, values), strict=True), *extra])
-            return
-        text = ""
-        for key, value in zip(keys, values, strict=True):
-            if value is not None:
-                text += f' {key}="{self.num(value)}"'
-        self.out.append(f"{ind}<{tag}{text}/>")
-
     def fragment(self, ind: str, frag: Fragment) -> None:
-        self.comments(ind, frag.comments)
+        if frag.comments:
+            self.comments(ind, frag.comments)
         xml = frag.xml
         if "\n\n" not in xml and xml[-1:] != "\n":  # every line indented: no empty one
             self.out.append(ind + xml.replace("\n", "\n" + ind))
@@ -103,39 +99,35 @@ class _Writer:
         self.out.append(ind + first)
         self.out.extend((ind + ln) if ln else ln for ln in rest)
 
-    def pose(self, ind: str, pose: Pose | None) -> None:
-        if pose is None:
-            return
+    def origin(self, ind: str, pose: Pose) -> str:
         xyz, rpy = pose.written
-        if self.formats is not None:
-            self.leaf(ind, "origin", [("xyz", self.nums(pose.xyz) if xyz else None),
-                                      ("rpy", self.nums(pose.rpy) if rpy else None)])
-            return
-        text = f' xyz="{self.nums(pose.xyz)}"' if xyz else ""
-        if rpy:
-            text += f' rpy="{self.nums(pose.rpy)}"'
-        self.out.append(f"{ind}<origin{text}/>")
+        xyz_text = f' xyz="{self.nums(pose.xyz, "xyz")}"' if xyz else ""
+        rpy_text = f' rpy="{self.nums(pose.rpy, "rpy")}"' if rpy else ""
+        return f"{ind}<origin{xyz_text}{rpy_text}/>"
 
-    def geometry(self, ind: str, geometry: Geometry, attrs: Attrs) -> None:
-        self.out.append(f"{ind}<geometry{self.attrs(attrs)}>" if attrs else f"{ind}<geometry>")
+    def geometry(self, ind: str, geometry: Geometry, attrs: Attrs) -> str:
+        """The <geometry> element's lines, as one text."""
         d = ind + IND
         match geometry:
             case Mesh():
-                scale = self.nums(geometry.scale) if geometry.scale is not None else None
-                if self.formats is None and not geometry.extra_attrs:
-                    scale = f' scale="{scale}"' if scale is not None else ""
-                    self.out.append(f'{d}<mesh filename="{self.escape(self.mesh_name(geometry))}"{scale}/>')
-                else:
-                    self.leaf(d, "mesh", [("filename", self.mesh_name(geometry)), ("scale", scale),
-                                          *geometry.extra_attrs])
+                scale = (f' scale="{self.nums(geometry.scale, "scale")}"'
+                         if geometry.scale is not None else "")
+                extra = self.attrs(geometry.extra_attrs, True) if geometry.extra_attrs else ""
+                name = self.escape(self.mesh_name(geometry))
+                shape = f'\n{d}<mesh filename="{name}"{scale}{extra}/>'
             case Box():
-                self.leaf(d, "box", [("size", self.nums(geometry.size)), *geometry.extra_attrs])
+                shape = (f'\n{d}<box size="{self.nums(geometry.size, "size")}"'
+                         f'{self.attrs(geometry.extra_attrs, True)}/>')
             case Cylinder():
-                self.numbers(d, "cylinder", ("radius", "length"), (geometry.radius, geometry.length),
-                             geometry.extra_attrs)
+                shape = (f'\n{d}<cylinder{self.number("radius", geometry.radius)}'
+                         f'{self.number("length", geometry.length)}'
+                         f'{self.attrs(geometry.extra_attrs, True)}/>')
             case Sphere():
-                self.numbers(d, "sphere", ("radius",), (geometry.radius,), geometry.extra_attrs)
-        self.out.append(f"{ind}</geometry>")
+                shape = (f'\n{d}<sphere{self.number("radius", geometry.radius)}'
+                         f'{self.attrs(geometry.extra_attrs, True)}/>')
+            case _:
+                shape = ""
+        return f"{ind}<geometry{self.attrs(attrs) if attrs else ''}>{shape}\n{ind}</geometry>"
 
     def material(self, ind: str, material: Material) -> None:
         self.comments(ind, material.comments)
@@ -145,38 +137,45 @@ class _Writer:
             return
         self.out.append(head + ">")
         if material.rgba is not None:
-            self.leaf(ind + IND, "color", [("rgba", self.nums(material.rgba))])
+            self.out.append(f'{ind}{IND}<color rgba="{self.nums(material.rgba, "rgba")}"/>')
         if material.texture is not None:
-            self.leaf(ind + IND, "texture", [("filename", material.texture or None)])
+            texture = self.attrs([("filename", material.texture or None)])
+            self.out.append(f"{ind}{IND}<texture{texture}/>")
         self.out.append(f"{ind}</material>")
 
     def inertial(self, ind: str, inertial: Inertial) -> None:
-        self.out.append(f"{ind}<inertial>")
         d = ind + IND
-        self.pose(d, inertial.origin)
-        self.numbers(d, "mass", ("value",), (inertial.mass,))
-        i = inertial.inertia
-        self.numbers(d, "inertia", _INERTIA, (i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz))
+        i, number = inertial.inertia, self.number
+        if inertial.origin is not None:
+            self.out.append(f"{ind}<inertial>\n{self.origin(d, inertial.origin)}")
+        else:
+            self.out.append(f"{ind}<inertial>")
+        self.out.append(
+            f'{d}<mass{number("value", inertial.mass)}/>\n'
+            f'{d}<inertia{number("ixx", i.ixx)}{number("ixy", i.ixy)}{number("ixz", i.ixz)}'
+            f'{number("iyy", i.iyy)}{number("iyz", i.iyz)}{number("izz", i.izz)}/>')
         for frag in inertial.extras:
             self.fragment(d, frag)
         self.out.append(f"{ind}</inertial>")
 
     def shape(self, ind: str, tag: str, item: Visual | Collision) -> None:
-        self.out.append(f"{ind}<{tag}{self.attrs([('name', item.name), *item.extra_attrs])}>")
         d = ind + IND
-        self.pose(d, item.origin)
-        self.geometry(d, item.geometry, item.geometry_attrs)
+        head = f"{ind}<{tag}{self.attrs([('name', item.name), *item.extra_attrs])}>"
+        if item.origin is not None:
+            head += "\n" + self.origin(d, item.origin)
+        self.out.append(f"{head}\n{self.geometry(d, item.geometry, item.geometry_attrs)}")
         if isinstance(item, Visual) and item.material is not None:
             if item.inline_material is not None:
                 self.material(d, item.inline_material)
-            else:  # names are never formatted
+            else:
                 self.out.append(f'{d}<material name="{self.escape(item.material)}"/>')
         for frag in item.extras:
             self.fragment(d, frag)
         self.out.append(f"{ind}</{tag}>")
 
     def link(self, ind: str, link: Link) -> None:
-        self.comments(ind, link.comments)
+        if link.comments:
+            self.comments(ind, link.comments)
         head = f"{ind}<link{self.attrs([('name', link.name), *link.extra_attrs])}"
         body = link.inertial or link.visuals or link.collisions or link.extras
         if not body and not link.inner_comments:
@@ -196,35 +195,35 @@ class _Writer:
         self.out.append(f"{ind}</link>")
 
     def joint(self, ind: str, joint: Joint) -> None:
-        self.comments(ind, joint.comments)
+        if joint.comments:
+            self.comments(ind, joint.comments)
         attrs = self.attrs([("name", joint.name), ("type", joint.type), *joint.extra_attrs])
         self.out.append(f"{ind}<joint{attrs}>")
-        d = ind + IND
+        d, number = ind + IND, self.number
         self.comments(d, joint.inner_comments)
-        self.pose(d, joint.origin)
-        self.out.append(f'{d}<parent link="{self.escape(joint.parent)}"/>')  # never formatted
-        self.out.append(f'{d}<child link="{self.escape(joint.child)}"/>')
+        lines = [f"{self.origin(d, joint.origin)}\n" if joint.origin is not None else "",
+                 f'{d}<parent link="{self.escape(joint.parent)}"/>\n',  # links are never formatted
+                 f'{d}<child link="{self.escape(joint.child)}"/>']
         if joint.axis is not None:
-            if self.formats is None:
-                self.out.append(f'{d}<axis xyz="{self.nums(joint.axis)}"/>')
-            else:
-                self.leaf(d, "axis", [("xyz", self.nums(joint.axis))])
+            lines.append(f'\n{d}<axis xyz="{self.nums(joint.axis, "xyz")}"/>')
         if (c := joint.calibration) is not None:
-            self.numbers(d, "calibration", ("rising", "falling", "reference_position"),
-                         (c.rising, c.falling, c.reference_position))
+            lines.append(f'\n{d}<calibration{number("rising", c.rising)}{number("falling", c.falling)}'
+                         f'{number("reference_position", c.reference_position)}/>')
         if (dyn := joint.dynamics) is not None:
-            self.numbers(d, "dynamics", ("damping", "friction"), (dyn.damping, dyn.friction),
-                         dyn.extra_attrs)
+            lines.append(f'\n{d}<dynamics{number("damping", dyn.damping)}'
+                         f'{number("friction", dyn.friction)}{self.attrs(dyn.extra_attrs, True)}/>')
         if (lim := joint.limit) is not None:
-            self.numbers(d, "limit", ("lower", "upper", "effort", "velocity"),
-                         (lim.lower, lim.upper, lim.effort, lim.velocity), lim.extra_attrs)
+            lines.append(f'\n{d}<limit{number("lower", lim.lower)}{number("upper", lim.upper)}'
+                         f'{number("effort", lim.effort)}{number("velocity", lim.velocity)}'
+                         f'{self.attrs(lim.extra_attrs, True)}/>')
         if (m := joint.mimic) is not None:
-            self.leaf(d, "mimic", [("joint", m.joint), ("multiplier", self.num(m.multiplier)),
-                                   ("offset", self.num(m.offset))])
+            lines.append(f'\n{d}<mimic{self.attrs([("joint", m.joint)])}'
+                         f'{number("multiplier", m.multiplier)}{number("offset", m.offset)}/>')
         if (s := joint.safety_controller) is not None:
-            self.numbers(d, "safety_controller",
-                         ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"),
-                         (s.soft_lower_limit, s.soft_upper_limit, s.k_position, s.k_velocity))
+            lines.append(f'\n{d}<safety_controller{number("soft_lower_limit", s.soft_lower_limit)}'
+                         f'{number("soft_upper_limit", s.soft_upper_limit)}'
+                         f'{number("k_position", s.k_position)}{number("k_velocity", s.k_velocity)}/>')
+        self.out.append("".join(lines))
         for frag in joint.extras:
             self.fragment(d, frag)
         self.out.append(f"{ind}</joint>")
