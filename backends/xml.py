@@ -78,14 +78,16 @@ class XmlSource:
         text = data.decode("utf-8", errors="replace")
         src = cls(file, text, root, text.split("\n"))
         # The scan matches every element to its own start tag, and `_on_lines` may look for it,
-        # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag),
-        # no name the scan does not see whole (`<:x`, which libxml2 2.12 refuses; odd letters),
-        # an encoding that writes each `<` of the markup as `<` (not UTF-7's `+ADw-`), and lines
-        # that libxml2 counts (past 65535 only with XML_PARSE_BIG_LINES).
-        encoding = (root.getroottree().docinfo.encoding or "").lower()
-        src._quick = ("<!DOCTYPE" not in text and "<:" not in text and len(src._lines) < 65535
-                      and encoding in _PLAIN_ENCODINGS
-                      and (text.isascii() or _ODD_START.search(text) is None))
+        # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag;
+        # elsewhere the scan skips it with the comment, CDATA or PI that holds it), no name the
+        # scan does not see whole (`<:x`, when libxml2 takes it; odd letters), an encoding that
+        # writes each `<` of the markup as `<` (not UTF-7's `+ADw-`), and lines that libxml2
+        # counts (past 65535 only with XML_PARSE_BIG_LINES).
+        info = root.getroottree().docinfo
+        src._quick = (not info.doctype and len(src._lines) < 65535
+                      and (info.encoding or "").lower() in _PLAIN_ENCODINGS
+                      and (text.isascii() or _ODD_START.search(text) is None)
+                      and (not _colon_names() or "<:" not in text))
         return src
 
     def span(self, el: etree._Element, attr: str | None = None) -> Span:
@@ -199,6 +201,17 @@ class XmlSource:
         for el, (offset, tag) in zip(elements, starts, strict=True):
             if tag.rsplit(":", 1)[-1] == _localname(el):
                 self._offsets[el] = offset
+
+
+@functools.cache
+def _colon_names() -> bool:
+    """Whether this libxml2 takes an element name that begins with `:` (2.12 refuses it, so
+    the text need not be searched for one)."""
+    try:
+        etree.fromstring(b"<a><:b/></a>", hardened_parser())
+    except etree.XMLSyntaxError:
+        return False
+    return True
 
 
 @functools.lru_cache(maxsize=256)
