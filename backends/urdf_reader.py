@@ -196,6 +196,14 @@ class _Reader:
             return None
         return name
 
+    def named(self, el: etree._Element, known: tuple[str, ...] = _NAME) -> tuple[str | None, Attrs]:
+        """The 'name' attribute of `el` and its attributes not `known`, from one look at them
+        (links, joints, visuals and collisions have a name and seldom anything else)."""
+        items = el.items()
+        if len(items) == 1 and items[0][0] == "name":
+            return items[0][1], ()
+        return el.get("name"), tuple([item for item in items if item[0] not in known])
+
     def children(self, el: etree._Element) -> list[etree._Element]:
         return [c for c in el if c.tag.__class__ is str]
 
@@ -216,11 +224,11 @@ class _Reader:
         return first, tuple(extras)
 
     def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
-        span = self.src.span(el)
+        span, tag = self.src.span(el), el.tag
         xml = etree.tostring(el, encoding="unicode", with_tail=False)
         if self.declared:
             # tostring re-declares every namespace in scope; <robot> declares them already.
-            cut = len(el.tag) + 1 if el.tag[0] != "{" else xml.find(" ")
+            cut = len(tag) + 1 if tag[0] != "{" else xml.find(" ")
             if xml.startswith(self.declared, cut) and xml.find(">", 0, cut) < 0:
                 xml = xml[:cut] + xml[cut + len(self.declared):]
             else:  # declared in another order, or among declarations of its own
@@ -231,7 +239,7 @@ class _Reader:
                 xml = head + xml[head_end:]
         if span.col > 1:  # its lines less the indentation of its first
             xml = xml.replace("\n" + " " * (span.col - 1), "\n")
-        return Fragment(tag=el.tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
+        return Fragment(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
 
     def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
         """Every attribute or text in the fragment that equals a link or joint name, in
@@ -239,13 +247,16 @@ class _Reader:
         out: list[FragmentRef] = []
         names = self.names
         for node in el.iter(etree.Element):
-            for attr, value in node.items():
-                if (name := value.strip()) in names:
-                    out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, node.tag + attr), name))
+            items = node.items()
+            if items:
+                for attr, value in items:
+                    if (name := value.strip()) in names:
+                        kind = self.kind_of(name, node.tag + attr)
+                        out.append(FragmentRef(_path(el, node), attr, kind, name))
             text = node.text
             if text and (name := text.strip()) and name in names:
                 out.append(FragmentRef(_path(el, node), None, self.kind_of(name, node.tag), name))
-        return tuple(out)
+        return tuple(out) if out else ()
 
     def kind_of(self, name: str, hint: str) -> RefKind:
         """Whether the known `name` is a link's or a joint's; `hint` (where it stands) decides
@@ -338,8 +349,9 @@ class _Reader:
         table[name] = item
 
     def link(self, el: etree._Element, comments: tuple[str, ...]) -> Link | None:
-        name = self.name(el, "link")
-        if name is None:
+        name, extra_attrs = self.named(el)
+        if not name:
+            self.error(el, "E0403", "<link> without a 'name' attribute")
             return None
         where = f"link '{name}'"
         inertial, visuals, collisions, extras = None, [], [], []
@@ -359,7 +371,7 @@ class _Reader:
                 extras.append(self.fragment(child))
         return Link(
             name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
-            extra_attrs=self.extra_attrs(el, _NAME), extras=tuple(extras),
+            extra_attrs=extra_attrs, extras=tuple(extras),
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )
 
@@ -399,14 +411,15 @@ class _Reader:
         if el is None:
             self.error(parent, "E0403", f"<{parent.tag}> in {where} has no <geometry>")
             return None
-        shapes = self.children(el)
-        if len(shapes) != 1:
-            self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, "
-                       f"found {len(shapes)}")
+        shape, count = None, 0
+        for child in el:
+            if child.tag.__class__ is str:
+                shape, count = shape if count else child, count + 1
+        if count != 1:
+            self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, found {count}")
             return None
-        shape = shapes[0]
-        if shape.tag == "mesh":
-            return self.mesh(shape, where)
+        if shape.tag == "mesh":  # type: ignore[union-attr]
+            return self.mesh(shape, where)  # type: ignore[arg-type]
         if shape.tag == "box":
             size = self.floats(shape, "size", 3, where, True)
             return Box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
@@ -477,10 +490,11 @@ class _Reader:
                 inline = self.material(material_el, (), where)
         if geometry is None:
             return None
+        name, extra_attrs = self.named(el)
         return Visual(
-            geometry=geometry, name=el.get("name"), origin=self.pose(origin_el, where),
+            geometry=geometry, name=name, origin=self.pose(origin_el, where),
             material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
-            extra_attrs=self.extra_attrs(el, _NAME), extras=extras, span=self.src.span(el),
+            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
         )
 
     def collision(self, el: etree._Element, where: str) -> Collision | None:
@@ -488,10 +502,11 @@ class _Reader:
         geometry = self.geometry(geometry_el, el, where)
         if geometry is None:
             return None
+        name, extra_attrs = self.named(el)
         return Collision(
-            geometry=geometry, name=el.get("name"), origin=self.pose(origin_el, where),
+            geometry=geometry, name=name, origin=self.pose(origin_el, where),
             geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
-            extra_attrs=self.extra_attrs(el, _NAME), extras=extras, span=self.src.span(el),
+            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
         )
 
     def material(self, el: etree._Element, comments: tuple[str, ...], where: str) -> Material | None:
