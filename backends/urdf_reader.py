@@ -577,11 +577,11 @@ class _Reader:
         limit = self.limits.get(items)
         if limit is not None:
             return limit  # type: ignore[return-value]
-        errors = self.sink.error_count
+        reported = len(self.sink.diagnostics)
         limit = Limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
                       effort=self.number(el, "effort", where),
                       velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
-        if self.sink.error_count == errors:
+        if len(self.sink.diagnostics) == reported:
             self.limits[items] = limit
         return limit
 
@@ -592,11 +592,11 @@ class _Reader:
         dynamics = self.limits.get(items)
         if dynamics is not None:
             return dynamics  # type: ignore[return-value]
-        errors = self.sink.error_count
+        reported = len(self.sink.diagnostics)
         dynamics = Dynamics(damping=self.number(el, "damping", where),
                             friction=self.number(el, "friction", where),
                             extra_attrs=self.extra_attrs(el, _DYNAMICS))
-        if self.sink.error_count == errors:
+        if len(self.sink.diagnostics) == reported:
             self.limits[items] = dynamics
         return dynamics
 

@@ -275,6 +275,11 @@ def parse_floats(text: str | None) -> tuple[float, ...] | None:
     """Whitespace-separated numbers, or None when any token is not a number."""
     if text is None or "_" in text:  # float() would accept "1_0"; URDF does not
         return None
+    if " " not in text:  # most often one number: float() strips the whitespace split() would
+        try:
+            return (float(text),)
+        except ValueError:
+            pass  # not one number; maybe several, between tabs or newlines
     try:
         return tuple(map(float, text.split()))
     except ValueError:

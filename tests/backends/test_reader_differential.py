@@ -16,10 +16,12 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from lxml import etree
 
 from mpc.backends import sdf, urdf_reader
-from mpc.backends.xml import XmlError, XmlSource
+from mpc.backends.xml import XmlError, XmlSource, parse_floats
 from mpc.core.diagnostics import Diagnostic, Sink
 from mpc.core.packages import PackageResolver
 from tests.backends import refusal_before, urdf_reader_before, xml_source_before
@@ -155,6 +157,20 @@ def test_hostile_inputs_read_the_same(name: str, tmp_path: Path) -> None:
     for variant in (data, data.replace(b"m.stl", b"link.stl")):
         assert compare_urdf(variant, name, tmp_path) is None
         assert compare_spans(variant, name) is None
+
+
+_WORDS = ["0", "1", "-2.5", "1e3", ".5", "inf", "nan", "1_0", "x", "0x1", "", "١"]
+_NUMBER_TEXT = st.lists(st.sampled_from(_WORDS) | st.floats().map(repr), max_size=4).flatmap(
+    lambda words: st.lists(st.sampled_from([" ", "  ", "\t", "\n", "\u00a0", "\u2028", ""]),
+                           min_size=len(words) + 1, max_size=len(words) + 1).map(
+        lambda spaces: "".join(a + b for a, b in zip(spaces, [*words, ""], strict=True))))
+
+
+@given(_NUMBER_TEXT | st.text(max_size=12))
+def test_numbers_are_read_the_same(text: str) -> None:
+    """parse_floats's shortcut for one number (float() alone) against split() and float()."""
+    assert parse_floats(text) == xml_source_before.parse_floats(text) or (
+        repr(parse_floats(text)) == repr(xml_source_before.parse_floats(text)))  # nan != nan
 
 
 def _outcome(refuse: Callable[..., str | None], *args: object) -> str | None:
