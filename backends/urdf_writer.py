@@ -130,7 +130,8 @@ class _Writer:
         return f"{ind}<geometry{self.attrs(attrs) if attrs else ''}>{shape}\n{ind}</geometry>"
 
     def material(self, ind: str, material: Material) -> None:
-        self.comments(ind, material.comments)
+        if material.comments:
+            self.comments(ind, material.comments)
         head = f"{ind}<material{self.attrs([('name', material.name)])}"
         if material.rgba is None and material.texture is None:
             self.out.append(head + "/>")
@@ -183,7 +184,8 @@ class _Writer:
             return
         self.out.append(head + ">")
         d = ind + IND
-        self.comments(d, link.inner_comments)
+        if link.inner_comments:
+            self.comments(d, link.inner_comments)
         if link.inertial is not None:
             self.inertial(d, link.inertial)
         for visual in link.visuals:
@@ -200,7 +202,8 @@ class _Writer:
         attrs = self.attrs([("name", joint.name), ("type", joint.type), *joint.extra_attrs])
         self.out.append(f"{ind}<joint{attrs}>")
         d, number = ind + IND, self.number
-        self.comments(d, joint.inner_comments)
+        if joint.inner_comments:
+            self.comments(d, joint.inner_comments)
         lines = [f"{self.origin(d, joint.origin)}\n" if joint.origin is not None else "",
                  f'{d}<parent link="{self.escape(joint.parent)}"/>\n',  # links are never formatted
                  f'{d}<child link="{self.escape(joint.child)}"/>']
