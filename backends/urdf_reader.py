@@ -8,13 +8,16 @@ they mention. Comments are kept. Mesh files are resolved to paths, never opened.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
+from types import SimpleNamespace
 
 from lxml import etree
 
 from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
+from mpc.core.record import maker
 from mpc.core.span import Span
 from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, MeshSource, Sphere, mesh_source
@@ -51,6 +54,20 @@ _MODELLED = frozenset({
     "box", "cylinder", "sphere", "mesh", "color", "texture", "parent", "child", "axis", "limit",
     "dynamics", "mimic", "calibration", "safety_controller",
 })
+
+
+@functools.cache
+def _makers() -> SimpleNamespace:
+    """A maker of each IR record a read makes (core/record.py: maker, a quarter of the class
+    call's time; a URDF read makes 1,600 of them), written at the first read rather than at
+    import: `mpc check` imports this module on every save."""
+    return SimpleNamespace(
+        pose=maker(Pose), fragment=maker(Fragment), ref=maker(FragmentRef), robot=maker(Robot),
+        link=maker(Link), inertial=maker(Inertial), inertia=maker(Inertia), box=maker(Box),
+        cylinder=maker(Cylinder), sphere=maker(Sphere), mesh=maker(Mesh), visual=maker(Visual),
+        collision=maker(Collision), material=maker(Material), joint=maker(Joint), limit=maker(Limit),
+        dynamics=maker(Dynamics), mimic=maker(Mimic), calibration=maker(Calibration),
+        safety=maker(SafetyController))
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
@@ -96,6 +113,7 @@ class _Reader:
     def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
                  base_dir: Path) -> None:
         self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
+        self.new = _makers()
         self.link_names: set[str] = set()
         self.joint_names: set[str] = set()
         self.names: set[str] = set()  # both
@@ -184,7 +202,7 @@ class _Reader:
             self.warn_unknown_attrs(el, _POSE, where)
         xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
         rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
-        pose = Pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
+        pose = self.new.pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
         if len(keys) == has_xyz + has_rpy and (xyz or not has_xyz) and (rpy or not has_rpy):
             self.poses[items] = pose
         return pose
@@ -239,7 +257,7 @@ class _Reader:
                 xml = head + xml[head_end:]
         if span.col > 1:  # its lines less the indentation of its first
             xml = xml.replace("\n" + " " * (span.col - 1), "\n")
-        return Fragment(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
+        return self.new.fragment(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
 
     def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
         """Every attribute or text in the fragment that equals a link or joint name, in
@@ -252,10 +270,10 @@ class _Reader:
                 for attr, value in items:
                     if (name := value.strip()) in names:
                         kind = self.kind_of(name, node.tag + attr)
-                        out.append(FragmentRef(_path(el, node), attr, kind, name))
+                        out.append(self.new.ref(_path(el, node), attr, kind, name))
             text = node.text
             if text and (name := text.strip()) and name in names:
-                out.append(FragmentRef(_path(el, node), None, self.kind_of(name, node.tag), name))
+                out.append(self.new.ref(_path(el, node), None, self.kind_of(name, node.tag), name))
         return tuple(out) if out else ()
 
     def kind_of(self, name: str, hint: str) -> RefKind:
@@ -331,7 +349,7 @@ class _Reader:
         root_link = check_tree(links, joints, self.sink, robot_span, name)
         if root_link is None or not name:
             return None
-        return Robot(
+        return self.new.robot(
             name=name, root=root_link, links=links, joints=joints, materials=materials,
             fragments=tuple(fragments), extra_attrs=extra, header_comments=tuple(reversed(header)),
             trailing_comments=tuple(pending), span=robot_span,
@@ -369,7 +387,7 @@ class _Reader:
                 inertial = self.inertial(child, where)
             elif tag.__class__ is str:
                 extras.append(self.fragment(child))
-        return Link(
+        return self.new.link(
             name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
             extra_attrs=extra_attrs, extras=tuple(extras),
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
@@ -403,8 +421,9 @@ class _Reader:
         if mass is None or len(values) != 6 or None in values:
             return None
         ixx, ixy, ixz, iyy, iyz, izz = values
-        return Inertial(mass=mass, inertia=Inertia(ixx=ixx, ixy=ixy, ixz=ixz, iyy=iyy, iyz=iyz, izz=izz),  # type: ignore[arg-type]
-                        origin=self.pose(origin_el, where), extras=tuple(extras) if extras else ())
+        inertia = self.new.inertia(ixx=ixx, ixy=ixy, ixz=ixz, iyy=iyy, iyz=iyz, izz=izz)
+        return self.new.inertial(mass=mass, inertia=inertia, origin=self.pose(origin_el, where),
+                                 extras=tuple(extras) if extras else ())
 
     def geometry(self, el: etree._Element | None, parent: etree._Element,
                  where: str) -> Geometry | None:
@@ -422,18 +441,18 @@ class _Reader:
             return self.mesh(shape, where)  # type: ignore[arg-type]
         if shape.tag == "box":
             size = self.floats(shape, "size", 3, where, True)
-            return Box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
+            return self.new.box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
         if shape.tag == "cylinder":
             r, h = self.number(shape, "radius", where, True), self.number(shape, "length", where, True)
             if r is None or h is None:
                 return None
-            return Cylinder(radius=r, length=h,
+            return self.new.cylinder(radius=r, length=h,
                             extra_attrs=self.extra_attrs(shape, ("radius", "length")))
         if shape.tag == "sphere":
             r = self.number(shape, "radius", where, True)
             if r is None:
                 return None
-            return Sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
+            return self.new.sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
         self.error(shape, "E0405", f"unsupported geometry <{shape.tag}> in {where}; URDF has "
                    "box, cylinder, sphere and mesh")
         return None
@@ -453,7 +472,7 @@ class _Reader:
         if why:
             self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
             return None
-        return Mesh(source=source, scale=scale, span=self.src.span(el, "filename"),  # type: ignore[arg-type]
+        return self.new.mesh(source=source, scale=scale, span=self.src.span(el, "filename"),  # type: ignore[arg-type]
                     extra_attrs=self.extra_attrs(el, _MESH))
 
     def shape_children(self, el: etree._Element, visual: bool) -> tuple[
@@ -491,7 +510,7 @@ class _Reader:
         if geometry is None:
             return None
         name, extra_attrs = self.named(el)
-        return Visual(
+        return self.new.visual(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
             material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
@@ -503,7 +522,7 @@ class _Reader:
         if geometry is None:
             return None
         name, extra_attrs = self.named(el)
-        return Collision(
+        return self.new.collision(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
             geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
@@ -521,7 +540,7 @@ class _Reader:
             elif child.tag == "texture" and texture is None:
                 texture = child
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
-        return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
+        return self.new.material(name=name, rgba=rgba,  # type: ignore[arg-type]
                         texture=texture.get("filename", "") if texture is not None else None,
                         comments=comments, span=self.src.span(el))
 
@@ -559,7 +578,7 @@ class _Reader:
             return None
         if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
             jtype = "fixed"
-        return Joint(
+        return self.new.joint(
             name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
             origin=self.pose(first.get("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
             dynamics=self.dynamics(first.get("dynamics"), where),
@@ -578,7 +597,7 @@ class _Reader:
         if limit is not None:
             return limit  # type: ignore[return-value]
         reported = len(self.sink.diagnostics)
-        limit = Limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
+        limit = self.new.limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
                       effort=self.number(el, "effort", where),
                       velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
         if len(self.sink.diagnostics) == reported:
@@ -593,7 +612,7 @@ class _Reader:
         if dynamics is not None:
             return dynamics  # type: ignore[return-value]
         reported = len(self.sink.diagnostics)
-        dynamics = Dynamics(damping=self.number(el, "damping", where),
+        dynamics = self.new.dynamics(damping=self.number(el, "damping", where),
                             friction=self.number(el, "friction", where),
                             extra_attrs=self.extra_attrs(el, _DYNAMICS))
         if len(self.sink.diagnostics) == reported:
@@ -613,7 +632,7 @@ class _Reader:
             self.sink.warning(self.src.span(el, "joint"), "W0411",
                               f"<mimic> in {where} refers to unknown joint '{target}'"
                               f"{did_you_mean(target, self.joint_names)}; it has no effect")
-        return Mimic(joint=target, multiplier=self.number(el, "multiplier", where),
+        return self.new.mimic(joint=target, multiplier=self.number(el, "multiplier", where),
                      offset=self.number(el, "offset", where))
 
     def calibration(self, el: etree._Element | None, where: str) -> Calibration | None:
@@ -621,7 +640,7 @@ class _Reader:
             return None
         keys = ("rising", "falling", "reference_position")
         self.warn_unknown_attrs(el, keys, where)
-        return Calibration(**{k: self.number(el, k, where) for k in keys})
+        return self.new.calibration(**{k: self.number(el, k, where) for k in keys})
 
     def safety(self, el: etree._Element | None, where: str) -> SafetyController | None:
         if el is None:
@@ -631,5 +650,5 @@ class _Reader:
         k_velocity = self.number(el, "k_velocity", where, True)
         if k_velocity is None:
             return None
-        return SafetyController(k_velocity=k_velocity,
+        return self.new.safety(k_velocity=k_velocity,
                                 **{k: self.number(el, k, where) for k in keys[1:]})

@@ -10,7 +10,8 @@ order, the class's qualified name, equal only to the same class, tuple hash), so
 
 A record with slots gets, when it is first made, an `__init__` that sets each slot through
 the slot's own setter (`_fast_init`): dataclass's frozen one goes through object.__setattr__
-for every field, which takes twice as long, and a reader makes thousands of records.
+for every field, which takes twice as long. Code that makes thousands of records (a reader)
+asks for a `maker`, which skips the class call too: a quarter of its time.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from operator import attrgetter
 from typing import Any, TypeVar, dataclass_transform, overload
 
 T = TypeVar("T", bound=type)
+R = TypeVar("R")
 
 _VALUES: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
 
@@ -106,6 +108,64 @@ def _first_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
 
     __init__.__qualname__, __init__.__wrapped__ = slow.__qualname__, slow  # type: ignore[attr-defined]
     return __init__
+
+
+_MAKERS: dict[type, Callable[..., Any]] = {}
+
+
+def maker(cls: type[R]) -> Callable[..., R]:
+    """A function that makes a `cls` as `cls(...)` would (the same parameters, defaults,
+    default_factory and __post_init__), in a quarter of the time, for code that makes many
+    (the readers): it fills an unfrozen twin of `cls` (the same slots, so each assignment is
+    the interpreter's direct slot store) and then makes it a `cls`; no class call, whose
+    keyword arguments go through a dict. `cls` itself for a record it does not cover (no
+    slots, a base class, InitVar or init=False fields, an __init__ of its own)."""
+    make = _MAKERS.get(cls)
+    if make is None:
+        make = _MAKERS[cls] = _maker(cls)
+    return make
+
+
+def _maker(cls: Any) -> Callable[..., Any]:
+    init = cls.__init__
+    slow = getattr(init, "__wrapped__", None)  # dataclass's, behind _first_init or _fast_init
+    own = fields(cls)
+    if (slow is None or cls.__bases__ != (object,)
+            or getattr(cls, "__slots__", None) != tuple(f.name for f in own)):
+        return cls  # type: ignore[no-any-return]
+    code = slow.__code__
+    params = code.co_varnames[1:code.co_argcount + code.co_kwonlyargcount]
+    if sorted(params) != sorted(f.name for f in own) or not all(f.init for f in own):
+        return cls  # type: ignore[no-any-return]
+    positional, keyword = params[:code.co_argcount - 1], params[code.co_argcount - 1:]
+    defaults = dict(zip(positional[len(positional) - len(slow.__defaults__ or ()):],
+                        slow.__defaults__ or (), strict=True))
+    defaults.update(slow.__kwdefaults__ or {})
+    env: dict[str, Any] = {"_cls": cls, "_twin": type(cls.__name__, (), {"__slots__": cls.__slots__})}
+
+    def param(name: str) -> str:
+        if name not in defaults:
+            return name
+        env[f"_d_{name}"] = defaults[name]
+        return f"{name}=_d_{name}"
+
+    stars = ["*", *map(param, keyword)] if keyword else []
+    lines = [f"def make({', '.join([*map(param, positional), *stars])}):\n", "    self = _twin()\n"]
+    for f in own:
+        value = f.name
+        if f.default_factory is not MISSING:  # its parameter's default is dataclass's sentinel
+            env[f"_f_{f.name}"] = f.default_factory
+            value = f"_f_{f.name}() if {f.name} is _d_{f.name} else {f.name}"
+        lines.append(f"    self.{f.name} = {value}\n")
+    lines.append("    self.__class__ = _cls\n")
+    if hasattr(cls, "__post_init__"):
+        lines.append("    self.__post_init__()\n")
+    lines.append("    return self\n")
+    namespace: dict[str, Any] = {}
+    exec(compile("".join(lines), "<record>", "exec"), env, namespace)
+    make = namespace["make"]
+    make.__qualname__ = f"{cls.__qualname__}.make"
+    return make  # type: ignore[no-any-return]
 
 
 @overload

@@ -7,7 +7,7 @@ import inspect
 
 import pytest
 
-from mpc.core.record import record
+from mpc.core.record import maker, record
 from mpc.core.span import Span
 from mpc.ir.geometry import Box
 
@@ -103,3 +103,24 @@ def test_slots_records_are_made_as_dataclass_would() -> None:
     assert WithInitVar.__init__.__code__.co_filename == "<string>"  # dataclass's
     assert str(inspect.signature(Mixed)) == \
         "(a: 'int', b: 'str' = 'b', c: 'list[int]' = <factory>, *, d: 'tuple[int, ...]' = ()) -> None"
+
+
+def test_makers_make_what_the_class_makes() -> None:
+    """record.maker: the same record as the class call (defaults, a fresh default_factory
+    value, keyword-only fields, __post_init__ and its errors), frozen as any; the class itself
+    where it does not apply (a base class, InitVar, an __init__ of its own, no slots)."""
+    make = maker(Mixed)
+    assert make is maker(Mixed) and make is not Mixed
+    assert make(1) == Mixed(1) and type(make(1)) is Mixed
+    assert make(1, "x", [2], d=(3,)) == Mixed(1, "x", [2], d=(3,))
+    assert make(1).c == [] and make(1).c is not make(1).c
+    assert maker(Pair)(a=1) == Pair(a=1) and maker(Pair)(a=2, b=("z",)) == Pair(a=2, b=("z",))
+    with pytest.raises(ValueError, match="negative"):
+        make(-1)
+    with pytest.raises(TypeError):
+        maker(Pair)(1)  # type: ignore[misc]  (keyword-only, as Pair(1) is)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        make(1).a = 2  # type: ignore[misc]
+    assert hash(maker(Pair)(a=1)) == hash(Pair(a=1))
+    assert maker(Child) is Child and maker(WithInitVar) is WithInitVar
+    assert maker(Span) is Span and maker(One) is One
