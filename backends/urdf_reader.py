@@ -101,6 +101,8 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
 
 def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:
     """The child indices (comments counted) from `root` down to its descendant `node`."""
+    if node is root:  # most names stand in a fragment's own attributes
+        return ()
     path: list[int] = []
     while node is not root:
         parent = node.getparent()
