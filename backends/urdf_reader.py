@@ -224,9 +224,6 @@ class _Reader:
             return items[0][1], ()
         return el.get("name"), tuple([item for item in items if item[0] not in known])
 
-    def children(self, el: etree._Element) -> list[etree._Element]:
-        return [c for c in el if c.tag.__class__ is str]
-
     def sort_children(self, el: etree._Element, known: frozenset[str]
                       ) -> tuple[dict[str, etree._Element], tuple[Fragment, ...]]:
         """The first element child of each tag (what `el.find(tag)` gives for a plain tag), and
@@ -309,9 +306,11 @@ class _Reader:
         name = root.get("name") or ""
         if not name:
             self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
-        elements = self.children(root)
-        self.link_names = {e.get("name", "") for e in elements if e.tag == "link"}
-        self.joint_names = {e.get("name", "") for e in elements if e.tag == "joint"}
+        for el in root:  # every name first: fragments and mimics refer to them
+            if el.tag == "link":
+                self.link_names.add(el.get("name", ""))
+            elif el.tag == "joint":
+                self.joint_names.add(el.get("name", ""))
         self.names = self.link_names | self.joint_names
 
         links: dict[str, Link] = {}
