@@ -130,7 +130,12 @@ class _Reader:
         self.commented = {parent for comment in src.root.iter(etree.Comment)
                           for parent in comment.iterancestors()}
         # What tostring adds to a fragment's start tag for the namespaces <robot> declares,
-        # each and (as it writes them, right after the tag's name) all together.
+        # each and (as it writes them, right after the tag's name) all together. When only
+        # <robot> declares any, those no element uses are dropped from the tree first: tostring
+        # would copy each into every fragment (all four of TALOS's), to be cut out again.
+        self.nsmap = src.root.nsmap
+        if self.nsmap and src.text.count("xmlns") == len(self.nsmap):
+            etree.cleanup_namespaces(src.root)
         self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
                                        for prefix, uri in src.root.nsmap.items()]
         self.declared = "".join(self.namespace_declarations)
@@ -342,7 +347,7 @@ class _Reader:
             prev = prev.getprevious()
         extra = self.extra_attrs(root, ("name",)) + tuple(
             (f"xmlns:{p}" if p else "xmlns", uri) for p, uri in sorted(
-                root.nsmap.items(), key=lambda kv: kv[0] or ""))
+                self.nsmap.items(), key=lambda kv: kv[0] or ""))
         if not links:
             self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
             return None

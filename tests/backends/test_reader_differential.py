@@ -54,6 +54,9 @@ HOSTILE = {
     "cr.urdf": b'<robot name="r">\r  <link name="a"/>\r  <link name="a"/>\r</robot>',
     "namespaces.urdf": b'<robot name="r" xmlns="urn:d" xmlns:x="urn:x">\n <link name="a" x:b="1"/>\n'
                        b' <x:gazebo reference="a"><x:mu>1</x:mu></x:gazebo>\n</robot>',
+    "unused_ns.urdf": b'<robot name="r" xmlns:u="urn:u" xmlns:x="urn:x">\n <link name="a" xmlns:v="urn:v">\n'
+                      b'  <gazebo><mu1>1</mu1></gazebo>\n  <x:y xmlns:w="urn:w"/>\n </link>\n'
+                      b' <gazebo reference="a" xmlns:w="urn:w"><x:z/></gazebo>\n</robot>',
     "undeclared.urdf": b'<robot name="r">\n <link name="a"><visual><geometry><u:mesh filename="m.stl"/>'
                        b'</geometry></visual></link>\n <u:gazebo reference="a"/>\n</robot>',
     "one_line.urdf": b'<robot name="r"><link name="a"><visual><geometry><box size="1 1"/></geometry>'

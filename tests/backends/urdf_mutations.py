@@ -192,8 +192,11 @@ def _prolog(rng: random.Random, data: bytes) -> bytes:
 
 
 def _namespaces(rng: random.Random, data: bytes) -> bytes:
-    """Namespace declarations on <robot> or below, prefixed tags and attributes."""
-    choice = rng.randrange(4)
+    """Namespace declarations on <robot> or below (used or not), prefixed tags and attributes."""
+    choice = rng.randrange(5)
+    if choice == 4:
+        return re.sub(rb"<(robot|link|joint|gazebo|transmission|plugin) ", lambda m: m.group(0) + (
+            b'xmlns:unused="urn:unused" ' if rng.random() < 0.3 else b""), data)
     if choice == 0:
         return data.replace(b"<robot ", b'<robot xmlns:xacro="http://ros.org/wiki/xacro" ', 1).replace(
             b"<gazebo", b"<xacro:gazebo", 1).replace(b"</gazebo>", b"</xacro:gazebo>", 1)
