@@ -12,12 +12,14 @@ import functools
 import itertools
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from lxml import etree
 
 from mpc.core.diagnostics import Sink
+from mpc.core.record import maker
 from mpc.core.span import Span, hardened_parser
 
 # Comments, CDATA, processing instructions, doctype and start tags (`<` and the name), in
@@ -59,6 +61,8 @@ class XmlSource:
     _quick: bool = False  # whether `_on_line` may be asked (see `parse`)
     _offsets: dict[etree._Element, int] | None = None  # the scan: start tag offsets, once made
     _line_starts: list[int] = field(default_factory=list)
+    # Span's maker (core/record.py): a file's spans are made here, one for nearly every element.
+    _new_span: Callable[..., Span] = Span
 
     @classmethod
     def parse(cls, data: bytes, file: str) -> XmlSource:
@@ -76,7 +80,7 @@ class XmlSource:
             raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
                            "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
-        src = cls(file, text, root, text.split("\n"))
+        src = cls(file, text, root, text.split("\n"), _new_span=maker(Span))
         # The scan matches every element to its own start tag, and `_on_lines` may look for it,
         # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag;
         # elsewhere the scan skips it with the comment, CDATA or PI that holds it), no name the
@@ -96,7 +100,7 @@ class XmlSource:
         if where is None:
             where = self._scanned(el)
             if where is None:
-                return Span(self.file, el.sourceline or 1, 1)
+                return self._new_span(self.file, el.sourceline or 1, 1)
         number, chunk, start, name = where
         if attr is not None:
             end = chunk.find(">", start)
@@ -104,8 +108,8 @@ class XmlSource:
             if m:
                 line, col = _position(chunk, number, m.start(m.lastindex))  # type: ignore[arg-type]
                 end_line, end_col = _position(chunk, number, m.end(m.lastindex))  # type: ignore[arg-type]
-                return Span(self.file, line, col, end_line, end_col)
-        return Span(self.file, number, start + 1, number, start + 2 + name)  # "<" and the name
+                return self._new_span(self.file, line, col, end_line, end_col)
+        return self._new_span(self.file, number, start + 1, number, start + 2 + name)  # "<" and the name
 
     def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int] | None:
         """Where `el`'s start tag begins, read from the line where it ends (lxml's sourceline)

@@ -26,18 +26,10 @@ class Span:
     end_line: int = 0
     end_col: int = 0
 
-    def __init__(self, file: str, line: int = 1, col: int = 1, end_line: int = 0,
-                 end_col: int = 0) -> None:
-        # Written here, not by dataclass (whose frozen __init__ sets each field through
-        # object.__setattr__ and then calls __post_init__): the readers make a span for nearly
-        # every element of a file, and the slots' own setters take half the time.
-        if end_line < line or (end_line == line and end_col < col):
-            end_line, end_col = line, col
-        _set_file(self, file)
-        _set_line(self, line)
-        _set_col(self, col)
-        _set_end_line(self, end_line)
-        _set_end_col(self, end_col)
+    def __post_init__(self) -> None:
+        if self.end_line < self.line or (self.end_line == self.line and self.end_col < self.col):
+            object.__setattr__(self, "end_line", self.line)
+            object.__setattr__(self, "end_col", self.col)
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.col}"
@@ -46,10 +38,6 @@ class Span:
     def of_file(cls, file: str) -> Span:
         """The span of a whole file, for errors that concern the file itself."""
         return cls(file, 1, 1)
-
-
-_set_file, _set_line, _set_col, _set_end_line, _set_end_col = (
-    getattr(Span, name).__set__ for name in ("file", "line", "col", "end_line", "end_col"))
 
 
 def hardened_parser(huge: bool = False) -> Any:
