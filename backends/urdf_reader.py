@@ -14,12 +14,13 @@ from types import SimpleNamespace
 
 from lxml import etree
 
+from mpc.backends.urdf_fragments import Fragments
 from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
 from mpc.core.record import maker
 from mpc.core.span import Span
-from mpc.ir.fragments import Fragment, FragmentRef, RefKind
+from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, MeshSource, Sphere, mesh_source
 from mpc.ir.robot import (
     JOINT_TYPES,
@@ -99,26 +100,11 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
     return robot
 
 
-def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:
-    """The child indices (comments counted) from `root` down to its descendant `node`."""
-    if node is root:  # most names stand in a fragment's own attributes
-        return ()
-    path: list[int] = []
-    while node is not root:
-        parent = node.getparent()
-        path.append(parent.index(node))
-        node = parent
-    return tuple(reversed(path))
-
-
 class _Reader:
     def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
                  base_dir: Path) -> None:
         self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
         self.new = _makers()
-        self.link_names: set[str] = set()
-        self.joint_names: set[str] = set()
-        self.names: set[str] = set()  # both
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
         # The numbers of each attribute text read so far (parse_floats), and the values of
         # <origin>, <limit> and <dynamics> by their attributes: a URDF repeats many. A value
@@ -129,16 +115,9 @@ class _Reader:
         # The elements that hold a comment somewhere inside (most hold none).
         self.commented = {parent for comment in src.root.iter(etree.Comment)
                           for parent in comment.iterancestors()}
-        # What tostring adds to a fragment's start tag for the namespaces <robot> declares,
-        # each and (as it writes them, right after the tag's name) all together. When only
-        # <robot> declares any, those no element uses are dropped from the tree first: tostring
-        # would copy each into every fragment (all four of TALOS's), to be cut out again.
-        self.nsmap = src.root.nsmap
-        if self.nsmap and src.text.count("xmlns") == len(self.nsmap):
-            etree.cleanup_namespaces(src.root)
-        self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
-                                       for prefix, uri in src.root.nsmap.items()]
-        self.declared = "".join(self.namespace_declarations)
+        self.fragments = Fragments(src, self.new.fragment, self.new.ref)
+        self.fragment = self.fragments.fragment
+        self.joint_names = self.fragments.joint_names  # filled by robot(), first
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -245,49 +224,6 @@ class _Reader:
                     extras.append(self.fragment(child))
         return first, tuple(extras)
 
-    def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
-        span, tag = self.src.span(el), el.tag
-        xml = etree.tostring(el, encoding="unicode", with_tail=False)
-        if self.declared:
-            # tostring re-declares every namespace in scope; <robot> declares them already.
-            cut = len(tag) + 1 if tag[0] != "{" else xml.find(" ")
-            if xml.startswith(self.declared, cut) and xml.find(">", 0, cut) < 0:
-                xml = xml[:cut] + xml[cut + len(self.declared):]
-            else:  # declared in another order, or among declarations of its own
-                head_end = xml.find(">")
-                head = xml[:head_end]
-                for declaration in self.namespace_declarations:
-                    head = head.replace(declaration, "", 1)
-                xml = head + xml[head_end:]
-        if span.col > 1:  # its lines less the indentation of its first
-            xml = xml.replace("\n" + " " * (span.col - 1), "\n")
-        return self.new.fragment(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
-
-    def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
-        """Every attribute or text in the fragment that equals a link or joint name, in
-        document order (each element's attributes, then its text)."""
-        out: list[FragmentRef] = []
-        names = self.names
-        for node in el.iter(etree.Element):
-            items = node.items()
-            if items:
-                for attr, value in items:
-                    if (name := value.strip()) in names:
-                        kind = self.kind_of(name, node.tag + attr)
-                        out.append(self.new.ref(_path(el, node), attr, kind, name))
-            text = node.text
-            if text and (name := text.strip()) and name in names:
-                out.append(self.new.ref(_path(el, node), None, self.kind_of(name, node.tag), name))
-        return tuple(out) if out else ()
-
-    def kind_of(self, name: str, hint: str) -> RefKind:
-        """Whether the known `name` is a link's or a joint's; `hint` (where it stands) decides
-        for a name that is both."""
-        is_link, is_joint = name in self.link_names, name in self.joint_names
-        if is_link and is_joint:
-            return "joint" if "joint" in hint.lower() else "link"
-        return "link" if is_link else "joint"
-
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
         """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
         if el not in self.commented:
@@ -311,12 +247,13 @@ class _Reader:
         name = root.get("name") or ""
         if not name:
             self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
+        names = self.fragments
         for el in root:  # every name first: fragments and mimics refer to them
             if el.tag == "link":
-                self.link_names.add(el.get("name", ""))
+                names.link_names.add(el.get("name", ""))
             elif el.tag == "joint":
-                self.joint_names.add(el.get("name", ""))
-        self.names = self.link_names | self.joint_names
+                names.joint_names.add(el.get("name", ""))
+        names.names = names.link_names | names.joint_names
 
         links: dict[str, Link] = {}
         joints: dict[str, Joint] = {}
@@ -347,7 +284,7 @@ class _Reader:
             prev = prev.getprevious()
         extra = self.extra_attrs(root, ("name",)) + tuple(
             (f"xmlns:{p}" if p else "xmlns", uri) for p, uri in sorted(
-                self.nsmap.items(), key=lambda kv: kv[0] or ""))
+                self.fragments.nsmap.items(), key=lambda kv: kv[0] or ""))
         if not links:
             self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
             return None
