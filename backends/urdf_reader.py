@@ -247,8 +247,8 @@ class _Reader:
         name = root.get("name") or ""
         if not name:
             self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
-        names = self.fragments
-        for el in root:  # every name first: fragments and mimics refer to them
+        names, children = self.fragments, list(root)  # kept: lxml makes each proxy once then
+        for el in children:  # every name first: fragments and mimics refer to them
             if el.tag == "link":
                 names.link_names.add(el.get("name", ""))
             elif el.tag == "joint":
@@ -260,7 +260,7 @@ class _Reader:
         materials: dict[str, Material] = {}
         fragments: list[Fragment] = []
         pending: list[str] = []
-        for el in root:
+        for el in children:
             if el.tag is etree.Comment:
                 pending.append(str(el.text))
                 continue
