@@ -8,15 +8,19 @@ they mention. Comments are kept. Mesh files are resolved to paths, never opened.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
+from types import SimpleNamespace
 
 from lxml import etree
 
+from mpc.backends.urdf_fragments import Fragments
 from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
+from mpc.core.record import maker
 from mpc.core.span import Span
-from mpc.ir.fragments import Fragment, FragmentRef, RefKind
+from mpc.ir.fragments import Fragment, FragmentRef
 from mpc.ir.geometry import Attrs, Box, Cylinder, Geometry, Mesh, MeshSource, Sphere, mesh_source
 from mpc.ir.robot import (
     JOINT_TYPES,
@@ -39,12 +43,32 @@ from mpc.ir.robot import (
 from mpc.ir.tree import check_tree
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_UNREAD = object()  # _Reader.numbers: a text not read yet
+_NAME, _NAME_TYPE, _POSE, _MESH = ("name",), ("name", "type"), ("xyz", "rpy"), ("filename", "scale")
+_LIMIT, _DYNAMICS = ("lower", "upper", "effort", "velocity"), ("damping", "friction")
+# The children of a joint that are no fragments.
+_JOINT_CHILDREN = frozenset({"origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
+                             "calibration", "safety_controller"})
 # Elements inside links and joints that become IR values (anything else is a fragment).
 _MODELLED = frozenset({
     "inertial", "visual", "collision", "origin", "geometry", "material", "mass", "inertia",
     "box", "cylinder", "sphere", "mesh", "color", "texture", "parent", "child", "axis", "limit",
     "dynamics", "mimic", "calibration", "safety_controller",
 })
+
+
+@functools.cache
+def _makers() -> SimpleNamespace:
+    """A maker of each IR record a read makes (core/record.py: maker, a quarter of the class
+    call's time; a URDF read makes 1,600 of them), written at the first read rather than at
+    import: `mpc check` imports this module on every save."""
+    return SimpleNamespace(
+        pose=maker(Pose), fragment=maker(Fragment), ref=maker(FragmentRef), robot=maker(Robot),
+        link=maker(Link), inertial=maker(Inertial), inertia=maker(Inertia), box=maker(Box),
+        cylinder=maker(Cylinder), sphere=maker(Sphere), mesh=maker(Mesh), visual=maker(Visual),
+        collision=maker(Collision), material=maker(Material), joint=maker(Joint), limit=maker(Limit),
+        dynamics=maker(Dynamics), mimic=maker(Mimic), calibration=maker(Calibration),
+        safety=maker(SafetyController))
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
@@ -76,27 +100,24 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
     return robot
 
 
-def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:
-    """The child indices (comments counted) from `root` down to its descendant `node`."""
-    path: list[int] = []
-    while node is not root:
-        parent = node.getparent()
-        path.append(parent.index(node))
-        node = parent
-    return tuple(reversed(path))
-
-
 class _Reader:
     def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
                  base_dir: Path) -> None:
         self.src, self.sink, self.resolver, self.base_dir = src, sink, resolver, base_dir
-        self.link_names: set[str] = set()
-        self.joint_names: set[str] = set()
-        self.names: set[str] = set()  # both
+        self.new = _makers()
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
-        # What tostring adds to a fragment's start tag for the namespaces <robot> declares.
-        self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
-                                       for prefix, uri in src.root.nsmap.items()]
+        # The numbers of each attribute text read so far (parse_floats), and the values of
+        # <origin>, <limit> and <dynamics> by their attributes: a URDF repeats many. A value
+        # is kept only when reading it reported nothing.
+        self.numbers: dict[str, tuple[float, ...] | None] = {}
+        self.poses: dict[tuple[tuple[str, str], ...], Pose] = {}
+        self.limits: dict[tuple[tuple[str, str], ...], Limit | Dynamics] = {}
+        # The elements that hold a comment somewhere inside (most hold none).
+        self.commented = {parent for comment in src.root.iter(etree.Comment)
+                          for parent in comment.iterancestors()}
+        self.fragments = Fragments(src, self.new.fragment, self.new.ref)
+        self.fragment = self.fragments.fragment
+        self.joint_names = self.fragments.joint_names  # filled by robot(), first
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -113,7 +134,11 @@ class _Reader:
                 )
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
-        return tuple([item for item in el.items() if item[0] not in known])
+        items = el.items()
+        for item in items:
+            if item[0] not in known:
+                return tuple([item for item in items if item[0] not in known])
+        return ()
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -122,27 +147,51 @@ class _Reader:
             if required:
                 self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
             return None
-        values = parse_floats(text)
+        values = self.numbers.get(text, _UNREAD)
+        if values is _UNREAD:
+            values = self.numbers[text] = parse_floats(text)
         if values is None or len(values) != n:
-            what = "a number" if n == 1 else f"{n} numbers"
-            self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
-                       f"got '{text}'", attr)
+            self.not_numbers(el, attr, n, where, text)
             return None
         return values
 
     def number(self, el: etree._Element, attr: str, where: str,
                required: bool = False) -> float | None:
-        values = self.floats(el, attr, 1, where, required)
-        return values[0] if values else None
+        """floats(…, 1, …)[0], without the tuple for the caller (most numbers are read here)."""
+        text = el.get(attr)
+        if text is None:
+            if required:
+                self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
+            return None
+        values = self.numbers.get(text, _UNREAD)
+        if values is _UNREAD:
+            values = self.numbers[text] = parse_floats(text)
+        if values is None or len(values) != 1:
+            self.not_numbers(el, attr, 1, where, text)
+            return None
+        return values[0]
+
+    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str) -> None:
+        what = "a number" if n == 1 else f"{n} numbers"
+        self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr)
 
     def pose(self, el: etree._Element | None, where: str) -> Pose | None:
         if el is None:
             return None
-        self.warn_unknown_attrs(el, ("xyz", "rpy"), where)
-        xyz = self.floats(el, "xyz", 3, where)
-        rpy = self.floats(el, "rpy", 3, where)
-        keys = el.keys()
-        return Pose(xyz or ZERO, rpy or ZERO, ("xyz" in keys, "rpy" in keys))  # type: ignore[arg-type]
+        items = tuple(el.items())
+        pose = self.poses.get(items)
+        if pose is not None:
+            return pose
+        keys = [key for key, _ in items]
+        has_xyz, has_rpy = "xyz" in keys, "rpy" in keys
+        if len(keys) > has_xyz + has_rpy:
+            self.warn_unknown_attrs(el, _POSE, where)
+        xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
+        rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
+        pose = self.new.pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
+        if len(keys) == has_xyz + has_rpy and (xyz or not has_xyz) and (rpy or not has_rpy):
+            self.poses[items] = pose
+        return pose
 
     def name(self, el: etree._Element, kind: str) -> str | None:
         name = el.get("name")
@@ -151,65 +200,33 @@ class _Reader:
             return None
         return name
 
-    def children(self, el: etree._Element) -> list[etree._Element]:
-        return [c for c in el if isinstance(c.tag, str)]
+    def named(self, el: etree._Element, known: tuple[str, ...] = _NAME) -> tuple[str | None, Attrs]:
+        """The 'name' attribute of `el` and its attributes not `known`, from one look at them
+        (links, joints, visuals and collisions have a name and seldom anything else)."""
+        items = el.items()
+        if len(items) == 1 and items[0][0] == "name":
+            return items[0][1], ()
+        return el.get("name"), tuple([item for item in items if item[0] not in known])
 
-    @staticmethod
-    def by_tag(el: etree._Element) -> tuple[list[etree._Element], dict[str, etree._Element]]:
-        """The element children of `el` in order, and the first of each tag: what `el.find(tag)`
-        gives for a plain tag, in one pass (each `find` call costs microseconds)."""
-        kids: list[etree._Element] = []
+    def sort_children(self, el: etree._Element, known: frozenset[str]
+                      ) -> tuple[dict[str, etree._Element], tuple[Fragment, ...]]:
+        """The first element child of each tag (what `el.find(tag)` gives for a plain tag), and
+        the children whose tags are not `known` as fragments, in one pass (each `find` call
+        costs microseconds; a fragment reports nothing, so it may be made first)."""
         first: dict[str, etree._Element] = {}
+        extras: list[Fragment] = []
         for child in el:
             tag = child.tag
-            if isinstance(tag, str):
-                kids.append(child)
+            if tag.__class__ is str:
                 if tag not in first:
                     first[tag] = child
-        return kids, first
-
-    def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
-        span = self.src.span(el)
-        xml = etree.tostring(el, encoding="unicode", with_tail=False)
-        # tostring re-declares every namespace in scope; <robot> declares them already.
-        head_end = xml.find(">")
-        head = xml[:head_end]
-        for declaration in self.namespace_declarations:
-            head = head.replace(declaration, "", 1)
-        xml = head + xml[head_end:]
-        if "\n" in xml:
-            indent = " " * (span.col - 1)
-            lines = xml.split("\n")
-            xml = "\n".join([lines[0]] + [ln.removeprefix(indent) for ln in lines[1:]])
-        return Fragment(tag=str(el.tag), xml=xml, refs=self.refs(el), comments=comments, span=span)
-
-    def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
-        """Every attribute or text in the fragment that equals a link or joint name, in
-        document order (each element's attributes, then its text)."""
-        out: list[FragmentRef] = []
-        names = self.names
-        for node in el.iter(etree.Element):
-            tag = node.tag
-            for attr, value in node.items():
-                name = value.strip()
-                if name in names:
-                    out.append(FragmentRef(_path(el, node), attr, self.kind_of(name, tag + attr), name))
-            text = node.text
-            if text and (name := text.strip()) and name in names:
-                out.append(FragmentRef(_path(el, node), None, self.kind_of(name, tag), name))
-        return tuple(out)
-
-    def kind_of(self, name: str, hint: str) -> RefKind:
-        """Whether the known `name` is a link's or a joint's; `hint` (where it stands) decides
-        for a name that is both."""
-        is_link, is_joint = name in self.link_names, name in self.joint_names
-        if is_link and is_joint:
-            return "joint" if "joint" in hint.lower() else "link"
-        return "link" if is_link else "joint"
+                if tag not in known:
+                    extras.append(self.fragment(child))
+        return first, tuple(extras)
 
     def inner_comments(self, el: etree._Element) -> tuple[str, ...]:
         """Comments inside `el`, except those inside opaque fragments (which keep theirs)."""
-        if next(el.iter(etree.Comment), None) is None:  # most elements hold none: one C-level walk
+        if el not in self.commented:
             return ()
         out: list[str] = []
         for child in el:
@@ -230,17 +247,20 @@ class _Reader:
         name = root.get("name") or ""
         if not name:
             self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
-        elements = self.children(root)
-        self.link_names = {e.get("name", "") for e in elements if e.tag == "link"}
-        self.joint_names = {e.get("name", "") for e in elements if e.tag == "joint"}
-        self.names = self.link_names | self.joint_names
+        names, children = self.fragments, list(root)  # kept: lxml makes each proxy once then
+        for el in children:  # every name first: fragments and mimics refer to them
+            if el.tag == "link":
+                names.link_names.add(el.get("name", ""))
+            elif el.tag == "joint":
+                names.joint_names.add(el.get("name", ""))
+        names.names = names.link_names | names.joint_names
 
         links: dict[str, Link] = {}
         joints: dict[str, Joint] = {}
         materials: dict[str, Material] = {}
         fragments: list[Fragment] = []
         pending: list[str] = []
-        for el in root:
+        for el in children:
             if el.tag is etree.Comment:
                 pending.append(str(el.text))
                 continue
@@ -264,7 +284,7 @@ class _Reader:
             prev = prev.getprevious()
         extra = self.extra_attrs(root, ("name",)) + tuple(
             (f"xmlns:{p}" if p else "xmlns", uri) for p, uri in sorted(
-                root.nsmap.items(), key=lambda kv: kv[0] or ""))
+                self.fragments.nsmap.items(), key=lambda kv: kv[0] or ""))
         if not links:
             self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
             return None
@@ -272,7 +292,7 @@ class _Reader:
         root_link = check_tree(links, joints, self.sink, robot_span, name)
         if root_link is None or not name:
             return None
-        return Robot(
+        return self.new.robot(
             name=name, root=root_link, links=links, joints=joints, materials=materials,
             fragments=tuple(fragments), extra_attrs=extra, header_comments=tuple(reversed(header)),
             trailing_comments=tuple(pending), span=robot_span,
@@ -290,33 +310,48 @@ class _Reader:
         table[name] = item
 
     def link(self, el: etree._Element, comments: tuple[str, ...]) -> Link | None:
-        name = self.name(el, "link")
-        if name is None:
+        name, extra_attrs = self.named(el)
+        if not name:
+            self.error(el, "E0403", "<link> without a 'name' attribute")
             return None
         where = f"link '{name}'"
         inertial, visuals, collisions, extras = None, [], [], []
-        for child in self.children(el):
-            if child.tag == "inertial":
+        for child in el:
+            tag = child.tag
+            if tag == "visual":
+                if (visual := self.visual(child, where)) is not None:
+                    visuals.append(visual)
+            elif tag == "collision":
+                if (collision := self.collision(child, where)) is not None:
+                    collisions.append(collision)
+            elif tag == "inertial":
                 if inertial is not None:
                     self.error(child, "E0406", f"{where} has more than one <inertial>")
                 inertial = self.inertial(child, where)
-            elif child.tag == "visual":
-                visuals.append(self.visual(child, where))
-            elif child.tag == "collision":
-                collisions.append(self.collision(child, where))
-            else:
+            elif tag.__class__ is str:
                 extras.append(self.fragment(child))
-        return Link(
-            name=name, inertial=inertial,
-            visuals=tuple(v for v in visuals if v is not None),
-            collisions=tuple(c for c in collisions if c is not None),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=tuple(extras),
+        return self.new.link(
+            name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
+            extra_attrs=extra_attrs, extras=tuple(extras),
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )
 
     def inertial(self, el: etree._Element, where: str) -> Inertial | None:
-        kids, first = self.by_tag(el)
-        mass_el, inertia_el = first.get("mass"), first.get("inertia")
+        origin_el = mass_el = inertia_el = None
+        extras: list[Fragment] = []
+        for child in el:  # sort_children without a dict, for one of the commonest elements
+            tag = child.tag
+            if tag == "mass":
+                if mass_el is None:
+                    mass_el = child
+            elif tag == "inertia":
+                if inertia_el is None:
+                    inertia_el = child
+            elif tag == "origin":
+                if origin_el is None:
+                    origin_el = child
+            elif tag.__class__ is str:
+                extras.append(self.fragment(child))
         mass = self.number(mass_el, "value", where, True) if mass_el is not None else None
         if mass_el is None:
             self.error(el, "E0403", f"<inertial> in {where} has no <mass>")
@@ -324,92 +359,116 @@ class _Reader:
         if inertia_el is None:
             self.error(el, "E0403", f"<inertial> in {where} has no <inertia>")
         else:
-            values = [self.number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "mass", "inertia"))
+            number = self.number
+            values = [number(inertia_el, k, where, True) for k in _INERTIA_KEYS]
         if mass is None or len(values) != 6 or None in values:
             return None
-        return Inertial(mass=mass, inertia=Inertia(**dict(zip(_INERTIA_KEYS, values, strict=True))),
-                        origin=self.pose(first.get("origin"), where), extras=extras)
+        ixx, ixy, ixz, iyy, iyz, izz = values
+        inertia = self.new.inertia(ixx=ixx, ixy=ixy, ixz=ixz, iyy=iyy, iyz=iyz, izz=izz)
+        return self.new.inertial(mass=mass, inertia=inertia, origin=self.pose(origin_el, where),
+                                 extras=tuple(extras) if extras else ())
 
     def geometry(self, el: etree._Element | None, parent: etree._Element,
                  where: str) -> Geometry | None:
         if el is None:
             self.error(parent, "E0403", f"<{parent.tag}> in {where} has no <geometry>")
             return None
-        shapes = self.children(el)
-        if len(shapes) != 1:
-            self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, "
-                       f"found {len(shapes)}")
+        shape, count = None, 0
+        for child in el:
+            if child.tag.__class__ is str:
+                shape, count = shape if count else child, count + 1
+        if count != 1:
+            self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, found {count}")
             return None
-        shape = shapes[0]
+        if shape.tag == "mesh":  # type: ignore[union-attr]
+            return self.mesh(shape, where)  # type: ignore[arg-type]
         if shape.tag == "box":
             size = self.floats(shape, "size", 3, where, True)
-            return Box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
+            return self.new.box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
         if shape.tag == "cylinder":
             r, h = self.number(shape, "radius", where, True), self.number(shape, "length", where, True)
             if r is None or h is None:
                 return None
-            return Cylinder(radius=r, length=h,
+            return self.new.cylinder(radius=r, length=h,
                             extra_attrs=self.extra_attrs(shape, ("radius", "length")))
         if shape.tag == "sphere":
             r = self.number(shape, "radius", where, True)
             if r is None:
                 return None
-            return Sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
-        if shape.tag == "mesh":
-            uri = shape.get("filename")
-            if not uri:
-                self.error(shape, "E0403", f"<mesh> in {where} has no 'filename' attribute")
-                return None
-            scale = self.floats(shape, "scale", 3, where)
-            if uri not in self.mesh_sources:  # a file's visuals and collisions share meshes
-                source = mesh_source(self.resolver, uri, self.base_dir)
-                refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
-                self.mesh_sources[uri] = source, refusal
-            source, why = self.mesh_sources[uri]
-            if why:
-                self.error(shape, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
-                return None
-            return Mesh(source=source,
-                        scale=scale, span=self.src.span(shape, "filename"),  # type: ignore[arg-type]
-                        extra_attrs=self.extra_attrs(shape, ("filename", "scale")))
+            return self.new.sphere(radius=r, extra_attrs=self.extra_attrs(shape, ("radius",)))
         self.error(shape, "E0405", f"unsupported geometry <{shape.tag}> in {where}; URDF has "
                    "box, cylinder, sphere and mesh")
         return None
 
+    def mesh(self, el: etree._Element, where: str) -> Mesh | None:
+        uri = el.get("filename")
+        if not uri:
+            self.error(el, "E0403", f"<mesh> in {where} has no 'filename' attribute")
+            return None
+        scale = self.floats(el, "scale", 3, where)
+        found = self.mesh_sources.get(uri)
+        if found is None:  # a file's visuals and collisions share meshes
+            source = mesh_source(self.resolver, uri, self.base_dir)
+            refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
+            found = self.mesh_sources[uri] = source, refusal
+        source, why = found
+        if why:
+            self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
+            return None
+        return self.new.mesh(source=source, scale=scale, span=self.src.span(el, "filename"),  # type: ignore[arg-type]
+                    extra_attrs=self.extra_attrs(el, _MESH))
+
+    def shape_children(self, el: etree._Element, visual: bool) -> tuple[
+            etree._Element | None, etree._Element | None, etree._Element | None, tuple[Fragment, ...]]:
+        """The first <origin>, <geometry> and (of a visual) <material> of a visual or collision,
+        and the other children as fragments: sort_children without a dict for the commonest
+        elements."""
+        origin = geometry = material = None
+        extras: list[Fragment] = []
+        for child in el:
+            tag = child.tag
+            if tag == "geometry":
+                if geometry is None:
+                    geometry = child
+            elif tag == "origin":
+                if origin is None:
+                    origin = child
+            elif tag == "material" and visual:
+                if material is None:
+                    material = child
+            elif tag.__class__ is str:
+                extras.append(self.fragment(child))
+        return origin, geometry, material, tuple(extras) if extras else ()
+
     def visual(self, el: etree._Element, where: str) -> Visual | None:
-        kids, first = self.by_tag(el)
-        geometry_el = first.get("geometry")
+        origin_el, geometry_el, material_el, extras = self.shape_children(el, True)
         geometry = self.geometry(geometry_el, el, where)
         material, inline = None, None
-        material_el = first.get("material")
         if material_el is not None:
             material = material_el.get("name")
             if material is None:
                 self.error(material_el, "E0403", f"<material> in {where} has no 'name' attribute")
             if len(material_el):
                 inline = self.material(material_el, (), where)
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry", "material"))
         if geometry is None:
             return None
-        return Visual(
-            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
-            material=material, inline_material=inline,
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+        name, extra_attrs = self.named(el)
+        return self.new.visual(
+            geometry=geometry, name=name, origin=self.pose(origin_el, where),
+            material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
         )
 
     def collision(self, el: etree._Element, where: str) -> Collision | None:
-        kids, first = self.by_tag(el)
-        geometry_el = first.get("geometry")
+        origin_el, geometry_el, _, extras = self.shape_children(el, False)
         geometry = self.geometry(geometry_el, el, where)
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in ("origin", "geometry"))
         if geometry is None:
             return None
-        return Collision(
-            geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
-            extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
+        name, extra_attrs = self.named(el)
+        return self.new.collision(
+            geometry=geometry, name=name, origin=self.pose(origin_el, where),
+            geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
         )
 
     def material(self, el: etree._Element, comments: tuple[str, ...], where: str) -> Material | None:
@@ -417,10 +476,14 @@ class _Reader:
         if name is None:
             self.error(el, "E0403", f"<material> in {where} has no 'name' attribute")
             return None
-        _, first = self.by_tag(el)
-        color, texture = first.get("color"), first.get("texture")
+        color = texture = None
+        for child in el:  # the first of each, as el.find would give (each call costs microseconds)
+            if child.tag == "color" and color is None:
+                color = child
+            elif child.tag == "texture" and texture is None:
+                texture = child
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
-        return Material(name=name, rgba=rgba,  # type: ignore[arg-type]
+        return self.new.material(name=name, rgba=rgba,  # type: ignore[arg-type]
                         texture=texture.get("filename", "") if texture is not None else None,
                         comments=comments, span=self.src.span(el))
 
@@ -436,7 +499,7 @@ class _Reader:
             self.error(el, "E0422", f"{where} has unknown type '{jtype}'{hint}", "type",
                        hint="URDF joint types: " + ", ".join(JOINT_TYPES))
             ok = False
-        kids, first = self.by_tag(el)
+        first, extras = self.sort_children(el, _JOINT_CHILDREN)
         ends = {}
         for end in ("parent", "child"):
             end_el = first.get(end)
@@ -454,37 +517,50 @@ class _Reader:
             self.error(el, "E0421", f"{where} is {jtype} but has no <limit> with effort and "
                        "velocity", "name")
             ok = False
-        known = ("origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
-                 "calibration", "safety_controller")
-        extras = tuple(self.fragment(c) for c in kids if c.tag not in known)
         if len(ends) < 2:
             return None
         if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
             jtype = "fixed"
-        return Joint(
+        return self.new.joint(
             name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
             origin=self.pose(first.get("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
             dynamics=self.dynamics(first.get("dynamics"), where),
             mimic=self.mimic(first.get("mimic"), where),
             calibration=self.calibration(first.get("calibration"), where),
             safety_controller=self.safety(first.get("safety_controller"), where),
-            extra_attrs=self.extra_attrs(el, ("name", "type")), extras=extras,
+            extra_attrs=self.extra_attrs(el, _NAME_TYPE), extras=extras,
             comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
         )
 
     def limit(self, el: etree._Element | None, where: str) -> Limit | None:
         if el is None:
             return None
-        keys = ("lower", "upper", "effort", "velocity")
-        return Limit(**{k: self.number(el, k, where) for k in keys},
-                     extra_attrs=self.extra_attrs(el, keys))
+        items = tuple(el.items())
+        limit = self.limits.get(items)
+        if limit is not None:
+            return limit  # type: ignore[return-value]
+        reported = len(self.sink.diagnostics)
+        limit = self.new.limit(lower=self.number(el, "lower", where), upper=self.number(el, "upper", where),
+                      effort=self.number(el, "effort", where),
+                      velocity=self.number(el, "velocity", where), extra_attrs=self.extra_attrs(el, _LIMIT))
+        if len(self.sink.diagnostics) == reported:
+            self.limits[items] = limit
+        return limit
 
     def dynamics(self, el: etree._Element | None, where: str) -> Dynamics | None:
         if el is None:
             return None
-        keys = ("damping", "friction")
-        return Dynamics(**{k: self.number(el, k, where) for k in keys},
-                        extra_attrs=self.extra_attrs(el, keys))
+        items = ("dynamics", *el.items())
+        dynamics = self.limits.get(items)
+        if dynamics is not None:
+            return dynamics  # type: ignore[return-value]
+        reported = len(self.sink.diagnostics)
+        dynamics = self.new.dynamics(damping=self.number(el, "damping", where),
+                            friction=self.number(el, "friction", where),
+                            extra_attrs=self.extra_attrs(el, _DYNAMICS))
+        if len(self.sink.diagnostics) == reported:
+            self.limits[items] = dynamics
+        return dynamics
 
     def mimic(self, el: etree._Element | None, where: str) -> Mimic | None:
         if el is None:
@@ -499,7 +575,7 @@ class _Reader:
             self.sink.warning(self.src.span(el, "joint"), "W0411",
                               f"<mimic> in {where} refers to unknown joint '{target}'"
                               f"{did_you_mean(target, self.joint_names)}; it has no effect")
-        return Mimic(joint=target, multiplier=self.number(el, "multiplier", where),
+        return self.new.mimic(joint=target, multiplier=self.number(el, "multiplier", where),
                      offset=self.number(el, "offset", where))
 
     def calibration(self, el: etree._Element | None, where: str) -> Calibration | None:
@@ -507,7 +583,7 @@ class _Reader:
             return None
         keys = ("rising", "falling", "reference_position")
         self.warn_unknown_attrs(el, keys, where)
-        return Calibration(**{k: self.number(el, k, where) for k in keys})
+        return self.new.calibration(**{k: self.number(el, k, where) for k in keys})
 
     def safety(self, el: etree._Element | None, where: str) -> SafetyController | None:
         if el is None:
@@ -517,5 +593,5 @@ class _Reader:
         k_velocity = self.number(el, "k_velocity", where, True)
         if k_velocity is None:
             return None
-        return SafetyController(k_velocity=k_velocity,
+        return self.new.safety(k_velocity=k_velocity,
                                 **{k: self.number(el, k, where) for k in keys[1:]})

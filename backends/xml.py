@@ -12,12 +12,14 @@ import functools
 import itertools
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from lxml import etree
 
 from mpc.core.diagnostics import Sink
+from mpc.core.record import maker
 from mpc.core.span import Span, hardened_parser
 
 # Comments, CDATA, processing instructions, doctype and start tags (`<` and the name), in
@@ -25,6 +27,13 @@ from mpc.core.span import Span, hardened_parser
 _TOKENS = re.compile(
     r"(<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<!DOCTYPE[^>]*>|<[A-Za-z_][\w:.\-]*)", re.DOTALL
 )
+# A `<` that _TOKENS would not see as markup or as a start tag with its whole name (the name
+# starts with a non-ASCII letter or holds a character outside \w:.-): only in a non-ASCII text.
+_ODD_START = re.compile(r"<(?![!?/]|[A-Za-z_][\w:.\-]*[ \t\r\n/>])")
+# Encodings in which the text, decoded as UTF-8, has every `<` and ASCII name where libxml2 saw it.
+_PLAIN_ENCODINGS = frozenset({"utf-8", "utf8", "us-ascii", "ascii", "iso-8859-1", "latin1", "latin-1"})
+_DELIMITERS = frozenset(" \t\r\n/>")  # what may follow an element's name in its start tag
+_LOOK_BACK = 50  # lines above an element's last line that may hold the `<` of its start tag
 
 
 class XmlError(Exception):
@@ -37,13 +46,23 @@ class XmlError(Exception):
 
 @dataclass
 class XmlSource:
-    """A parsed XML file that can say where each of its elements and attributes is."""
+    """A parsed XML file that can say where each of its elements and attributes is.
+
+    An element's start tag is looked for on the line where lxml says it ends: when that line
+    holds it beyond doubt (see `_on_line`), nothing else is read. Otherwise, and for every
+    element of an unusual text (a DOCTYPE, odd names or encodings), the start tags of the
+    whole text are scanned once (`_scan`) and the elements matched to them in order.
+    """
 
     file: str
     text: str
     root: etree._Element
+    _lines: list[str] = field(default_factory=list)
+    _quick: bool = False  # whether `_on_line` may be asked (see `parse`)
+    _offsets: dict[etree._Element, int] | None = None  # the scan: start tag offsets, once made
     _line_starts: list[int] = field(default_factory=list)
-    _offsets: dict[etree._Element, int] = field(default_factory=dict)
+    # Span's maker (core/record.py): a file's spans are made here, one for nearly every element.
+    _new_span: Callable[..., Span] = Span
 
     @classmethod
     def parse(cls, data: bytes, file: str) -> XmlSource:
@@ -61,8 +80,115 @@ class XmlSource:
             raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
                            "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
-        src = cls(file, text, root)
-        src._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
+        src = cls(file, text, root, text.split("\n"), _new_span=maker(Span))
+        # The scan matches every element to its own start tag, and `_on_lines` may look for it,
+        # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag;
+        # elsewhere the scan skips it with the comment, CDATA or PI that holds it), no name the
+        # scan does not see whole (`<:x`, when libxml2 takes it; odd letters), an encoding that
+        # writes each `<` of the markup as `<` (not UTF-7's `+ADw-`), and lines that libxml2
+        # counts (past 65535 only with XML_PARSE_BIG_LINES).
+        info = root.getroottree().docinfo
+        src._quick = (not info.doctype and len(src._lines) < 65535
+                      and (info.encoding or "").lower() in _PLAIN_ENCODINGS
+                      and (text.isascii() or _ODD_START.search(text) is None)
+                      and (not _colon_names() or "<:" not in text))
+        return src
+
+    def span(self, el: etree._Element, attr: str | None = None) -> Span:
+        """The span of an element's start tag, or of one of its attribute values."""
+        where = self._on_lines(el) if self._quick else None
+        if where is None:
+            where = self._scanned(el)
+            if where is None:
+                return self._new_span(self.file, el.sourceline or 1, 1)
+        number, chunk, start, name = where
+        if attr is not None:
+            end = chunk.find(">", start)
+            m = _attribute_pattern(attr).search(chunk, start, end + 1 if end >= 0 else len(chunk))
+            if m:
+                line, col = _position(chunk, number, m.start(m.lastindex))  # type: ignore[arg-type]
+                end_line, end_col = _position(chunk, number, m.end(m.lastindex))  # type: ignore[arg-type]
+                return self._new_span(self.file, line, col, end_line, end_col)
+        return self._new_span(self.file, number, start + 1, number, start + 2 + name)  # "<" and the name
+
+    def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int] | None:
+        """Where `el`'s start tag begins, read from the line where it ends (lxml's sourceline)
+        and the lines above: (the number of the line it begins on, the text from there to the
+        line where it ends, the index of its `<` in that text, the length of its local name),
+        or None when they do not tell.
+
+        Why the lines tell: a tag that begins on an earlier line leaves on its last line only
+        the end of its attributes (which hold no `<`) and its `>`, before any `<`, and began
+        at the last `<` above that line. A tag that begins on its last line is one of the
+        `<name` there. So when that line has one `<name` and either no `>` before its first
+        `<` or no `<name` as the last `<` above it, the tag begins at that `<name`; when it has
+        none, at the last `<` above.
+        """
+        number, lines = el.sourceline, self._lines
+        if not number or number > len(lines):
+            return None
+        line, tag = lines[number - 1], el.tag
+        if tag[0] == "{":
+            local = tag.rpartition("}")[2]
+            written = f"{el.prefix}:{local}" if el.prefix else local
+        elif ":" in tag:  # a QName libxml2 2.12 refuses and older ones keep whole: the scan decides
+            return None
+        else:
+            local = written = tag
+        needle = "<" + written
+        start = line.find(needle)
+        if start >= 0 and line.find(needle, start + 1) < 0:  # most tags: alone on one line
+            end = start + len(needle)
+            if (end == len(line) or line[end] in _DELIMITERS) and line.find(">", 0, line.find("<")) < 0:
+                return number, line, start, len(local)
+        here = _starts(line, needle)
+        if len(here) == 1 and line.find(">", 0, line.find("<")) < 0:
+            where = number, line, here[0]
+        elif len(here) > 1:
+            return None
+        else:
+            above = self._above(number)
+            if above is None:
+                return None
+            first, start = above
+            chunk = "\n".join(lines[first - 1:number])
+            begins = bool(_starts(chunk[start:start + len(needle) + 1], needle))
+            if here and not begins:
+                where = number, line, here[0]
+            elif begins and not here:
+                where = first, chunk, start
+            else:
+                return None
+        return (*where, len(local))
+
+    def _above(self, number: int) -> tuple[int, int] | None:
+        """(line number, index) of the last `<` above line `number`, when one of the few lines
+        right above it has one."""
+        lines = self._lines
+        for k in range(number - 2, max(number - 2 - _LOOK_BACK, -1), -1):
+            i = lines[k].rfind("<")
+            if i >= 0:
+                return k + 1, i
+        return None
+
+    def _scanned(self, el: etree._Element) -> tuple[int, str, int, int] | None:
+        """Where the scan found `el`'s start tag (as `_on_lines` says it), or None."""
+        if self._offsets is None:
+            self._scan()
+        offset = self._offsets.get(el)  # type: ignore[union-attr]
+        if offset is None:
+            return None
+        number = bisect.bisect_right(self._line_starts, offset)
+        line_start = self._line_starts[number - 1]
+        end = self.text.find(">", offset)
+        return (number, self.text[line_start:end + 1 if end >= 0 else len(self.text)], offset - line_start,
+                len(_localname(el)))
+
+    def _scan(self) -> None:
+        """The offset of every element's start tag, from one pass over the whole text."""
+        text, root = self.text, self.root
+        self._offsets = {}
+        self._line_starts = [0] + [m.end() for m in re.finditer("\n", text)]
         # split, not finditer: the offsets come from the parts' lengths without a match object
         # per token (twice as fast on a large URDF); parts alternate text and token.
         parts = _TOKENS.split(text)
@@ -71,41 +197,49 @@ class XmlSource:
             itertools.islice(offsets, 1, None, 2), parts[1::2], strict=False) if token[1] not in "!?"]
         elements = list(root.iter(etree.Element))
         if len(starts) != len(elements):
-            return src
+            return
         tags = [tag for _, tag in starts]
         if tags == [el.tag for el in elements] and ":" not in "".join(tags):  # no namespaces
-            src._offsets = dict(zip(elements, (offset for offset, _ in starts), strict=True))
-            return src
+            self._offsets = dict(zip(elements, (offset for offset, _ in starts), strict=True))
+            return
         for el, (offset, tag) in zip(elements, starts, strict=True):
             if tag.rsplit(":", 1)[-1] == _localname(el):
-                src._offsets[el] = offset
-        return src
+                self._offsets[el] = offset
 
-    def _pos(self, offset: int) -> tuple[int, int]:
-        line = bisect.bisect_right(self._line_starts, offset)
-        return line, offset - self._line_starts[line - 1] + 1
 
-    def span(self, el: etree._Element, attr: str | None = None) -> Span:
-        """The span of an element's start tag, or of one of its attribute values."""
-        offset = self._offsets.get(el)
-        if offset is None:
-            line = el.sourceline or 1
-            return Span(self.file, line, 1)
-        if attr is not None:
-            end = self.text.find(">", offset)
-            m = _attribute_pattern(attr).search(self.text, offset, end + 1 if end >= 0 else len(self.text))
-            if m:
-                line, col = self._pos(m.start(2))
-                end_line, end_col = self._pos(m.end(2))
-                return Span(self.file, line, col, end_line, end_col)
-        line, col = self._pos(offset)
-        return Span(self.file, line, col, line, col + 1 + len(_localname(el)))  # "<" and the name
+@functools.cache
+def _colon_names() -> bool:
+    """Whether this libxml2 takes an element name that begins with `:` (2.12 refuses it, so
+    the text need not be searched for one)."""
+    try:
+        etree.fromstring(b"<a><:b/></a>", hardened_parser())
+    except etree.XMLSyntaxError:
+        return False
+    return True
 
 
 @functools.lru_cache(maxsize=256)
 def _attribute_pattern(attr: str) -> re.Pattern[str]:
-    """Where the value of attribute `attr` is in a start tag (group 2)."""
-    return re.compile(rf"\s{re.escape(attr)}\s*=\s*([\"'])(.*?)\1", re.DOTALL)
+    """Where the value of attribute `attr` is in a start tag (the group that matched: 1 in double
+    quotes, 2 in single ones; a class of characters, not `(.*?)` and a back-reference, which
+    tried the closing quote at every character)."""
+    return re.compile(rf"\s{re.escape(attr)}\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
+
+
+def _starts(text: str, needle: str) -> list[int]:
+    """Where `needle` (`<` and a name) occurs in `text` followed by what may end a name."""
+    out, i = [], text.find(needle)
+    while i >= 0:
+        end = i + len(needle)
+        if end == len(text) or text[end] in _DELIMITERS:
+            out.append(i)
+        i = text.find(needle, i + 1)
+    return out
+
+
+def _position(chunk: str, number: int, index: int) -> tuple[int, int]:
+    """The line and column of `chunk[index]`, `chunk` beginning at the start of line `number`."""
+    return number + chunk.count("\n", 0, index), index - chunk.rfind("\n", 0, index)
 
 
 def _localname(el: etree._Element) -> str:
@@ -145,6 +279,11 @@ def parse_floats(text: str | None) -> tuple[float, ...] | None:
     """Whitespace-separated numbers, or None when any token is not a number."""
     if text is None or "_" in text:  # float() would accept "1_0"; URDF does not
         return None
+    if " " not in text:  # most often one number: float() strips the whitespace split() would
+        try:
+            return (float(text),)
+        except ValueError:
+            pass  # not one number; maybe several, between tabs or newlines
     try:
         return tuple(map(float, text.split()))
     except ValueError:

@@ -17,6 +17,7 @@ import functools
 import os
 import sys
 import sysconfig
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -112,16 +113,25 @@ class PackageResolver:
         of the package roots (and `base_dir`, the folder of the file naming it), a special
         file (core/files.py: input_problem). A missing file is no refusal: whoever reads
         it reports that."""
-        from mpc.core.files import input_problem, package_roots
+        from mpc.core.files import input_problem, plain_stat
 
-        if not path.exists():
+        found = plain_stat(path, self._real_dirs)
+        if found is False or (found is True and not path.exists()):
             return None
+        return input_problem(path, self._package_roots(base_dir), self._real_dirs,
+                             None if found is True else found)
+
+    def _package_roots(self, base_dir: Path | None) -> Iterator[Path]:
+        """The package roots and `base_dir`, resolved once for every mesh of a model, and only
+        when a link asks (a generator: most input files are no links)."""
+        from mpc.core.files import package_roots
+
         assert self.search_path is not None
         folders = (*self.package_map.values(), *self.search_path, *self.roots,
                    *([base_dir] if base_dir else []))
-        if folders not in self._real_roots:  # resolved once for every mesh of a model
+        if folders not in self._real_roots:
             self._real_roots[folders] = package_roots(folders)
-        return input_problem(path, self._real_roots[folders], self._real_dirs)
+        yield from self._real_roots[folders]
 
     def locate(self, uri: str, base_dir: Path) -> tuple[Path | None, str]:
         """A filename as written in a file in `base_dir` → (the file, or None when its package

@@ -1,0 +1,96 @@
+"""URDF elements mpc does not model → ir Fragment: the element as lxml serialises it (less the
+namespace declarations <robot> makes, dedented) and the link and joint names it mentions.
+
+It reads no meaning into a fragment: `<gazebo>`, `<transmission>`, `<ros2_control>`, vendor
+tags and unknown children of links and joints travel as text (backends/urdf_reader.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from lxml import etree
+
+from mpc.backends.xml import XmlSource
+from mpc.ir.fragments import Fragment, FragmentRef, RefKind
+
+
+class Fragments:
+    """The fragments of one URDF file, made as the reader meets them.
+
+    names: every link and joint name of the file (`link_names`, `joint_names`: each kind),
+    set before the first fragment is made. make, make_ref: the makers of the records
+    (core/record.py maker).
+    """
+
+    def __init__(self, src: XmlSource, make: Callable[..., Fragment],
+                 make_ref: Callable[..., FragmentRef]) -> None:
+        self.src, self.make, self.make_ref = src, make, make_ref
+        self.link_names: set[str] = set()
+        self.joint_names: set[str] = set()
+        self.names: set[str] = set()
+        # What tostring adds to a fragment's start tag for the namespaces <robot> declares,
+        # each and (as it writes them, right after the tag's name) all together. When only
+        # <robot> declares any, those no element uses are dropped from the tree first: tostring
+        # would copy each into every fragment (all four of TALOS's), to be cut out again.
+        self.nsmap = src.root.nsmap  # as the file wrote it, for the robot's attributes
+        if self.nsmap and src.text.count("xmlns") == len(self.nsmap):
+            etree.cleanup_namespaces(src.root)
+        self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
+                                       for prefix, uri in src.root.nsmap.items()]
+        self.declared = "".join(self.namespace_declarations)
+
+    def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
+        span, tag = self.src.span(el), el.tag
+        xml = etree.tostring(el, encoding="unicode", with_tail=False)
+        if self.declared:
+            # tostring re-declares every namespace in scope; <robot> declares them already.
+            cut = len(tag) + 1 if tag[0] != "{" else xml.find(" ")
+            if xml.startswith(self.declared, cut) and xml.find(">", 0, cut) < 0:
+                xml = xml[:cut] + xml[cut + len(self.declared):]
+            else:  # declared in another order, or among declarations of its own
+                head_end = xml.find(">")
+                head = xml[:head_end]
+                for declaration in self.namespace_declarations:
+                    head = head.replace(declaration, "", 1)
+                xml = head + xml[head_end:]
+        if span.col > 1:  # its lines less the indentation of its first
+            xml = xml.replace("\n" + " " * (span.col - 1), "\n")
+        return self.make(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
+
+    def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
+        """Every attribute or text in the fragment that equals a link or joint name, in
+        document order (each element's attributes, then its text)."""
+        out: list[FragmentRef] = []
+        names = self.names
+        for node in el.iter(etree.Element):
+            items = node.items()
+            if items:
+                for attr, value in items:
+                    if (name := value.strip()) in names:
+                        kind = self.kind_of(name, node.tag + attr)
+                        out.append(self.make_ref(_path(el, node), attr, kind, name))
+            text = node.text
+            if text and (name := text.strip()) and name in names:
+                out.append(self.make_ref(_path(el, node), None, self.kind_of(name, node.tag), name))
+        return tuple(out) if out else ()
+
+    def kind_of(self, name: str, hint: str) -> RefKind:
+        """Whether the known `name` is a link's or a joint's; `hint` (where it stands) decides
+        for a name that is both."""
+        is_link, is_joint = name in self.link_names, name in self.joint_names
+        if is_link and is_joint:
+            return "joint" if "joint" in hint.lower() else "link"
+        return "link" if is_link else "joint"
+
+
+def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:
+    """The child indices (comments counted) from `root` down to its descendant `node`."""
+    if node is root:  # most names stand in a fragment's own attributes
+        return ()
+    path: list[int] = []
+    while node is not root:
+        parent = node.getparent()
+        path.append(parent.index(node))
+        node = parent
+    return tuple(reversed(path))
