@@ -6,7 +6,7 @@ Cold: an empty build folder and an empty mesh cache. No-op: the same run again, 
 changed (the median of five). Targets (issue 19): the 50 models at -j2 at least 1.6× faster
 than at -j1; the fleet's no-op rebuild at most 0.25 s. Times are wall-clock times of the
 `mpc` command as users run it, Python start-up included; the machine's load average is
-printed with them. Run: python bench/bench_pipeline.py [fleet|50]   (default: both)
+printed with them. Run: python bench/bench_pipeline.py [fleet] [50] [--runs N]   (default: both, 3)
 """
 
 from __future__ import annotations
@@ -100,16 +100,22 @@ def copies(folder: Path, count: int) -> Path:
     return folder / "pipeline.yml"
 
 
-def cold_and_noop(base: Path, name: str, make: Callable[[Path], Path], noop: bool) -> None:
-    times = {}
-    for jobs in ("1", "2"):
-        pipeline = make(base / f"{name}-j{jobs}")
-        env = {**os.environ, "MPC_CACHE_DIR": str(base / f"cache-{name}-j{jobs}")}
-        seconds, _, peak = run(pipeline, "-j", jobs, env=env)
-        times[jobs] = seconds
-        print(f"cold, -j{jobs}:        {seconds:6.2f} s   peak memory of the process tree "
-              f"{peak / 2**20:4.0f} MB   (load average {os.getloadavg()[0]:.1f})")
-    print(f"-j2 vs -j1:       {times['1'] / times['2']:6.2f}×  (target ≥ 1.6× for 50 models)")
+def cold_and_noop(base: Path, name: str, make: Callable[[Path], Path], noop: bool, runs: int) -> None:
+    """Cold builds at -j1 and -j2, `runs` of each taken in turns (the machine's speed drifts:
+    turns share the drift), their medians and the ratio of the medians; then the no-op."""
+    times: dict[str, list[float]] = {"1": [], "2": []}
+    for turn in range(runs):
+        for jobs in ("1", "2"):
+            folder = base / f"{name}-j{jobs}-{turn}"
+            pipeline = make(folder)
+            env = {**os.environ, "MPC_CACHE_DIR": str(base / f"cache-{name}-j{jobs}-{turn}")}
+            seconds, _, peak = run(pipeline, "-j", jobs, env=env)
+            times[jobs].append(seconds)
+            print(f"cold, -j{jobs}:        {seconds:6.2f} s   peak memory of the process tree "
+                  f"{peak / 2**20:4.0f} MB   (load average {os.getloadavg()[0]:.1f})")
+    j1, j2 = statistics.median(times["1"]), statistics.median(times["2"])
+    print(f"-j2 vs -j1:       {j1 / j2:6.2f}×  (medians of {runs}: {j1:.2f} s / {j2:.2f} s; "
+          f"target ≥ 1.6× for 50 models)")
     if noop:
         noops = [run(pipeline, env=env) for _ in range(5)]
         wall = statistics.median(n[0] for n in noops)
@@ -119,18 +125,26 @@ def cold_and_noop(base: Path, name: str, make: Callable[[Path], Path], noop: boo
               f"{os.getloadavg()[0]:.1f})")
 
 
-def main(which: list[str]) -> None:
+def main(which: list[str], runs: int) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(tmp)
         if "fleet" in which:
             print("mpc run examples/fleet/pipeline.yml (12 models: 10 built, 1 broken, 1 skipped)")
-            cold_and_noop(base, "fleet", lambda folder: copies(folder, 12), noop=True)
+            cold_and_noop(base, "fleet", lambda folder: copies(folder, 12), noop=True, runs=runs)
         if "50" in which:
             print("mpc run on 50 models: copies of the fleet (their meshes are the fleet's)")
-            cold_and_noop(base, "50", lambda folder: copies(folder, 50), noop=False)
+            cold_and_noop(base, "50", lambda folder: copies(folder, 50), noop=False, runs=runs)
         largest = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
         print(f"largest process:  {largest:6.0f} MB  (peak resident memory of one mpc process)")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["fleet", "50"])
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("which", nargs="*", help="fleet, 50 (default: both)")
+    parser.add_argument("--runs", type=int, default=3, help="cold runs of each -j (default 3)")
+    args = parser.parse_args()
+    if not set(args.which) <= {"fleet", "50"}:
+        parser.error(f"unknown: {' '.join(set(args.which) - {'fleet', '50'})}")
+    main(args.which or ["fleet", "50"], args.runs)
