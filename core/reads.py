@@ -43,8 +43,9 @@ class ReadRecorder:
         self.packages: dict[tuple[str, str], str | None] = {}  # (package, near) → its folder
         self.volatile: list[str] = []  # why the result may differ with no file changed
         # The Python installation holds code; its `share/` folders hold data (robot packages).
-        self.code = tuple({os.path.realpath(p) + os.sep for p in (sys.prefix, sys.base_prefix,
-                                                                    sys.exec_prefix)})
+        prefixes = (sys.prefix, sys.base_prefix, sys.exec_prefix)
+        self.code = tuple({os.path.realpath(p) + os.sep for p in prefixes})
+        self.code_as_named = tuple({os.path.abspath(p) + os.sep for p in prefixes})
 
     def install(self) -> ReadRecorder:
         """Record from now on, for the life of the process (a worker of `mpc run`)."""
@@ -76,6 +77,9 @@ class ReadRecorder:
             if os.path.splitext(text)[1] in _CODE_SUFFIXES or f"{os.sep}__pycache__{os.sep}" in text \
                     or ".dist-info" + os.sep in text:
                 continue
+            data = f"{os.sep}share{os.sep}" in text
+            if text.startswith(self.code_as_named) and not data:
+                continue  # no realpath for the many files read from the installation
             real = os.path.realpath(text)
             if real.startswith(self.code) and f"{os.sep}share{os.sep}" not in real:
                 continue
