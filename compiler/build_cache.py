@@ -146,8 +146,7 @@ class KeptBuild:
         (None, None) when `sink` makes one of them an error (--werror)."""
         assert self.header is not None
         self.model_used = True
-        for diagnostic in pickle.loads(self.header["diagnostics"]):
-            sink.report(diagnostic)
+        _report(sink, self.header["diagnostics"])
         return (None, None) if sink.has_errors() else self.model()
 
     def write_outputs(self, staging: Path) -> bool:
@@ -170,10 +169,8 @@ class KeptBuild:
     def replay_outputs(self, sink: Sink) -> None:
         """The diagnostics of the kept build, reported into `sink` again."""
         assert self.header is not None
-        for diagnostic in pickle.loads(self.header["diagnostics"]):
-            sink.report(diagnostic)
-        for diagnostic in pickle.loads(self.header["outputs"]["diagnostics"]):
-            sink.report(diagnostic)
+        _report(sink, self.header["diagnostics"])
+        _report(sink, self.header["outputs"]["diagnostics"])
 
     def drop_outputs(self) -> None:
         self.outputs_hold = False
@@ -216,21 +213,20 @@ class KeptBuild:
                       "packages": sorted((p, n, f) for (p, n), f in self.recorder.packages.items()),
                       "model": buffer.getvalue(), "diagnostics": diagnostics,
                       "modelname": program.modelname, "span": program.span, "outputs": None}
-        model_files = header["files"]
         with contextlib.suppress(OSError):
             if out is not None and all(e.type in _KEPT_EXPORTS for e in program.exports):
-                header["outputs"] = self._keep_outputs(out, output_diagnostics, model_files)
+                opened = {f for f, _ in header["files"]}
+                header["outputs"] = self._keep_outputs(out, output_diagnostics, opened)
             self.folder.mkdir(parents=True, exist_ok=True)
             cache.store_entry(self.entry, pickle.dumps(header, protocol=pickle.HIGHEST_PROTOCOL))
             cache.trace(f"keep build {self.folder.name}")
             self._remove_old_outputs(header["outputs"])
 
     def _keep_outputs(self, out: Path, diagnostics: list[Diagnostic],
-                      model_files: Files) -> dict[str, Any] | None:
+                      model_files: set[str]) -> dict[str, Any] | None:
         """A copy of the outputs in `out` (hard links where the cache is on the same file system:
         a file changed in place through one is found by its digest when it is written out)."""
-        model = {f for f, _ in model_files}
-        files = _digests([p for p in self.recorder.inputs() if str(p) not in model], self.started)
+        files = _digests([p for p in self.recorder.inputs() if str(p) not in model_files], self.started)
         if files is None:
             return None
         self.folder.mkdir(parents=True, exist_ok=True)
@@ -288,6 +284,11 @@ class KeptBuild:
             if (str(folder) if folder is not None else None) != found:
                 return False
         return True
+
+
+def _report(sink: Sink, pickled: bytes) -> None:
+    for diagnostic in pickle.loads(pickled):
+        sink.report(diagnostic)
 
 
 def _pickled(diagnostics: list[Diagnostic]) -> bytes:

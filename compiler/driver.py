@@ -232,7 +232,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
 
         with stage("apply ops"):
             check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
-        out = options.out or Path("build") / program.modelname
+        out = _out(options, program.modelname)
         with stage("write"):
             written = emit(program, robot, out, sink, options.target)  # emit, rename into place
     if not written:
@@ -246,7 +246,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
 def _write_kept(kept: KeptBuild, sink: Sink, options: Options) -> Result | None:
     """The kept outputs written into place, their diagnostics said again; None (nothing said)
     when one of them is damaged: the build runs."""
-    out = options.out or Path("build") / kept.modelname
+    out = _out(options, kept.modelname)
     own = Sink()
     with stage("write"):
         written = into_place(out, own, kept.span, kept.write_outputs)
@@ -258,6 +258,11 @@ def _write_kept(kept: KeptBuild, sink: Sink, options: Options) -> Result | None:
     for diagnostic in own.diagnostics:  # E0660: the output folder cannot be written
         sink.report(diagnostic)
     return Result(out=out, model=kept.model) if written else Result()
+
+
+def _out(options: Options, modelname: str) -> Path:
+    """The output folder: `-o`, else build/<modelname> in the working folder."""
+    return options.out or Path("build") / modelname
 
 
 def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Program | None, Robot | None]:

@@ -27,14 +27,24 @@ from typing import Any, TypeVar, dataclass_transform, overload
 T = TypeVar("T", bound=type)
 R = TypeVar("R")
 
+_NAMES: dict[type, tuple[str, ...]] = {}
 _VALUES: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
 
 
+def _names(cls: type) -> tuple[str, ...]:
+    """The record's field names, in order (looked up once per class)."""
+    names = _NAMES.get(cls)
+    if names is None:
+        names = _NAMES[cls] = tuple(f.name for f in fields(cls))  # type: ignore[arg-type]
+    return names
+
+
 def _values(obj: Any) -> tuple[Any, ...]:
+    """The record's field values, in order; also what it pickles (`__getstate__`)."""
     cls = type(obj)
     get = _VALUES.get(cls)
     if get is None:
-        names = [f.name for f in fields(obj)]
+        names = _names(cls)
         get = attrgetter(*names) if len(names) > 1 else (
             (lambda o, n=names[0]: (getattr(o, n),)) if names else (lambda o: ()))
         _VALUES[cls] = get
@@ -56,19 +66,8 @@ def _hash(self: Any) -> int:
     return hash(_values(self))
 
 
-_NAMES: dict[type, tuple[str, ...]] = {}
-
-
-def _getstate(self: Any) -> tuple[Any, ...]:
-    return _values(self)
-
-
 def _setstate(self: Any, state: tuple[Any, ...]) -> None:
-    cls = type(self)
-    names = _NAMES.get(cls)
-    if names is None:
-        names = _NAMES[cls] = tuple(f.name for f in fields(self))
-    for name, value in zip(names, state, strict=True):
+    for name, value in zip(_names(type(self)), state, strict=True):
         object.__setattr__(self, name, value)
 
 
@@ -201,7 +200,7 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) ->
         out = dataclass(c, frozen=True, repr=False, eq=False, slots=slots, kw_only=kw_only)
         methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
         if slots:  # dataclass's own look each field up anew for every object pickled (build cache)
-            methods += [("__getstate__", _getstate), ("__setstate__", _setstate)]
+            methods += [("__getstate__", _values), ("__setstate__", _setstate)]
         for name, method in methods:
             if name not in c.__dict__:
                 setattr(out, name, method)
