@@ -288,7 +288,7 @@ class _Reader:
         if not links:
             self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
             return None
-        robot_span = self.src.span(root)
+        robot_span = self.src.lazy_span(root)
         root_link = check_tree(links, joints, self.sink, robot_span, name)
         if root_link is None or not name:
             return None
@@ -333,7 +333,7 @@ class _Reader:
         return self.new.link(
             name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
             extra_attrs=extra_attrs, extras=tuple(extras),
-            comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
+            comments=comments, inner_comments=self.inner_comments(el), span=self.src.lazy_span(el),
         )
 
     def inertial(self, el: etree._Element, where: str) -> Inertial | None:
@@ -415,7 +415,7 @@ class _Reader:
         if why:
             self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
             return None
-        return self.new.mesh(source=source, scale=scale, span=self.src.span(el, "filename"),  # type: ignore[arg-type]
+        return self.new.mesh(source=source, scale=scale, span=self.src.lazy_span(el, "filename"),  # type: ignore[arg-type]
                     extra_attrs=self.extra_attrs(el, _MESH))
 
     def shape_children(self, el: etree._Element, visual: bool) -> tuple[
@@ -456,7 +456,7 @@ class _Reader:
         return self.new.visual(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
             material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
-            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
+            extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 
     def collision(self, el: etree._Element, where: str) -> Collision | None:
@@ -468,7 +468,7 @@ class _Reader:
         return self.new.collision(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
             geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
-            extra_attrs=extra_attrs, extras=extras, span=self.src.span(el),
+            extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 
     def material(self, el: etree._Element, comments: tuple[str, ...], where: str) -> Material | None:
@@ -485,7 +485,7 @@ class _Reader:
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
         return self.new.material(name=name, rgba=rgba,  # type: ignore[arg-type]
                         texture=texture.get("filename", "") if texture is not None else None,
-                        comments=comments, span=self.src.span(el))
+                        comments=comments, span=self.src.lazy_span(el))
 
     def joint(self, el: etree._Element, comments: tuple[str, ...]) -> Joint | None:
         name = self.name(el, "joint")
@@ -529,7 +529,7 @@ class _Reader:
             calibration=self.calibration(first.get("calibration"), where),
             safety_controller=self.safety(first.get("safety_controller"), where),
             extra_attrs=self.extra_attrs(el, _NAME_TYPE), extras=extras,
-            comments=comments, inner_comments=self.inner_comments(el), span=self.src.span(el),
+            comments=comments, inner_comments=self.inner_comments(el), span=self.src.lazy_span(el),
         )
 
     def limit(self, el: etree._Element | None, where: str) -> Limit | None:

@@ -7,7 +7,9 @@ found at any stage points at the user's text.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from functools import lru_cache
+from operator import attrgetter
 from pathlib import Path
 from typing import Any
 
@@ -37,10 +39,69 @@ class Span:
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.col}"
 
+    # Written here, not by @record, so that a LazySpan is a Span like any other: equal to the
+    # Span of the same place, with its hash and repr.
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Span):
+            return NotImplemented
+        return _fields(self) == _fields(other)
+
+    def __hash__(self) -> int:
+        return hash(_fields(self))
+
+    def __repr__(self) -> str:
+        return "Span(file={!r}, line={!r}, col={!r}, end_line={!r}, end_col={!r})".format(*_fields(self))
+
     @classmethod
     def of_file(cls, file: str) -> Span:
         """The span of a whole file, for errors that concern the file itself."""
         return cls(file, 1, 1)
+
+
+_fields = attrgetter("file", "line", "col", "end_line", "end_col")
+_POSITION = frozenset({"line", "col", "end_line", "end_col"})
+_set_file, _set_line, _set_col, _set_end_line, _set_end_col = (
+    Span.__dict__[name].__set__ for name in ("file", "line", "col", "end_line", "end_col"))
+
+
+class LazySpan(Span):
+    """A Span whose position is found when it is first asked for (`lazy_span`).
+
+    A reader knows where each element is but seldom needs to say so: only a diagnostic, the
+    language server or a kept build (which pickles it) asks. Finding the column of a start
+    tag or an attribute is most of what a span costs (a third of TALOS's URDF read went to
+    spans). Until then it holds the finder, and with it the parsed file; afterwards it is a
+    Span in all but its class, and it pickles and copies as one.
+    """
+
+    __slots__ = ("_find",)
+    _find: Callable[[], Span] | None
+
+    def __getattr__(self, name: str) -> Any:  # only for a slot not set yet: the position
+        find = object.__getattribute__(self, "_find") if name in _POSITION else None
+        if find is None:
+            raise AttributeError(name)
+        found = find()
+        _set_line(self, found.line)
+        _set_col(self, found.col)
+        _set_end_line(self, found.end_line)
+        _set_end_col(self, found.end_col)
+        _set_find(self, None)  # lets the parsed file go
+        return object.__getattribute__(self, name)
+
+    def __reduce__(self) -> tuple[type[Span], tuple[Any, ...]]:
+        return Span, _fields(self)
+
+
+_set_find = LazySpan.__dict__["_find"].__set__
+
+
+def lazy_span(file: str, find: Callable[[], Span]) -> Span:
+    """A Span of `file` whose position `find` gives when first asked for (LazySpan)."""
+    span = object.__new__(LazySpan)
+    _set_file(span, file)
+    _set_find(span, find)
+    return span
 
 
 def hardened_parser(huge: bool = False) -> Any:
