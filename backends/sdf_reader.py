@@ -185,7 +185,7 @@ class _Reader:
 
         walk(root, ())
         return Fragment(tag=str(root.tag), xml=etree.tostring(root, encoding="unicode"),
-                        refs=tuple(refs), span=self.src.span(els[0]))
+                        refs=tuple(refs), span=self.src.lazy_span(els[0]))
 
     def keep(self, el: etree._Element, known: tuple[str, ...], reference: str | None) -> None:
         unknown = [c for c in el if isinstance(c.tag, str) and c.tag not in known]
@@ -385,7 +385,7 @@ class _Reader:
             name=j.name, type=j.type, parent=j.parent, child=j.child, origin=origin(j),  # type: ignore[arg-type]
             axis=None if j.type == "fixed" else self.axis(j, X_CJ[j.name], X_M[j.child]),  # type: ignore[arg-type]
             limit=j.limit, dynamics=j.dynamics, annotations=j.annotations, comments=comments[j.name],
-            inner_comments=_comments(j.el), span=self.src.span(j.el))
+            inner_comments=_comments(j.el), span=self.src.lazy_span(j.el))
             for j in sorted(tree, key=lambda j: j.order)}
         cut_joints = {}
         for j in cuts:  # the joint frame and axis, as seen from the child link's IR frame
@@ -394,7 +394,7 @@ class _Reader:
             if j.axis is not None:
                 notes["axis"] = list(self.axis(j, X_CJ[j.name], X_M[j.child]))  # type: ignore[arg-type]
             cut_joints[j.name] = CutJoint(name=j.name, type=j.type, parent=j.parent, child=j.child,
-                                          origin=origin(j), annotations=notes, span=self.src.span(j.el))
+                                          origin=origin(j), annotations=notes, span=self.src.lazy_span(j.el))
         # The root's pose in the model (e.g. a standing height) is not a pose between links.
         annotations = {} if np.array_equal(X_IR[root], np.eye(4)) else {
             "sdf": {"root_pose_in_model": _pose_dict(X_IR[root])}}  # type: ignore[arg-type]
@@ -405,7 +405,7 @@ class _Reader:
             prev = prev.getprevious()
         return Robot(name=name, root=root, links=links, joints=joints, fragments=tuple(self.fragments),
                      header_comments=tuple(reversed(header)), trailing_comments=trailing,
-                     cut_joints=cut_joints, annotations=annotations, span=self.src.span(model))
+                     cut_joints=cut_joints, annotations=annotations, span=self.src.lazy_span(model))
 
     def axis(self, j: _Joint, X_CJ: np.ndarray, X_MC: np.ndarray) -> tuple[float, ...]:
         """The joint axis in the child link's frame (in SDF: in the joint frame, or expressed_in)."""
@@ -435,7 +435,7 @@ class _Reader:
             if item.tag not in ("visual", "collision") or (
                     geometry := self.geometry(item.find("geometry"), item, where)) is None:
                 continue
-            kw = {"geometry": geometry, "name": item.get("name"), "span": self.src.span(item),
+            kw = {"geometry": geometry, "name": item.get("name"), "span": self.src.lazy_span(item),
                   "origin": self.local(item, name, shift, where)}
             if item.tag == "collision":
                 collisions.append(Collision(**kw, extras=self.extras(item, ("pose", "geometry"))))  # type: ignore[arg-type]
@@ -445,7 +445,7 @@ class _Reader:
                                   extras=self.extras(item, ("pose", "geometry", "material", "transparency"))))
         self.keep(el, ("pose", "inertial", "visual", "collision"), name)
         return Link(name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),
-                    comments=comments, inner_comments=_comments(el), span=self.src.span(el))
+                    comments=comments, inner_comments=_comments(el), span=self.src.lazy_span(el))
 
     def material(self, visual: etree._Element, name: str, where: str) -> Material | None:
         el, transparency = visual.find("material"), self.number(visual, "transparency", where)
@@ -494,7 +494,7 @@ class _Reader:
                 self.error(uri_el, "E0650", f"mesh '{uri}' in {where} is not read: {why}")
                 return None
             return Mesh(source=replace(found, uri=uri), scale=self.floats(s.find("scale"), 3, where),  # type: ignore[arg-type]
-                        span=self.src.span(uri_el))
+                        span=self.src.lazy_span(uri_el))
         v = {t: self.floats(s.find(t), 3 if t == "size" else 1, where) for t in _SHAPES[s.tag]}
         if None in v.values():
             return None

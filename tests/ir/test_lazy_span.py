@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mpc.backends import urdf
+from mpc.backends import sdf_reader, urdf
 from mpc.backends.xml import XmlSource
 from mpc.core.diagnostics import Sink
 from mpc.core.span import LazySpan, Span, lazy_span
@@ -128,3 +128,28 @@ def test_a_robot_read_holds_its_parsed_file_no_longer_than_itself(tmp_path: Path
     del robot
     gc.collect()
     assert source() is None
+
+
+SDF = b"""<sdf version="1.9">
+  <model name="m">
+    <link name="base"/>
+    <link name="arm">
+      <pose>0 0 1 0 0 0</pose>
+    </link>
+    <joint name="j" type="fixed">
+      <parent>base</parent>
+      <child>arm</child>
+    </joint>
+  </model>
+</sdf>
+"""
+
+
+def test_the_sdf_reader_finds_no_span_until_asked_and_then_the_eager_one(tmp_path: Path) -> None:
+    path = tmp_path / "m.sdf"
+    path.write_bytes(SDF)
+    robot = sdf_reader.read(path, Sink())
+    assert robot is not None
+    spans = [robot.span, robot.links["base"].span, robot.links["arm"].span, robot.joints["j"].span]
+    assert all(type(s) is LazySpan and not _set_slots(s) for s in spans)
+    assert [(s.line, s.col, s.end_col) for s in spans] == [(2, 3, 9), (3, 5, 10), (4, 5, 10), (7, 5, 11)]
