@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -185,3 +186,26 @@ def test_a_colcon_symlink_install_workspace_is_read_through_its_links(tmp_path: 
     refused = subprocess.run([*run, "--format", "gcc"], capture_output=True, text=True, env=env)
     assert refused.returncode == 1
     assert "[E0650]" in refused.stderr
+
+
+def test_the_program_ends_with_mains_status_its_atexit_work_done_and_its_output_whole(
+        tmp_path: Path) -> None:
+    """`mpc` skips the interpreter's teardown (cli/main.py: program); what users see of the
+    end stays: the exit status, every byte written to a pipe, and the atexit functions run
+    (multiprocessing's and tempfile's among them)."""
+    arm(tmp_path)
+    good = write(tmp_path / "good.yml", definition("arm.urdf"))
+    bad = write(tmp_path / "bad.yml", definition("arm.urdf").replace("robotname:", "robtname:"))
+    probe = ("import atexit, sys\nfrom mpc.cli.main import program\n"
+             "atexit.register(lambda: print('atexit ran', file=sys.stderr))\n"
+             "print('before mpc', end='')  # left in the buffer of a pipe\n"
+             "sys.argv = ['mpc', *sys.argv[1:]]\nprogram()\n")
+    buffered = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    for args, status in (([good, "-o", tmp_path / "out"], 0), ([bad], 1), (["--bogus"], 2)):
+        run = subprocess.run([sys.executable, "-c", probe, "compile", *map(str, args)],
+                             capture_output=True, text=True, timeout=600, env=buffered)
+        assert run.returncode == status, run.stderr
+        assert run.stdout.startswith("before mpc")
+        assert run.stderr.endswith("atexit ran\n")
+    assert (tmp_path / "out/urdf/robot.urdf").is_file()
+    assert mpc_process("compile", bad).stderr.endswith(f"error: could not compile '{bad}' (2 errors)\n")
