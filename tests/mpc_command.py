@@ -1,9 +1,10 @@
 """`mpc ARGS` for tests, run in the test's own process.
 
-The command line is the same `main(argv)` the `mpc` script calls, with its stdout and stderr
-captured; what a separate process would add is Python's start and the imports of Pinocchio,
-PyBullet, MuJoCo and trimesh, which a worker of the suite pays once instead of at every call
-(about two seconds each). The working folder and the environment are restored afterwards.
+The command line is the same `main(argv)` the `mpc` script runs (cli/main.py: program), with
+its stdout and stderr captured; what a separate process would add is Python's start and end
+and the imports of Pinocchio, PyBullet, MuJoCo and trimesh, which a worker of the suite pays
+once instead of at every call (about two seconds each). The working folder and the environment
+are restored afterwards.
 
 Commands that start processes of their own or handle signals (`run`, `ci`, `view`) still run
 as a process, and so does every call a test makes through `mpc_process`.
