@@ -18,7 +18,10 @@ import json
 import os
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from mpc.core.packages import PackageResolver
 
 
 def digest(*parts: str) -> str:
@@ -43,6 +46,7 @@ def file_digest(path: Path) -> str:
 
 
 MISSING = "missing"  # the digest of a file the build looked for and did not find
+PACKAGE = -2  # the size of a dep that is a package lookup (`package_entry`), not a file
 
 
 def dep_name(path: Path, root: Path) -> str:
@@ -65,11 +69,34 @@ def dep_entry(path: Path, root: Path) -> list[Any] | None:
         return None
 
 
-def deps_current(deps: list[list[Any]], root: Path) -> list[list[Any]] | None:
+def package_entry(package: str, near: str, found: str | None, root: Path) -> list[Any]:
+    """A dep on where a `package://` name was found, as a file's entry is written: [package://NAME,
+    then NUL and the folder it was looked up from (dep_name; empty when none), PACKAGE, 0, the
+    folder it resolved to (dep_name) or "missing"]. A build depends on which copy of a package
+    ROS_PACKAGE_PATH, AMENT_PREFIX_PATH or --package names, not only on the files it read there:
+    with another copy named, those files are all unchanged."""
+    near_name = dep_name(Path(near), root) if near else ""
+    return [f"package://{package}\0{near_name}", PACKAGE, 0,
+            dep_name(Path(found), root) if found else MISSING]
+
+
+def _package_now(name: str, root: Path, resolver: PackageResolver) -> str:
+    """Where the package of a `package_entry` named `name` is found now (its last field)."""
+    package, _, near = name.removeprefix("package://").partition("\0")
+    found = resolver.find(package, root / near if near else None)
+    return dep_name(found, root) if found is not None else MISSING
+
+
+def deps_current(deps: list[list[Any]], root: Path, resolver: PackageResolver) -> list[list[Any]] | None:
     """The recorded deps, refreshed where only the time changed; None when a file's content
-    changed or the file is gone."""
+    changed or the file is gone, or a package is found elsewhere now (`resolver`: the run's)."""
     out = []
     for name, size, mtime, sha in deps:
+        if size == PACKAGE:
+            if _package_now(name, root, resolver) != sha:
+                return None
+            out.append([name, size, mtime, sha])
+            continue
         path = root / name  # an absolute name stays as it is
         try:
             st = os.stat(path)

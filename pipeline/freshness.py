@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from mpc.core.packages import PackageResolver
 from mpc.core.version import source_version
 from mpc.pipeline.fingerprint import data_digest, dep_name, deps_current, digest
 from mpc.pipeline.plan import Plan, PlannedModel
@@ -29,6 +30,7 @@ class Freshness:
         # Package folders inside the root are named relative to it, as the files a build read.
         packages = repr(sorted((k, dep_name(v, plan.root)) for k, v in package_map.items()))
         self.options = digest(source_version(), packages, str(werror))
+        self.resolver = PackageResolver(package_map=dict(package_map))  # where packages are now
 
     def before_build(self, model: PlannedModel, this_run: Mapping[str, str | None]) -> str:
         """What is known before building: mpc and the options, the definition as planned,
@@ -47,7 +49,7 @@ class Freshness:
         failure = self.store.state(name).get("failure")
         if self.force or failure is None or failure["pre"] != pre:
             return None
-        return failure if deps_current(failure["deps"], self.plan.root) is not None else None
+        return failure if deps_current(failure["deps"], self.plan.root, self.resolver) is not None else None
 
     def cached_stages(self, name: str, pre: str) -> list[str]:
         """The stages (of `stages`) whose result from an earlier run still holds."""
@@ -56,7 +58,7 @@ class Freshness:
         if (self.force or state.get("pre") != pre or "compile" not in done
                 or not self.store.output(name).is_dir()):
             return []
-        deps = deps_current(state.get("deps", []), self.plan.root)
+        deps = deps_current(state.get("deps", []), self.plan.root, self.resolver)
         if deps is None:
             return []
         if deps != state.get("deps", []):  # only times changed: remember them, so the next run stats only

@@ -19,7 +19,7 @@ from typing import Any
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.reads import ReadRecorder
 from mpc.core.span import Span
-from mpc.pipeline.fingerprint import dep_entry
+from mpc.pipeline.fingerprint import dep_entry, package_entry
 from mpc.pipeline.stages import STAGES, StageJob, StageOutcome, ensure_program, first_error
 
 
@@ -77,4 +77,6 @@ def run_stages(job: StageJob, run: list[str], cached: list[str], recorder: ReadR
                           "blocked": bool(missing)}
         if name == "compile":
             deps = [e for p in recorder.inputs() if (e := dep_entry(p, job.root)) is not None]
+            deps += [package_entry(package, near, found, job.root)
+                     for (package, near), found in recorder.packages.items()]
     return {"outcomes": outcomes, "deps": deps}

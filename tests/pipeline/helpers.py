@@ -39,13 +39,21 @@ def env(cache: Path) -> dict[str, str]:
     return {**os.environ, "MPC_CACHE_DIR": str(cache)}
 
 
-def mpc(*args: str | Path, cwd: Path | None = None,
-        cache: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return mpc_process(*args, cwd=cwd, env=env(cache) if cache else None)
+def mpc(*args: str | Path, cwd: Path | None = None, cache: Path | None = None,
+        environ: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """`mpc ARGS` as a process; `environ`: variables set (or, when "", removed) for it."""
+    changed = env(cache) if cache else dict(os.environ)
+    for name, value in (environ or {}).items():
+        if value:
+            changed[name] = value
+        else:
+            changed.pop(name, None)
+    return mpc_process(*args, cwd=cwd, env=changed if cache or environ else None)
 
 
-def run_json(pipeline: Path, *args: str, cache: Path, cwd: Path | None = None) -> Run:
-    done = mpc("run", pipeline, "--log-format", "json", *args, cwd=cwd, cache=cache)
+def run_json(pipeline: Path, *args: str, cache: Path, cwd: Path | None = None,
+             environ: dict[str, str] | None = None) -> Run:
+    done = mpc("run", pipeline, "--log-format", "json", *args, cwd=cwd, cache=cache, environ=environ)
     events = [json.loads(line) for line in done.stdout.splitlines()]
     end = events[-1]
     assert end["event"] == "end", done.stdout + done.stderr

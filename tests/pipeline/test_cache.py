@@ -9,12 +9,14 @@ found through `--package`), its dependant `child`, and `other` (an installed URD
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from pathlib import Path
 
 import pytest
 
+from mpc.pipeline.fingerprint import PACKAGE
 from tests.conftest import ERD, write
 from tests.pipeline.helpers import run_json
 
@@ -137,6 +139,33 @@ def test_package_folders_and_werror_are_part_of_the_fingerprint(project: Path, t
     assert _rebuilt(_run(project)) == ALL  # back to the project's own copy
     assert _rebuilt(_run(project, "--werror")) == ALL
     assert _rebuilt(_run(project, "--werror")) == set()
+
+
+def test_where_ros_package_path_finds_a_package_is_part_of_the_fingerprint(project: Path,
+                                                                          tmp_path: Path) -> None:
+    """Another copy of a package named by ROS_PACKAGE_PATH rebuilds the models that found it
+    there, though no file they read changed; the same copy again rebuilds nothing."""
+    copies = {}
+    for name in ("a", "b"):
+        copies[name] = tmp_path / name
+        shutil.copytree(project / "erd", copies[name] / "example-robot-data")
+    pipeline, cache = project / "ci/pipeline.yml", tmp_path / "cache"
+
+    def rebuilt(ros_package_path: str) -> set[str]:
+        run = run_json(pipeline, cache=cache, environ={"ROS_PACKAGE_PATH": ros_package_path,
+                                                       "AMENT_PREFIX_PATH": ""})
+        assert run.returncode == 0, run.stderr
+        return _rebuilt(run.states())
+
+    assert rebuilt(str(copies["a"])) == ALL  # no --package: another fingerprint
+    assert rebuilt(str(copies["a"])) == set()
+    assert rebuilt(str(copies["b"])) == {"base", "child"}
+    assert rebuilt(str(copies["b"])) == set()
+    state = json.loads((project / "build/.mpc/state/base.json").read_text())
+    found = str(copies["b"] / "example-robot-data")
+    assert sorted(d for d in state["deps"] if d[1] == PACKAGE) == [  # from the definition, the URDF
+        [f"package://example-robot-data\0{found}/robots/{DOUBLE_PENDULUM}/urdf", PACKAGE, 0, found],
+        ["package://example-robot-data\0models", PACKAGE, 0, found]]
 
 
 def test_touching_every_file_or_running_from_another_folder_rebuilds_nothing(project: Path,

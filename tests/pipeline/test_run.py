@@ -20,6 +20,8 @@ import pinocchio as pin
 import pytest
 from lxml import etree
 
+from mpc.pipeline.fingerprint import PACKAGE
+from tests.conftest import ERD_PACKAGE
 from tests.pipeline.helpers import Run, copy_fleet, mpc, run_json
 
 BUILT = ["arm", "arm_prefixed", "arm_short", "arm_shoulder", "quad", "quad_front", "quad_hind",
@@ -130,14 +132,18 @@ def test_pipeline_default_export_config_applies_to_models_without_one(fleet: Fle
 
 def test_the_state_lists_the_files_the_build_read(fleet: Fleet) -> None:
     state = json.loads((fleet.build / ".mpc/state/arm.json").read_text())
+    files = [d for d in state["deps"] if d[1] != PACKAGE]
     # Files inside the root by their path from it (a clone elsewhere keeps its cache), others absolute.
-    assert {"arm.yml", "ur5.urdf"} <= {d[0] for d in state["deps"]}
-    read = {fleet.pipeline.parent / d[0] for d in state["deps"]}
+    assert {"arm.yml", "ur5.urdf"} <= {d[0] for d in files}
+    read = {fleet.pipeline.parent / d[0] for d in files}
     meshes = {p.name for p in read if p.suffix in (".dae", ".stl")}
     assert {"base.dae", "shoulder.dae", "wrist3.dae", "base.stl", "wrist3.stl"} <= meshes
     assert all(p.suffix not in (".py", ".pyc", ".so") for p in read)
     assert not any(fleet.cache in p.parents or fleet.build in p.parents for p in read)
-    assert all(len(d[3]) == 64 for d in state["deps"])
+    assert all(len(d[3]) == 64 for d in files)
+    # ur5.urdf's meshes are package:// paths: where the package was found is a dep too.
+    assert [d for d in state["deps"] if d[1] == PACKAGE] == [
+        ["package://example-robot-data\0.", PACKAGE, 0, str(ERD_PACKAGE)]]
 
 
 def test_second_run_rebuilds_nothing(fleet: Fleet) -> None:
