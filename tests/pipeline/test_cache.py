@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from mpc.pipeline.fingerprint import PACKAGE
+from mpc.core.packages import PackageResolver
+from mpc.pipeline.fingerprint import PACKAGE, deps_current, package_entry
 from tests.conftest import ERD, write
 from tests.pipeline.helpers import run_json
 
@@ -232,3 +233,17 @@ def test_mpc_version_hashes_the_sources_of_mpc_and_nothing_else() -> None:
     packages = {name.split("/")[0] for name in names}
     assert packages == {"backends", "checks", "cli", "compiler", "core", "deploy", "grammar", "ir",
                         "lsp", "pipeline"}
+
+
+def test_a_package_not_found_then_found_makes_the_deps_stale(tmp_path: Path) -> None:
+    """A build that failed because a package was not found is built again once it is found
+    (its failure is not "unchanged since it failed")."""
+    (tmp_path / "share/nopkg").mkdir(parents=True)
+    deps = [package_entry("nopkg", str(tmp_path / "models"), None, tmp_path)]
+    assert deps == [["package://nopkg\0models", PACKAGE, 0, "missing"]]
+    nowhere = PackageResolver(search_path=[])
+    assert deps_current(deps, tmp_path, nowhere) == deps
+    found = PackageResolver(search_path=[tmp_path / "share"])
+    assert deps_current(deps, tmp_path, found) is None
+    assert package_entry("nopkg", "", str(tmp_path / "share/nopkg"), tmp_path) == [
+        "package://nopkg\0", PACKAGE, 0, "share/nopkg"]
