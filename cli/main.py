@@ -213,9 +213,9 @@ def program() -> NoReturn:
     Python frees every object of every module at exit; after a build that loaded trimesh and
     SciPy that took 0.2 s, a tenth of a cold build. What of the teardown matters is done here
     first: the atexit functions (multiprocessing's, tempfile's, logging's) and the standard
-    streams; mpc's own files are closed when written (core/files.py). A process that still runs
-    another thread, or runs under a profiler or tracer (cProfile, coverage: they write their
-    results at the end), ends the usual way."""
+    streams, C's too (what a C library printed); mpc's own files are closed when written
+    (core/files.py). A process that still runs another thread, or runs under a profiler or
+    tracer (cProfile, coverage: they write their results at the end), ends the usual way."""
     try:
         code = main()
     except SystemExit as e:
@@ -228,6 +228,10 @@ def program() -> NoReturn:
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):  # a closed pipe: what it took is all there is
             stream.flush()
+    with contextlib.suppress(ImportError, OSError, AttributeError):  # C's streams: PyBullet prints
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
     os._exit(code)
 
 

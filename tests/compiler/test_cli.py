@@ -191,21 +191,22 @@ def test_a_colcon_symlink_install_workspace_is_read_through_its_links(tmp_path: 
 def test_the_program_ends_with_mains_status_its_atexit_work_done_and_its_output_whole(
         tmp_path: Path) -> None:
     """`mpc` skips the interpreter's teardown (cli/main.py: program); what users see of the
-    end stays: the exit status, every byte written to a pipe, and the atexit functions run
-    (multiprocessing's and tempfile's among them)."""
+    end stays: the exit status, every byte written to a pipe (by Python or by C's stdio), and
+    the atexit functions run (multiprocessing's and tempfile's among them)."""
     arm(tmp_path)
     good = write(tmp_path / "good.yml", definition("arm.urdf"))
     bad = write(tmp_path / "bad.yml", definition("arm.urdf").replace("robotname:", "robtname:"))
-    probe = ("import atexit, sys\nfrom mpc.cli.main import program\n"
+    probe = ("import atexit, ctypes, sys\nfrom mpc.cli.main import program\n"
              "atexit.register(lambda: print('atexit ran', file=sys.stderr))\n"
              "print('before mpc', end='')  # left in the buffer of a pipe\n"
+             "ctypes.CDLL(None).printf(b' and C')  # in C's, as a C library prints\n"
              "sys.argv = ['mpc', *sys.argv[1:]]\nprogram()\n")
     buffered = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
     for args, status in (([good, "-o", tmp_path / "out"], 0), ([bad], 1), (["--bogus"], 2)):
         run = subprocess.run([sys.executable, "-c", probe, "compile", *map(str, args)],
                              capture_output=True, text=True, timeout=600, env=buffered)
         assert run.returncode == status, run.stderr
-        assert run.stdout.startswith("before mpc")
+        assert run.stdout.startswith("before mpc") and run.stdout.endswith(" and C")
         assert run.stderr.endswith("atexit ran\n")
     assert (tmp_path / "out/urdf/robot.urdf").is_file()
     assert mpc_process("compile", bad).stderr.endswith(f"error: could not compile '{bad}' (2 errors)\n")
