@@ -259,9 +259,9 @@ class Runner:
         ignore = [self.store.build.resolve(), cache_dir("x").parent]
         process = ctx.Process(target=worker.main, name=f"mpc {name}",
                               args=(job, run, cached, send, ignore, self.opts.werror))
+        now = time.perf_counter()  # before the fork: the worker's stages may start before it returns
         process.start()
         send.close()
-        now = time.perf_counter()
         self.running[name] = _Running(name, process, receive, pre, run, cached, now)
         self.status.models[name].started = now - self.start
         self.reporter.started(name, process.pid or 0)
