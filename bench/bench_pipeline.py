@@ -69,13 +69,13 @@ def run(pipeline: Path, *args: str, env: dict[str, str], sample: bool = False) -
             peak = max(peak, _tree_rss(proc.pid))
             time.sleep(0.02)
 
-    sampler = threading.Thread(target=sample_memory)
-    if sample:
+    sampler = threading.Thread(target=sample_memory) if sample else None
+    if sampler is not None:
         sampler.start()
     _, status, usage = os.wait4(proc.pid, 0)
     seconds = time.perf_counter() - t0
     done.set()
-    if sample:
+    if sampler is not None:
         sampler.join()
     proc.returncode = os.waitstatus_to_exitcode(status)
     assert proc.returncode == 1, "the fleet has one broken model: exit status 1 expected"

@@ -7,12 +7,10 @@ Exit status: 0 success, 1 the input has errors, 2 the command line is wrong,
 from __future__ import annotations
 
 import argparse
-import atexit
 import contextlib
 import gc
 import os
 import sys
-import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import NoReturn
@@ -222,6 +220,9 @@ def program() -> NoReturn:
         if not isinstance(e.code, int | None):
             raise
         code = e.code or 0
+    import atexit
+    import threading  # here: not on the path of `mpc check` before it has answered
+
     if threading.active_count() > 1 or sys.gettrace() is not None or sys.getprofile() is not None:
         sys.exit(code)
     atexit._run_exitfuncs()

@@ -71,22 +71,20 @@ def _setstate(self: Any, state: tuple[Any, ...]) -> None:
         object.__setattr__(self, name, value)
 
 
-def _fast_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
-    """dataclass's `__init__` of the slots record `cls` (`slow`), written with the slots'
-    setters: the same parameters and defaults (taken from `slow`), each default_factory
-    called for its sentinel, the fields set in order, then `__post_init__`. `slow` itself
-    for what it does not cover (InitVar or init=False fields, fields kept in a __dict__)."""
+def _parameters(cls: type, slow: Callable[..., None], env: dict[str, Any]
+                ) -> tuple[list[str], dict[str, str]] | None:
+    """What generated code needs of dataclass's `__init__` (`slow`) of `cls`: its parameters
+    as source, their defaults bound in `env` (as `_d_NAME`), and for each field the expression
+    of its value (a default_factory, as `_f_NAME`, called for dataclass's sentinel); None when
+    the fields are not the parameters (InitVar or init=False fields)."""
     code, own = slow.__code__, fields(cls)  # type: ignore[arg-type]
     params = code.co_varnames[1:code.co_argcount + code.co_kwonlyargcount]
-    setters = [getattr(cls, f.name, None) for f in own]
-    if (sorted(params) != sorted(f.name for f in own) or not all(f.init for f in own)
-            or not all(isinstance(s, types.MemberDescriptorType) for s in setters)):
-        return slow
+    if sorted(params) != sorted(f.name for f in own) or not all(f.init for f in own):
+        return None
     positional, keyword = params[:code.co_argcount - 1], params[code.co_argcount - 1:]
     defaults = dict(zip(positional[len(positional) - len(slow.__defaults__ or ()):],
                         slow.__defaults__ or (), strict=True))
     defaults.update(slow.__kwdefaults__ or {})
-    env: dict[str, Any] = {}
 
     def param(name: str) -> str:
         if name not in defaults:
@@ -94,23 +92,43 @@ def _fast_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
         env[f"_d_{name}"] = defaults[name]
         return f"{name}=_d_{name}"
 
-    stars = ["*", *map(param, keyword)] if keyword else []
-    signature = ", ".join(["self", *map(param, positional), *stars])
+    values = {}
+    for f in own:
+        values[f.name] = f.name
+        if f.default_factory is not MISSING:  # its parameter's default is dataclass's sentinel
+            env[f"_f_{f.name}"] = f.default_factory
+            values[f.name] = f"_f_{f.name}() if {f.name} is _d_{f.name} else {f.name}"
+    return [*map(param, positional), *(["*", *map(param, keyword)] if keyword else [])], values
+
+
+def _compiled(source: str, env: dict[str, Any], name: str) -> Callable[..., Any]:
+    namespace: dict[str, Any] = {}
+    exec(compile(source, "<record>", "exec"), env, namespace)
+    return namespace[name]  # type: ignore[no-any-return]
+
+
+def _fast_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
+    """dataclass's `__init__` of the slots record `cls` (`slow`), written with the slots'
+    setters: the same parameters and defaults (taken from `slow`), each default_factory
+    called for its sentinel, the fields set in order, then `__post_init__`. `slow` itself
+    for what it does not cover (InitVar or init=False fields, fields kept in a __dict__)."""
+    own = fields(cls)  # type: ignore[arg-type]
+    setters = [getattr(cls, f.name, None) for f in own]
+    env: dict[str, Any] = {}
+    found = _parameters(cls, slow, env)
+    if found is None or not all(isinstance(s, types.MemberDescriptorType) for s in setters):
+        return slow
+    params, values = found
     body = []
     for f, setter in zip(own, setters, strict=True):
         env[f"_s_{f.name}"] = setter.__set__  # type: ignore[union-attr]
-        value = f.name
-        if f.default_factory is not MISSING:  # its parameter's default is dataclass's sentinel
-            env[f"_f_{f.name}"] = f.default_factory
-            value = f"_f_{f.name}() if {f.name} is _d_{f.name} else {f.name}"
-        body.append(f"    _s_{f.name}(self, {value})\n")
+        body.append(f"    _s_{f.name}(self, {values[f.name]})\n")
     if hasattr(cls, "__post_init__"):
         body.append("    self.__post_init__()\n")
-    namespace: dict[str, Any] = {}
-    exec(compile(f"def __init__({signature}):\n{''.join(body) or '    pass'}", "<record>", "exec"),
-         env, namespace)
-    fast = namespace["__init__"]
-    fast.__qualname__, fast.__wrapped__ = slow.__qualname__, slow  # inspect.signature shows slow's
+    fast = _compiled(f"def __init__({', '.join(['self', *params])}):\n{''.join(body) or '    pass'}",
+                     env, "__init__")
+    # inspect.signature shows slow's
+    fast.__qualname__, fast.__wrapped__ = slow.__qualname__, slow  # type: ignore[attr-defined]
     return fast
 
 
@@ -150,39 +168,20 @@ def _maker(cls: Any) -> Callable[..., Any]:
     if (slow is None or cls.__bases__ != (object,)
             or getattr(cls, "__slots__", None) != tuple(f.name for f in own)):
         return cls  # type: ignore[no-any-return]
-    code = slow.__code__
-    params = code.co_varnames[1:code.co_argcount + code.co_kwonlyargcount]
-    if sorted(params) != sorted(f.name for f in own) or not all(f.init for f in own):
-        return cls  # type: ignore[no-any-return]
-    positional, keyword = params[:code.co_argcount - 1], params[code.co_argcount - 1:]
-    defaults = dict(zip(positional[len(positional) - len(slow.__defaults__ or ()):],
-                        slow.__defaults__ or (), strict=True))
-    defaults.update(slow.__kwdefaults__ or {})
     env: dict[str, Any] = {"_cls": cls, "_twin": type(cls.__name__, (), {"__slots__": cls.__slots__})}
-
-    def param(name: str) -> str:
-        if name not in defaults:
-            return name
-        env[f"_d_{name}"] = defaults[name]
-        return f"{name}=_d_{name}"
-
-    stars = ["*", *map(param, keyword)] if keyword else []
-    lines = [f"def make({', '.join([*map(param, positional), *stars])}):\n", "    self = _twin()\n"]
-    for f in own:
-        value = f.name
-        if f.default_factory is not MISSING:  # its parameter's default is dataclass's sentinel
-            env[f"_f_{f.name}"] = f.default_factory
-            value = f"_f_{f.name}() if {f.name} is _d_{f.name} else {f.name}"
-        lines.append(f"    self.{f.name} = {value}\n")
+    found = _parameters(cls, slow, env)
+    if found is None:
+        return cls  # type: ignore[no-any-return]
+    params, values = found
+    lines = [f"def make({', '.join(params)}):\n", "    self = _twin()\n"]
+    lines += [f"    self.{f.name} = {values[f.name]}\n" for f in own]
     lines.append("    self.__class__ = _cls\n")
     if hasattr(cls, "__post_init__"):
         lines.append("    self.__post_init__()\n")
     lines.append("    return self\n")
-    namespace: dict[str, Any] = {}
-    exec(compile("".join(lines), "<record>", "exec"), env, namespace)
-    make = namespace["make"]
+    make = _compiled("".join(lines), env, "make")
     make.__qualname__ = f"{cls.__qualname__}.make"
-    return make  # type: ignore[no-any-return]
+    return make
 
 
 @overload
