@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from mpc.checks import bullet, dynamics, masses, pictures, process, topology, validity  # noqa: F401  (registration)
+from mpc.checks.compare_name import compare_name
 from mpc.checks.models import Model, load_built, load_compare
 from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
@@ -49,7 +50,7 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     if plan.compare is not None:
         ctx.old, ctx.old_problem = _load(load_compare, plan.compare, workdir)
         target = plan.compare
-        where = target.git or str(target.path)
+        where = compare_name(target, Path(program.span.file) if program.span.file else None)
         if ctx.old is None:
             sink.error(target.span, "E0704", ctx.old_problem)
             protocol.compare = f"`{where}`, which could not be loaded"

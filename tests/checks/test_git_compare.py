@@ -65,7 +65,8 @@ def test_compare_at_a_commit_finds_the_difference_and_a_waiver_for_another_commi
     keys = compare(repo, commit=first[:10], ignore_failing_tests_for=second[:8])
     write(tmp_path / "m.yml", definition(heavier_solo(tmp_path), "solo", TESTS, keys))
     protocol = run(tmp_path / "m.yml", tmp_path / "out", tmp_path / "work")
-    assert protocol.compare == f"`{repo}` at commit `{first[:12]}`"
+    assert protocol.compare == f"`models.git` at commit `{first[:12]}`"  # not the runner's path
+    assert f"\n\nCompared with `models.git` at commit `{first[:12]}`.\n\n" in protocol.markdown()
     assert protocol.waiver == ""
     assert failing(protocol) == {"compare_link_masses", "compare_masses", "compare_com"}  # 50 g on 2.5 kg
     assert statuses(protocol)["compare_link_masses"] == "failed"
