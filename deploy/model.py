@@ -24,6 +24,7 @@ from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
 from mpc.deploy.repository import Clone, locked, open_clone, publish
 from mpc.deploy.result import DeployResult, record_push
 from mpc.deploy.settings import DeploySettings
+from mpc.deploy.test_outcome import TestOutcome, test_outcome
 from mpc.ir.program import Program
 
 
@@ -32,6 +33,9 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
                  pictures: Path | None = None) -> DeployResult:
     """Deploy the build of `program` in `built` (what `mpc compile` wrote).
 
+    protocol_markdown, tests_failed: the caller's test protocol and verdict; without a
+    protocol, the one `mpc test` wrote into the build decides (deploy/test_outcome.py), and a
+    protocol that says its tests failed sends the model to the failure branch.
     pictures: the folder of the protocol's pictures (`test_pictures/` beside it), committed
     with the model when it is not the build's own; the merge request links them.
 
@@ -49,10 +53,10 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
         for entry in content.not_deployed(built):
             sink.warning(span, "W0840", f"the build's '{entry}' is not deployed: mpc writes no git "
                          "metadata from a build into a repository")
+        tests = test_outcome(built, protocol_markdown, tests_failed)
         workdir = _workdir(settings.workdir)
         with locked(workdir / program.modelname):
-            _deploy(program, built.resolve(), remote, workdir, settings, result, protocol_markdown,
-                    tests_failed, pictures)
+            _deploy(program, built.resolve(), remote, workdir, settings, result, tests, pictures)
     except DeployError as e:
         sink.error(span, e.code, e.message)
         result.ok = False
@@ -97,13 +101,13 @@ def _workdir(folder: Path) -> Path:
 
 
 def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings: DeploySettings,
-            result: DeployResult, protocol: str | None, tests_failed: bool,
-            pictures: Path | None = None) -> None:
+            result: DeployResult, tests: TestOutcome, pictures: Path | None = None) -> None:
     clone = open_clone(remote, workdir / program.modelname, settings.remote_name)
-    plan = make_plan(program, settings, clone.url, clone.default_branch, tests_failed)
+    plan = make_plan(program, settings, clone.url, clone.default_branch, tests.failed)
     check_plan_branches(plan)
     result.branch = plan.branch
-    prov = provenance(program, settings.definition_repo, protocol, tests_failed)
+    protocol = tests.markdown
+    prov = provenance(program, settings.definition_repo, tests)
     message = commit_message(program, prov)
 
     pinned = [submodules.pin(s, clone.url, plan.base, workdir) for s in plan.submodules]

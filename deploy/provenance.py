@@ -8,12 +8,12 @@ summary. It reads files and repositories; it writes nothing.
 from __future__ import annotations
 
 import hashlib
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.core.version import mpc_version
 from mpc.deploy.gitcmd import scrub, without_credentials
+from mpc.deploy.test_outcome import TestOutcome
 from mpc.ir.program import Program
 
 
@@ -52,8 +52,7 @@ class Provenance:
     tests: str
 
 
-def provenance(program: Program, definition_repo: Path | None, protocol: str | None,
-               tests_failed: bool) -> Provenance:
+def provenance(program: Program, definition_repo: Path | None, tests: TestOutcome) -> Provenance:
     """The provenance of `program`, built from the files it names."""
     definition = definition_file = None
     file = Path(program.span.file) if program.span.file else None
@@ -83,19 +82,7 @@ def provenance(program: Program, definition_repo: Path | None, protocol: str | N
             parts.append(f"sha256 {digest}")
         inputs.append(" ".join(parts))
     return Provenance(definition, definition_file, mpc_version(), tuple(inputs),
-                      test_summary(protocol, tests_failed))
-
-
-_COUNTS = re.compile(r"\b\d+ (?:passed|failed|skipped)\b(?:[,;]? *\d+ (?:passed|failed|skipped)\b)*")
-
-
-def test_summary(protocol: str | None, tests_failed: bool) -> str:
-    """`passed` / `failed` / `not run`, with the protocol's own counts when it states them."""
-    if protocol is None:
-        return "failed" if tests_failed else "not run"
-    outcome = "failed" if tests_failed else "passed"
-    counts = _COUNTS.search(protocol)
-    return f"{outcome} ({counts.group(0)})" if counts else outcome
+                      tests.summary())
 
 
 def commit_message(program: Program, prov: Provenance) -> str:

@@ -92,12 +92,30 @@ def open_clone(url: str, folder: Path, remote: str = "origin") -> Clone:
 
 
 def _default_branch(git: Git, remote: str) -> str:
-    """The remote's HEAD branch; for an empty remote, the unborn branch the clone got."""
+    """The remote's HEAD branch, asked of the remote on every run: never the clone's own
+    HEAD, which names whatever branch the last run (a failed one, say) checked out."""
     listing = git("ls-remote", "--symref", remote, "HEAD", check=False)
     for line in listing.splitlines():
         if line.startswith("ref: refs/heads/") and line.endswith("\tHEAD"):
             return line[len("ref: refs/heads/"):-len("\tHEAD")]
-    head = git("symbolic-ref", "-q", "HEAD", check=False)
+    return _unborn_head(git, remote)
+
+
+def _unborn_head(git: Git, remote: str) -> str:
+    """The branch an empty remote's HEAD names (or a remote whose HEAD branch has no commit
+    yet, while other branches have): `ls-remote` does not show it, but a clone gets it. The
+    clone follows HEAD alone, so it fetches nothing; it goes into a scratch folder of the
+    clone's `.git`. `master` when even that fails."""
+    import tempfile
+
+    url = git("remote", "get-url", remote, check=False)
+    scratch = git.folder / ".git" / "mpc-probe"
+    scratch.mkdir(exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=scratch) as folder:
+        probe = Git(Path(folder) / "head")
+        status, _, _ = Git(Path(folder)).result("clone", "-q", "--bare", "--no-local", "--single-branch",
+                                                "--no-tags", "--depth", "1", "--", url, str(probe.folder))
+        head = probe("symbolic-ref", "-q", "HEAD", check=False) if status == 0 else ""
     return head.removeprefix("refs/heads/") if head.startswith("refs/heads/") else "master"
 
 
