@@ -1,5 +1,6 @@
-"""A robot's meshes → W0582 for each closed mesh that a mesh op (reduce_meshes,
-convex_decomposition, apply_scale by a zero factor) left open; it changes nothing.
+"""A robot's collision meshes → W0582, once per mesh, for each closed mesh that a mesh op
+(reduce_meshes, convex_decomposition, apply_scale by a zero factor) left open; it changes
+nothing.
 
 A reflection (mirror) or a scale by non-zero factors keeps a closed mesh closed: the same
 triangles, their winding reversed where the mesh is reflected (tests/backends/
@@ -29,24 +30,32 @@ def _may_open(op: MeshOp) -> bool:
 
 
 def check_closed(robot: Robot, sink: Sink, span: Span) -> None:
-    """Warn (W0582) for each mesh that was closed and is not after one of its ops, naming the
-    link, the element and the op. Unreadable meshes are left to the mesh export (E0602)."""
+    """Warn (W0582) once for each mesh that was closed and is not after one of its ops,
+    naming the links whose collisions use it and the op. Only a collision serves as a solid
+    (volumes, centres, inertias, `join: union`): a visual that comes apart only looks so.
+    Unreadable meshes are left to the mesh export (E0602)."""
     from mpc.backends.meshes import mesh_uses
 
-    seen: set[tuple[str, str, object]] = set()
+    users: dict[tuple[object, object], tuple[Mesh, list[str]]] = {}
     for use in mesh_uses(robot):
         mesh = use.mesh
         joined = bool(mesh.ops) and isinstance(mesh.ops[0], JoinShapes)  # made of parts: no file to read
-        if joined or not any(_may_open(op) for op in mesh.ops):
+        if use.element != "collision" or joined or not any(_may_open(op) for op in mesh.ops):
             continue
         if mesh.source.path is None or not mesh.source.path.is_file():
             continue
+        links = users.setdefault((mesh.source.path, mesh.ops), (mesh, []))[1]
+        if use.link not in links:
+            links.append(use.link)
+    for mesh, links in users.values():
         opened = opened_by(mesh)
-        if opened is None or (use.link, use.element, mesh) in seen:
+        if opened is None:
             continue
-        seen.add((use.link, use.element, mesh))
-        sink.warning(mesh.span or span, "W0582", f"mesh '{mesh.source.uri}' of a {use.element} of link "
-                     f"'{use.link}' is a closed solid but not after {opened}",
+        named = f"link '{links[0]}'" if len(links) == 1 else \
+            "links " + ", ".join(f"'{link}'" for link in links[:3]) + (f" and {len(links) - 3} more"
+                                                                      if len(links) > 3 else "")
+        sink.warning(mesh.span or span, "W0582", f"mesh '{mesh.source.uri}' of a collision of {named} "
+                     f"is a closed solid but not after {opened}",
                      hint="volumes and inertias from it use its convex hull; try a gentler reduction")
 
 

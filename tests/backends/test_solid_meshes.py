@@ -152,3 +152,46 @@ def test_a_reduction_that_opens_a_closed_mesh_is_a_warning(tmp_path: Path,
     out = _compile(tmp_path / "b", text.replace("FACES", "20"), quiet)
     for path in (out / "meshes/stl").glob("*collision*"):
         assert closed(trimesh.load(path, force="mesh")), path.name
+
+
+def test_a_mesh_opened_by_a_reduction_is_one_warning_and_only_as_a_collision(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """UR5's wrist mesh, used by the visual and the collision of four links, comes apart at 4
+    faces: one W0582 for the mesh, naming the links whose collisions use it (a visual is no
+    solid); used by visuals alone, it is not warned about at all."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    wrist = ERD / "ur_description/meshes/ur5/collision/wrist1.stl"
+
+    def robot(collisions: bool) -> str:
+        links, joints = [], []
+        for i in range(4):
+            shape = f'<geometry><mesh filename="{wrist}"/></geometry>'
+            collision = f"<collision>{shape}</collision>" if collisions else ""
+            links.append(f'<link name="l{i}"><visual>{shape}</visual>{collision}</link>')
+            if i:
+                joints.append(f'<joint name="j{i}" type="fixed"><parent link="l{i - 1}"/>'
+                              f'<child link="l{i}"/></joint>')
+        return f'<robot name="wrists">{"".join(links)}{"".join(joints)}</robot>\n'
+
+    for name, collisions in (("both", True), ("visual", False)):
+        write(tmp_path / name / "wrists.urdf", robot(collisions))
+        text = """
+            model:
+              robotname: wrists
+              modelname: wrists
+              input_models: {src: {basefile: wrists.urdf}}
+              assemble: {model: src}
+              reduce_meshes: 4
+              export_config:
+                - type: urdf
+                  mesh_format: stl
+            """
+        sink = Diags()
+        _compile(tmp_path / name, text, sink)
+        found = [d.message for d in sink.diagnostics if d.code == "W0582"]
+        if collisions:
+            assert found == [f"mesh '{wrist}' of a collision of links 'l0', 'l1', 'l2' and 1 more is a "
+                             "closed solid but not after reduce_meshes"]
+        else:
+            assert found == []
+        sink.diagnostics[:] = [d for d in sink.diagnostics if d.code != "W0582"]
