@@ -26,6 +26,7 @@ from mpc.ir.geometry import (
     ConvexHull,
     ConvexPart,
     JoinShapes,
+    MaterialPart,
     Mesh,
     MeshOp,
     ReduceMesh,
@@ -118,7 +119,11 @@ _SUFFIXES = {ReflectMesh: "_mirrored", ConvexHull: "_hull", JoinShapes: "_joined
 
 
 def _op_suffix(op: MeshOp) -> str:
-    return f"_part{op.index}" if isinstance(op, ConvexPart) else _SUFFIXES[type(op)]
+    if isinstance(op, ConvexPart):
+        return f"_part{op.index}"
+    if isinstance(op, MaterialPart):
+        return f"_material{op.index}"
+    return _SUFFIXES[type(op)]
 
 
 def _suffix(ops: tuple[MeshOp, ...]) -> str:

@@ -24,6 +24,7 @@ from typing import Any, Literal
 import numpy as np
 
 from mpc.backends import meshes
+from mpc.backends.dae_colours import coloured
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir.program import RENDER_VIEWS
@@ -143,7 +144,7 @@ class Scene:
 
         from mpc.backends import mjcf
 
-        robot = _drawable(robot)
+        robot = coloured(_drawable(robot))
         files = _mesh_files(robot, workdir, sink, span)
         if files is None:
             return None

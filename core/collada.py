@@ -12,6 +12,7 @@ random ids; `stable` makes it the same bytes for the same mesh (mpc's outputs ar
 
 from __future__ import annotations
 
+import contextlib
 import io
 import re
 from pathlib import Path
@@ -24,6 +25,9 @@ from mpc.core.span import hardened_parser
 if TYPE_CHECKING:
     import collada
 
+RGBA = tuple[float, float, float, float]
+COLOURS = "1"  # changes when the colours read change, so old cache entries go unused
+
 
 def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:
     """The triangles of a DAE file, scaled to metres by its `<unit>`, and the broken references
@@ -34,12 +38,7 @@ def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:
     is turned into a mesh as trimesh's own COLLADA loader does, so the triangles, texture
     coordinates and names are those that `trimesh.load` gives.
     """
-    data = path.read_bytes()
-    document = _parse(data)
-    broken = tuple(sorted({str(getattr(e, "msg", e)) for e in document.errors}))
-    if broken:
-        data = _without_material_bindings(data)
-        document = _parse(data, strict=False)
+    document, data, broken = _document(path)
     mesh = _as_trimesh(document)
     mesh.apply_scale(_unit(data))
     return mesh, broken
@@ -71,11 +70,22 @@ def _parse(data: bytes, strict: bool = True) -> collada.Collada:
 def _as_trimesh(document: collada.Collada) -> trimesh.Trimesh:
     """The document's geometry as one mesh, as `trimesh.load(…, force="mesh", process=False)`
     makes it (trimesh.exchange.dae.load_collada, given the parsed document)."""
+    return _scene(document).to_mesh()
+
+
+def _scene(document: collada.Collada) -> trimesh.Scene:
+    """The document as trimesh's scene: one geometry per primitive, each with its material
+    (a material coloured by a texture has no `baseColorFactor`: no colour mpc can draw)."""
+    import collada as pycollada
     import numpy as np
     from trimesh.exchange import dae
     from trimesh.exchange.load import _load_kwargs
 
-    materials = {m.id: dae._parse_material(m.effect, None) for m in document.materials}
+    materials = {}
+    for m in document.materials:
+        materials[m.id] = dae._parse_material(m.effect, None)
+        if isinstance(m.effect.diffuse, pycollada.material.Map):
+            materials[m.id].baseColorFactor = None
     unit = document.assetInfo.unitmeter
     metadata = {"units": "meters"} if unit is None or np.isclose(unit, 1.0) else {"units": f"{unit} * meters"}
     meshes: dict = {}
@@ -84,7 +94,82 @@ def _as_trimesh(document: collada.Collada) -> trimesh.Trimesh:
     for node in document.scene.nodes:
         dae._parse_node(node=node, parent_matrix=dae._EYE, material_map=materials, meshes=meshes,
                         meshes_count=counts, graph=graph, resolver=None, metadata=metadata)
-    return _load_kwargs(process=False, **{"class": "Scene", "graph": graph, "geometry": meshes}).to_mesh()
+    return _load_kwargs(process=False, **{"class": "Scene", "graph": graph, "geometry": meshes})
+
+
+def _document(path: Path) -> tuple[collada.Collada, bytes, tuple[str, ...]]:
+    """The parsed file, the bytes parsed and its broken references: when there are any, the
+    file is parsed again without its material bindings (see the module's docstring)."""
+    data = path.read_bytes()
+    document = _parse(data)
+    broken = tuple(sorted({str(getattr(e, "msg", e)) for e in document.errors}))
+    if broken:
+        data = _without_material_bindings(data)
+        document = _parse(data, strict=False)
+    return document, data, broken
+
+
+def _colour(mesh: trimesh.Trimesh) -> RGBA | None:
+    """The rgba (0..1) of a primitive's material, None when it has none or only a texture."""
+    material = getattr(mesh.visual, "material", None)
+    factor = getattr(material, "baseColorFactor", None)
+    if factor is None:
+        return None
+    return tuple(round(int(c) / 255, 6) for c in factor)  # type: ignore[return-value]
+
+
+_PARTS: dict[tuple[str, str], list[tuple[RGBA | None, trimesh.Trimesh]]] = {}
+
+
+def material_parts(path: Path) -> list[tuple[RGBA | None, trimesh.Trimesh]]:
+    """The file's triangles in metres, one mesh per material colour (None: no colour), in the
+    order the colours first appear; the triangles of all parts are those `read` gives. Kept
+    for the last file read in this process: the parts of one file are asked for one by one."""
+    import numpy as np
+
+    from mpc.core.cache import file_digest
+
+    key = (str(path), file_digest(path))
+    if key not in _PARTS:
+        document, data, _ = _document(path)
+        unit = _unit(data)
+        groups: dict[RGBA | None, list[trimesh.Trimesh]] = {}
+        for piece in _scene(document).dump():
+            groups.setdefault(_colour(piece), []).append(piece)
+        parts = []
+        for colour, pieces in groups.items():
+            vertices, faces, offset = [], [], 0
+            for piece in pieces:
+                vertices.append(np.asarray(piece.vertices))
+                faces.append(np.asarray(piece.faces) + offset)
+                offset += len(piece.vertices)
+            mesh = trimesh.Trimesh(np.concatenate(vertices), np.concatenate(faces), process=False)
+            mesh.apply_scale(unit)
+            parts.append((colour, mesh))
+        _PARTS.clear()
+        _PARTS[key] = parts
+    return _PARTS[key]
+
+
+def material_colours(path: Path) -> tuple[RGBA | None, ...]:
+    """The colours of `material_parts`, in their order; kept in the cache (`meshes/materials/`),
+    so that a render that finds its split meshes in the mesh cache parses nothing."""
+    import json
+
+    from mpc.core.cache import cache_dir, file_digest, load_entry, store_entry
+
+    digest = file_digest(path)
+    entry = cache_dir("meshes") / "materials" / digest[:2] / f"{digest}-{COLOURS}.json"
+    try:
+        data, _ = load_entry(entry)
+        if data is not None:
+            return tuple(None if c is None else tuple(c) for c in json.loads(data))  # type: ignore[misc]
+    except (OSError, ValueError, TypeError):
+        pass  # unusable: computed again
+    colours = tuple(colour for colour, _ in material_parts(path))
+    with contextlib.suppress(OSError):  # a read-only cache: computed again next time
+        store_entry(entry, json.dumps(colours).encode())
+    return colours
 
 
 def _without_material_bindings(data: bytes) -> bytes:

@@ -121,7 +121,16 @@ class ConvexPart:
     scale: Vec3 | None = None
 
 
-MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh | ConvexPart
+@record(slots=True)
+class MaterialPart:
+    """Mesh op, first when present: the triangles of the file's `index`-th material colour (a
+    DAE file's, in the order the colours first appear: core/collada.py `material_parts`).
+    Only pictures use it (backends/scene.py), to draw each material in its colour."""
+
+    index: int
+
+
+MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh | ConvexPart | MaterialPart
 
 
 @record(slots=True, kw_only=True)

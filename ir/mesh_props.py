@@ -20,6 +20,7 @@ from mpc.ir.geometry import (
     Cylinder,
     Geometry,
     JoinShapes,
+    MaterialPart,
     Mesh,
     ReduceMesh,
     ReflectMesh,
@@ -50,6 +51,13 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
     assert isinstance(geometry, Mesh)
     if geometry.ops and isinstance(geometry.ops[0], JoinShapes):
         mesh = None  # the parts make the mesh; the file only names it
+    elif geometry.ops and isinstance(geometry.ops[0], MaterialPart):
+        from mpc.core.collada import material_parts
+
+        try:
+            mesh = material_parts(geometry.source.path)[geometry.ops[0].index][1].copy()  # type: ignore[arg-type]
+        except Exception as e:  # as for a whole file: cannot read this one
+            raise MeshError(f"cannot read mesh '{geometry.source.path}': {e}") from None
     else:
         path = geometry.source.path
         if path is None or not path.is_file():
@@ -82,6 +90,8 @@ def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | Non
                 mesh = mesh.simplify_quadric_decimation(face_count=target)
         elif isinstance(op, ScaleMesh):
             mesh.apply_scale(np.asarray(op.scale))
+        elif isinstance(op, MaterialPart):
+            continue  # read above
         elif isinstance(op, JoinShapes) and op.solid:
             from mpc.ir.solids import to_trimesh, union
 
