@@ -15,6 +15,7 @@ from pathlib import Path
 
 from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.ir.kinematics import zero_within_limits
 from mpc.ir.program import RenderExport
 from mpc.ir.robot import Robot
 
@@ -30,8 +31,11 @@ def file_stem(name: str) -> str:
 
 
 def pose_values(robot: Robot, pose: str) -> dict[str, float]:
-    """The joint values of a pose (`zero`: none), with mimic joints following their joint."""
-    values = dict(robot.poses.get(pose, {})) if pose != ZERO or ZERO in robot.poses else {}
+    """The joint values of a pose (`zero`: none), with mimic joints following their joint.
+    A joint the pose does not name is at 0, or at the limit nearest 0 when its limits leave
+    0 out (`zero_within_limits`, as `mpc view` starts it)."""
+    named = robot.poses.get(pose, {}) if pose != ZERO or ZERO in robot.poses else {}
+    values = {**zero_within_limits(robot), **named}
     for joint in robot.joints.values():
         m = joint.mimic
         if m is not None and m.joint in values and joint.name not in values:
@@ -53,11 +57,27 @@ def poses_of(robot: Robot, export: RenderExport, sink: Sink) -> list[str] | None
     return None if unknown else list(dict.fromkeys(export.poses))
 
 
+def clamped_note(robot: Robot) -> str:
+    """What the pictures draw other than at 0, for a warning or a note: "" when nothing."""
+    moved = zero_within_limits(robot)
+    if not moved:
+        return ""
+    listed = ", ".join(f"'{name}' at {value:g}" for name, value in sorted(moved.items()))
+    return (f"{len(moved)} joint{'s' * (len(moved) > 1)} of robot '{robot.name}' cannot be at 0 within "
+            f"{'their' if len(moved) > 1 else 'its'} limits and {'are' if len(moved) > 1 else 'is'} "
+            f"drawn at the limit nearest 0: {listed}")
+
+
 def draw_all(robot: Robot, export: RenderExport, sink: Sink) -> Mapping[str, bytes] | None:
-    """{file name: PNG bytes} of every pose and view, or None after an error."""
+    """{file name: PNG bytes} of every pose and view, or None after an error. W0590 names
+    the joints drawn at a limit instead of at 0."""
     poses = poses_of(robot, export, sink)
     if poses is None:
         return None
+    note = clamped_note(robot)
+    if note:
+        sink.warning(export.span, "W0590", note, hint="as `mpc view` starts them; name their values "
+                     "in a pose to draw them elsewhere")
     out: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory(prefix="mpc-render-") as work:
         scene = Scene.build(robot, Path(work), sink, export.span, export.geometry, export.background)

@@ -40,12 +40,14 @@ TREE = "kinematic_tree.pdf"  # the model's pdf export, its changed links coloure
 @dataclass
 class VisualDiff:
     """The pictures of a test run. files: {file name: PNG bytes} (written into FOLDER);
-    views: the views drawn, in order; changed: {link: why}; problem: why nothing was drawn."""
+    views: the views drawn, in order; changed: {link: why}; problem: why nothing was drawn;
+    notes: what the pictures show otherwise than asked (joints at a limit instead of at 0)."""
 
     files: dict[str, bytes] = field(default_factory=dict)
     views: tuple[str, ...] = ()
     changed: dict[str, str] = field(default_factory=dict)
     problem: str = ""
+    notes: list[str] = field(default_factory=list)  # joints drawn at a limit instead of at 0
 
     def path(self, view: str, side: str) -> str:
         """A picture's path relative to the protocol."""
@@ -144,6 +146,7 @@ def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, s
     the model's render export (default: iso, front and side at 480×360); a reason instead of
     pictures when they cannot be drawn (no EGL, a model MuJoCo cannot load). tree: also the
     kinematic tree as a PDF with the changed links coloured (the model has a pdf export)."""
+    from mpc.backends.render import ZERO, clamped_note, pose_values
     from mpc.backends.scene import GLMissing, Scene, frame, png
 
     views = render.views if render is not None else ("iso", "front", "side")
@@ -163,7 +166,10 @@ def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, s
                     (d.message for d in quiet.diagnostics if d.severity.name == "ERROR"), "")
                 return out
             scene.colour({link: colour for link in out.changed}, UNCHANGED)
-            scene.pose({})
+            scene.pose(pose_values(robot, ZERO))  # at 0, or at the limit nearest it
+            note = clamped_note(robot)
+            if note:
+                out.notes.append(f"The {side} model: {note}.")
             scenes.append(scene)
         try:
             points = np.concatenate([s.points() for s in scenes])

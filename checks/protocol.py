@@ -152,7 +152,8 @@ class Protocol:
         changed = ", ".join(f"`{link}` ({why})" for link, why in p.changed.items()) or "none"
         lines = ["", "### Pictures", "", "Links changed beyond the tolerances are coloured (blue in the "
                  "release, orange in the new model); the others are grey. The overlay shows both.",
-                 "", f"Changed links: {_cell(changed)}.", "", "| view | release | new | overlay |",
+                 "", f"Changed links: {_cell(changed)}.", *[line for n in p.notes for line in ("", n)],
+                 "", "| view | release | new | overlay |",
                  "|---|---|---|---|"]
         for view in p.views:
             cells = " | ".join(f"![{view}, {side}]({p.path(view, side)})" for side in _SIDES)
@@ -170,7 +171,8 @@ class Protocol:
         p = self.pictures
         pictures = None if p is None else {
             "views": {v: {s: p.path(v, s) for s in _SIDES} for v in p.views} if p.drawn else {},
-            "kinematic_tree": p.tree or None, "changed_links": p.changed, "problem": p.problem}
+            "kinematic_tree": p.tree or None, "changed_links": p.changed, "problem": p.problem,
+            "notes": p.notes}
         return {
             "model": self.model, "failed": self.failed, "counts": self.counts(),
             "compare": self.compare, "waiver": self.waiver, "pictures": pictures,

@@ -81,7 +81,8 @@ def serve(robot: Robot, ghost: Robot | None, host: str, port: int, workdir: Path
     import numpy as np
     import viser
 
-    from mpc.cli.view_scene import add_robot, joint_range, movable
+    from mpc.cli.view_scene import add_robot, movable
+    from mpc.ir.kinematics import joint_range
 
     try:
         server = viser.ViserServer(host=host, port=port, label=f"mpc view: {robot.name}", verbose=False)

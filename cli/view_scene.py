@@ -6,7 +6,6 @@ applied, as every export does.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,16 +27,6 @@ GREY: RGBA = (0.55, 0.55, 0.58, 1.0)
 COLLISION: RGBA = (0.95, 0.55, 0.1, 0.45)
 GHOST: RGBA = (0.2, 0.45, 0.95, 0.3)
 MOVABLE = ("revolute", "continuous", "prismatic")
-
-
-def joint_range(joint: Joint) -> tuple[float, float]:
-    """A slider's range: the joint's limits, ±π for a continuous joint (or one without
-    limits), ±1 m for a prismatic joint without limits."""
-    lim = joint.limit
-    if joint.type != "continuous" and lim is not None and lim.lower is not None and lim.upper is not None \
-            and lim.lower < lim.upper:
-        return lim.lower, lim.upper
-    return (-1.0, 1.0) if joint.type == "prismatic" else (-math.pi, math.pi)
 
 
 def movable(robot: Robot) -> list[Joint]:

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from mpc.ir import transforms as tf
-from mpc.ir.robot import Pose, Robot
+from mpc.ir.robot import Joint, Pose, Robot
 from mpc.ir.tree import depth_first, joints_up
 
 
@@ -41,3 +43,28 @@ def compose_poses(*poses: Pose | None) -> Pose:
 
 def inverse_pose(pose: Pose | None) -> Pose:
     return matrix_pose(tf.inverse(pose_matrix(pose)))
+
+
+def joint_range(joint: Joint) -> tuple[float, float]:
+    """The values a joint is drawn at (`mpc view`'s sliders, the pictures' zero pose): its
+    limits, ±π for a continuous joint (or one without limits), ±1 m for a prismatic joint
+    without limits."""
+    lim = joint.limit
+    if joint.type != "continuous" and lim is not None and lim.lower is not None and lim.upper is not None \
+            and lim.lower < lim.upper:
+        return lim.lower, lim.upper
+    return (-1.0, 1.0) if joint.type == "prismatic" else (-math.pi, math.pi)
+
+
+def zero_within_limits(robot: Robot) -> dict[str, float]:
+    """The joints whose limits leave out 0, each at the value of its range nearest 0 (as
+    `mpc view`'s sliders start): the zero pose a picture can draw. Mimic joints follow
+    their joint and are not listed."""
+    out = {}
+    for joint in robot.joints.values():
+        if joint.type in ("revolute", "prismatic") and joint.mimic is None:
+            low, high = joint_range(joint)
+            value = min(max(0.0, low), high)
+            if value != 0.0:
+                out[joint.name] = value
+    return out

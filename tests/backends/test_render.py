@@ -110,7 +110,11 @@ def test_talos_pictures_zero_pose_and_geometries(tmp_path: Path) -> None:
     bent = _with(result.robot, poses={"bent": {"leg_left_4_joint": 1.2, "arm_right_4_joint": -1.5}})
     export = RenderExport(span=Span.of_file("x.yml"), views=("front",), size=(64, 96), geometry="visual")
     visual = draw_all(bent, export, sink)
-    assert visual is not None and not sink.diagnostics
+    # TALOS's arms cannot be at 0 within their limits (issue 29, point 20)
+    assert visual is not None and [(d.code, d.message) for d in sink.diagnostics] == [(
+        "W0590", "2 joints of robot 'bot' cannot be at 0 within their limits and are drawn at the limit "
+        "nearest 0: 'arm_left_2_joint' at 0.00872665, 'arm_right_2_joint' at -0.00872665")]
+    sink.diagnostics.clear()
     assert sorted(visual) == ["bent_front.png", "zero_front.png"]
     zero, bent_picture = pixels(visual["zero_front.png"]), pixels(visual["bent_front.png"])
     assert np.mean(np.any(zero != both, axis=2)) > 0.02  # collisions drawn over the visuals

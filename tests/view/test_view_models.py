@@ -12,8 +12,9 @@ import pytest
 import viser
 
 from mpc.cli.view import compare_target, load_model, serve
-from mpc.cli.view_scene import joint_range, link_poses, movable
+from mpc.cli.view_scene import link_poses, movable
 from mpc.core.diagnostics import Sink
+from mpc.ir.kinematics import joint_range
 from tests.conftest import definition, write
 from tests.fixtures import arm
 
