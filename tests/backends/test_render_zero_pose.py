@@ -17,8 +17,10 @@ from tests.conftest import Diags, write
 
 ARM = """<robot name="arm">
   <link name="base"><visual><geometry><box size="0.2 0.2 0.1"/></geometry></visual></link>
-  <link name="upper"><visual><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></visual></link>
-  <link name="lower"><visual><origin xyz="0 0 0.2"/><geometry><box size="0.04 0.04 0.4"/></geometry></visual></link>
+  <link name="upper"><visual><origin xyz="0 0 0.25"/>
+    <geometry><box size="0.05 0.05 0.5"/></geometry></visual></link>
+  <link name="lower"><visual><origin xyz="0 0 0.2"/>
+    <geometry><box size="0.04 0.04 0.4"/></geometry></visual></link>
   <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><origin xyz="0 0 0.05"/>
     <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
   <joint name="elbow" type="revolute"><parent link="upper"/><child link="lower"/><origin xyz="0 0 0.5"/>
