@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
 from mpc.core.numbers import zero_small
@@ -379,11 +380,12 @@ def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path
 def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: Path,
                sink: Sink) -> tuple[Robot, dict[MeshKey, str]] | None:
     """Write the meshes of a urdf, sdf or mjcf export (`write`); the robot to write (numbers
-    near zero made 0 with `enforce_zero`) and where each mesh went, or None after an error."""
+    near zero made 0 with `enforce_zero`; every unnamed visual and collision named as the
+    SMURF names it, `named_shapes`) and where each mesh went, or None after an error."""
     files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
     if files is None:
         return None
-    return (zero_small(robot) if export.enforce_zero else robot), files
+    return named_shapes(zero_small(robot) if export.enforce_zero else robot), files
 
 
 def namer(files: dict[MeshKey, str], prefix: str) -> Callable[[Mesh], str]:

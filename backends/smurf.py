@@ -170,20 +170,22 @@ def _names(robot: Robot, link_name: str, kind: str) -> list[str]:
 
 
 def _shapes(robot: Robot, kind: str) -> list[dict[str, Any]] | None:
-    """An entry for every named visual or collision, and for every unnamed one that carries
-    annotations or a bitmask: its name (Phobos's name for an unnamed one, which is how a
-    reader finds it again), its link, its bitmask and annotations. None: the robot has none.
+    """An entry for every visual or collision that carries annotations or a bitmask, or has a
+    name of its own: its name (Phobos's name for an unnamed one, which the model files give
+    it too), its link, its bitmask and annotations. None: the robot has none.
 
-    Phobos 2.x reads an unnamed shape of a URDF as named "None" and fails on an entry it
-    cannot find, so an unnamed shape with nothing to say gets no entry (specs/smurf.md)."""
+    A shape unnamed in the input, or named as Phobos names an unnamed one (as mpc's model
+    files name it), with nothing to say gets no entry: so a build read back from its own
+    output writes the same SMURF (specs/smurf.md)."""
     if not any(getattr(link, f"{kind}s") for link in robot.links.values()):
         return None
     out = []
     for link_name in sorted(robot.links):
         shapes = getattr(robot.links[link_name], f"{kind}s")
-        for shape, name in zip(shapes, _names(robot, link_name, kind), strict=True):
+        defaults = shape_names(link_name, kind, [None] * len(shapes))
+        for shape, name, default in zip(shapes, _names(robot, link_name, kind), defaults, strict=True):
             bitmask = getattr(shape, "bitmask", None)
-            if shape.name is None and not shape.annotations and bitmask is None:
+            if shape.name in (None, default) and not shape.annotations and bitmask is None:
                 continue
             entry: dict[str, Any] = {**shape.annotations, "link": link_name, "name": name}
             if bitmask is not None:

@@ -11,10 +11,11 @@ repetition of a name in one link gets `k` appended (`<link>_collision1`, …).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
-from mpc.ir.robot import Robot
+from mpc.ir.robot import Link, Robot
 
 # Material fields SMURF holds and URDF does not, with their SMURF (MARS) key.
 MATERIAL_COLOURS = (("ambient", "ambientColor"), ("specular", "specularColor"), ("emissive", "emissionColor"))
@@ -89,6 +90,27 @@ def shape_names(link: str, kind: str, names: Sequence[str | None]) -> list[str]:
             seen[name] = 0
         out.append(name)
     return out
+
+
+def named_shapes(robot: Robot) -> Robot:
+    """`robot` with every unnamed visual and collision named as the SMURF names it
+    (`shape_names`), so that each name a SMURF's files hold names an element of the model
+    file it links: Phobos finds a shape's annotations by that name. A link whose shapes all
+    have names already is left as it is (and so is the robot when every link is)."""
+    links: dict[str, Link] = {}
+    for link in robot.links.values():
+        changes: dict[str, tuple[Any, ...]] = {}
+        for kind in ("visual", "collision"):
+            shapes = getattr(link, f"{kind}s")
+            if any(s.name is None for s in shapes):
+                names = shape_names(link.name, kind, [s.name for s in shapes])
+                changes[f"{kind}s"] = tuple(s if s.name is not None else dataclasses.replace(s, name=n)
+                                            for s, n in zip(shapes, names, strict=True))
+        if changes:
+            links[link.name] = dataclasses.replace(link, **changes)
+    if not links:
+        return robot
+    return dataclasses.replace(robot, links={**robot.links, **links})
 
 
 def motor_limits(robot: Robot, joint: str) -> dict[str, float]:

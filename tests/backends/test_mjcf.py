@@ -17,6 +17,7 @@ import pytest
 from lxml import etree
 
 from mpc.backends import meshes, mjcf, urdf
+from mpc.backends.smurf_forms import named_shapes
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
@@ -190,8 +191,9 @@ def test_model_loads_in_mujoco_as_the_same_robot(model: str, emitted: Callable[[
     assert set(codes) - broken_dae <= {"W0500", "E0504"} and codes.count("W0500") <= 1, \
         [d.message for d in e.diagnostics]
     assert ("W0605" in codes) == bool(broken_dae)
-    # Canonical: the same robot gives the same text, and to_string is what emit wrote.
-    assert mjcf.to_string(e.robot, e.namer) == e.xml.read_text()
+    # Canonical: the same robot gives the same text, and to_string is what emit wrote (of the
+    # robot as emit prepares it: its unnamed shapes named as the SMURF names them).
+    assert mjcf.to_string(named_shapes(e.robot), e.namer) == e.xml.read_text()
     flagged = _flagged(e.diagnostics)
     assert sorted(flagged) == sorted(BAD_INERTIA.get(model, ("", ()))[1])
     try:
