@@ -1,0 +1,102 @@
+"""The JSON-RPC layer of the server: a frame's body → a message for pygls's handlers, or an error
+response. pygls 1.x parsed a body with `json.loads(…, object_hook=…)` and took anything that
+came out for a message; what was not an object (`null`, `[]`, `3`, `"x"`) raised inside its
+reader, and a request whose params did not fit its method got no answer at all.
+
+Here (JSON-RPC 2.0, section 5.1):
+- a body that is not UTF-8 or not JSON gets a parse error (-32700), id null;
+- a body that is JSON but not a message (not an object, no `"jsonrpc": "2.0"`, a method that is
+  not a string, an id that is neither a number nor a string, neither method nor result) gets an
+  invalid request (-32600), with its id when it has a valid one, else null;
+- a request whose params do not fit its method gets invalid params (-32602) with its id; such a
+  notification is dropped (logged), as a notification has no one to answer;
+- a frame the reader refused (lsp/framing.py) gets a parse error, id null.
+The server goes on serving after each.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from typing import Any
+
+from pygls.exceptions import JsonRpcException, JsonRpcInternalError
+from pygls.protocol import LanguageServerProtocol
+
+from mpc.lsp.framing import Frame
+
+PARSE_ERROR = -32700
+INVALID_REQUEST = -32600
+
+logger = logging.getLogger(__name__)
+
+
+class MpcProtocol(LanguageServerProtocol):
+    """pygls's protocol, fed whole frames by `receive` instead of bytes by `data_received`."""
+
+    def receive(self, frame: Frame) -> None:
+        """Handle one frame: serve its message, or answer why it is not one."""
+        if frame.body is None:
+            self.refuse(None, PARSE_ERROR, f"message refused: {frame.problem}")
+            return
+        if frame.problem:
+            logger.warning("served a message despite %s", frame.problem)
+        try:
+            data = json.loads(frame.body.decode("utf-8"))
+        except UnicodeDecodeError as e:
+            self.refuse(None, PARSE_ERROR, f"the body is not UTF-8 (byte {e.start})")
+            return
+        except ValueError as e:
+            self.refuse(None, PARSE_ERROR, f"the body is not JSON: {e}")
+            return
+        problem = _not_a_message(data)
+        if problem is not None:
+            self.refuse(_valid_id(data), INVALID_REQUEST, problem)
+            return
+        if "method" in data:
+            data.setdefault("params", None)  # JSON-RPC lets it out; pygls's untyped message needs it
+        try:
+            message = self._deserialize_message(data)
+        except JsonRpcException as e:
+            if "method" in data and "id" in data:
+                self.refuse(data["id"], e.code, f"{e.message} of {data['method']}")
+            else:
+                logger.warning("dropped a %s: %s", data.get("method", "response"), e)
+            return
+        try:
+            self._procedure_handler(message)
+        except Exception as error:  # a handler's fault must not end the server (as in pygls)
+            logger.exception("error handling a message")
+            self._server._report_server_error(error, JsonRpcInternalError)
+
+    def refuse(self, message_id: int | str | None, code: int, text: str) -> None:
+        """Answer a message that cannot be served; the server goes on."""
+        logger.warning("%s", text)
+        self._send_data({"jsonrpc": "2.0", "id": message_id, "error": {"code": code, "message": text}})
+
+
+def _not_a_message(data: Any) -> str | None:
+    """Why a JSON value is not a JSON-RPC 2.0 message, or None if it is one."""
+    if not isinstance(data, dict):
+        kind = {list: "an array", str: "a string", bool: "a boolean", type(None): "null"}.get(
+            type(data), "a number")
+        return f"a message is a JSON object, not {kind}"
+    if data.get("jsonrpc") != "2.0":
+        return 'a message has "jsonrpc": "2.0"'
+    if "method" in data and not isinstance(data["method"], str):
+        return "a method is a string"
+    if "id" in data and _valid_id(data) is None and not ("method" not in data and "error" in data):
+        return "an id is a number or a string"
+    if "method" not in data and ("id" not in data or not ("result" in data or "error" in data)):
+        return "a message has a method (or is a response, with an id and a result or an error)"
+    if not isinstance(data.get("params"), dict | list | None):  # null: as some clients send
+        return "params are an object or an array"
+    return None
+
+
+def _valid_id(data: Any) -> int | str | None:
+    """The message's id if it is one JSON-RPC allows (a number or a string), else None."""
+    value = data.get("id") if isinstance(data, dict) else None
+    if isinstance(value, bool) or not isinstance(value, int | str):
+        return None
+    return value
