@@ -7,17 +7,18 @@ What this does not do: find what is under the cursor (lookup.py).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from lsprotocol import types as lsp
 
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.robot import Joint
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.diagnostics import DID_YOU_MEAN, location, uri_of
 from mpc.lsp.lookup import element, target
 from mpc.lsp.text import Lines
+from mpc.lsp.xacro_sources import find_element
 
 _FILE_KEYS = ("derived_base", "defaults", "basefile")
 
@@ -32,33 +33,30 @@ def definition(analysis: Analysis, position: lsp.Position) -> lsp.Location | Non
     if found.kinds:
         hit = element(analysis, found.word, found.kinds)
         if hit is not None and hit[1].span is not None:
-            return _in_source(hit[1].span, "joint" if isinstance(hit[1], Joint) else "link", found.word)
+            kind = "joint" if isinstance(hit[1], Joint) else "link"
+            return _in_source(analysis, hit[1].span, kind, found.word)
     return None
 
 
 _XACRO = " (expanded by xacro)"
 
 
-def _in_source(span: Span, kind: str, name: str) -> lsp.Location:
+def _in_source(analysis: Analysis, span: Span, kind: str, name: str) -> lsp.Location:
     """Where the element is written. A xacro model's spans are lines of the URDF xacro expanded
-    it to (backends/xacro_reader.py): there, the line of the xacro file that writes the element
-    with that very name, else the file's first line (a name that a macro puts together)."""
+    it to (backends/xacro_reader.py): there, the element in the xacro file or a file it
+    includes (lsp/xacro_sources.py), else the xacro file's first line."""
     if not span.file.endswith(_XACRO):
         return location(span)
     path = Path(span.file[:-len(_XACRO)])
-    pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name)}[\"']")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        text = ""
-    match = pattern.search(text)
-    if match is None:
+    resolver = analysis.loader.options.resolver if analysis.loader is not None else PackageResolver()
+    found = find_element(path, kind, name, resolver)
+    if found is None:
         return location(Span(str(path), 1, 1, 1, 1))
-    lines = Lines(text)
-    line = text.count("\n", 0, match.start()) + 1
-    col = match.start() - (text.rfind("\n", 0, match.start()) + 1) + 1
-    return lsp.Location(uri=uri_of(str(path)), range=lines.range(Span(str(path), line, col, line,
-                                                                      col + len(match.group()))))
+    try:
+        lines = Lines(Path(found.file).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError):
+        return location(Span(found.file, 1, 1, 1, 1))
+    return lsp.Location(uri=uri_of(found.file), range=lines.range(found))
 
 
 def _file(analysis: Analysis, key: str, written: str, line: int) -> lsp.Location | None:
