@@ -23,7 +23,7 @@ from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import describe
 from mpc.core.span import Span
 from mpc.ir.names import Names
-from mpc.ir.ops import Op
+from mpc.ir.ops import Attach, LoadModel, Op
 from mpc.ir.program import Program
 from mpc.ir.refs import refs
 from mpc.ir.robot import Robot
@@ -31,11 +31,13 @@ from mpc.ir.robot import Robot
 
 @dataclass(frozen=True)
 class Step:
-    """An op that ran on known names, with its part's names before and after it."""
+    """An op that ran on known names, with its part's names before and after it (and, for an
+    attach, the child part's names as it joins)."""
 
     op: Op
     before: Names
     after: Names
+    child: Names | None = None
 
 
 @dataclass(frozen=True)
@@ -78,15 +80,24 @@ class Analysis:
         if self._steps is None:
             steps: list[Step] = []
             if self.passed is not None and self.loader is not None:
-                symbolic(self.passed, PassContext(Sink(), self.loader.names, Severity.WARNING),
-                         lambda op, before, after: steps.append(Step(op, before, after)))
+                program, names = self.passed, self.loader.names
+                parts = {op.part: names(program.inputs[op.input])
+                         for op in program.ops if isinstance(op, LoadModel)}
+
+                def trace(op: Op, before: Names, after: Names) -> None:
+                    child = parts.get(op.child) if isinstance(op, Attach) else None
+                    parts[op.part] = after
+                    steps.append(Step(op, before, after, child))
+
+                symbolic(program, PassContext(Sink(), names, Severity.WARNING), trace)
             self._steps = steps
         return self._steps
 
-    def names_at(self, line: int, col: int, indent: int) -> Names | None:
+    def names_at(self, line: int, col: int, indent: int, child: bool = False) -> Names | None:
         """The names of the robot where the cursor is (1-based line, col; `indent` of its line):
         before the op whose entry holds the cursor, else after the last op written above it.
-        Ops written in other files (a defaults file) count where they run, not where they are."""
+        Ops written in other files (a defaults file) count where they run, not where they are.
+        `child`: in a child's `joint`, the child part's names (those of its `child` link)."""
         steps = self.steps()
         here = [s for s in steps if s.op.span.file == str(self.path)]
         if not here:
@@ -99,8 +110,10 @@ class Analysis:
         if not above:
             return min(here, key=where).before
         nearest = max(above, key=where)
-        return nearest.before if nearest.op.span.line == line or nearest.op.span.col - 1 < indent \
-            else nearest.after
+        inside = nearest.op.span.line == line or nearest.op.span.col - 1 < indent
+        if inside and child and nearest.child is not None:
+            return nearest.child
+        return nearest.before if inside else nearest.after
 
     def readers(self) -> dict[str, Span]:
         """The span of this buffer that reads each input model file, by absolute path."""

@@ -11,14 +11,11 @@ from pathlib import Path
 
 from lsprotocol import types as lsp
 
-from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
-from mpc.ir.robot import Joint
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.diagnostics import DID_YOU_MEAN, location, uri_of
-from mpc.lsp.lookup import element, target
+from mpc.lsp.lookup import element, target, written_at
 from mpc.lsp.text import Lines
-from mpc.lsp.xacro_sources import find_element
 
 _FILE_KEYS = ("derived_base", "defaults", "basefile")
 
@@ -32,31 +29,19 @@ def definition(analysis: Analysis, position: lsp.Position) -> lsp.Location | Non
         return _file(analysis, found.key, found.word, found.span.line)
     if found.kinds:
         hit = element(analysis, found.word, found.kinds)
-        if hit is not None and hit[1].span is not None:
-            kind = "joint" if isinstance(hit[1], Joint) else "link"
-            return _in_source(analysis, hit[1].span, kind, found.word)
+        span = written_at(analysis, hit[1]) if hit is not None else None
+        if span is not None:
+            return _location(span)
     return None
 
 
-_XACRO = " (expanded by xacro)"
-
-
-def _in_source(analysis: Analysis, span: Span, kind: str, name: str) -> lsp.Location:
-    """Where the element is written. A xacro model's spans are lines of the URDF xacro expanded
-    it to (backends/xacro_reader.py): there, the element in the xacro file or a file it
-    includes (lsp/xacro_sources.py), else the xacro file's first line."""
-    if not span.file.endswith(_XACRO):
-        return location(span)
-    path = Path(span.file[:-len(_XACRO)])
-    resolver = analysis.loader.options.resolver if analysis.loader is not None else PackageResolver()
-    found = find_element(path, kind, name, resolver)
-    if found is None:
-        return location(Span(str(path), 1, 1, 1, 1))
+def _location(span: Span) -> lsp.Location:
+    """The place of a span in a file on disk (a tag may span lines: the file's text is read)."""
     try:
-        lines = Lines(Path(found.file).read_text(encoding="utf-8"))
+        lines = Lines(Path(span.file).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError):
-        return location(Span(found.file, 1, 1, 1, 1))
-    return lsp.Location(uri=uri_of(found.file), range=lines.range(found))
+        return location(span)
+    return lsp.Location(uri=uri_of(span.file), range=lines.range(span))
 
 
 def _file(analysis: Analysis, key: str, written: str, line: int) -> lsp.Location | None:

@@ -154,6 +154,15 @@ def test_parent_of_a_child_joint_in_flow_style(server: Client, folder: Path) -> 
                                            "p_base", "p_upper"]
 
 
+def test_child_of_a_child_joint(server: Client, folder: Path) -> None:
+    text = TWO.replace("          parent: p_base\n", "          parent: p_base\n          child: g_palm\n")
+    text = text.replace("{parent: p_base, name: second}", "{parent: p_base, child: h_tcp, name: second}")
+    uri = opened(server, folder / "child.yml", text)
+    # the child's links (after its name editing), not the parent's
+    assert labels(server, uri, 15, 17) == ["g_finger_left", "g_finger_right", "g_palm", "g_tcp"]
+    assert labels(server, uri, 18, 40) == ["h_finger_left", "h_finger_right", "h_palm", "h_tcp"]
+
+
 JOINTS = ["g_finger_left_joint", "g_finger_right_joint", "g_tcp_joint", "h_finger_left_joint",
           "h_finger_right_joint", "h_tcp_joint", "p_base2g_palm", "p_shoulder", "second"]
 
@@ -177,5 +186,7 @@ def test_definition_in_the_files_a_xacro_includes(server: Client, folder: Path) 
     assert definition(server, uri, 10, 5) == (body, 3, 4)  # torso: written as it is
     assert definition(server, uri, 8, 5) == (leg, 9, 4)  # left_thigh: "${side}_thigh"
     assert definition(server, uri, 13, 5) == (leg, 3, 4)  # right_hip: "${side}_hip"
+    hover = server.request("textDocument/hover", server.at(uri, 8, 5))["contents"]["value"]
+    assert hover.startswith("**link left_thigh**\n\nmass: 1 kg") and hover.endswith("\n\nleg.xacro:10")
     for line, text in ((3, '<link name="torso">'), (9, '<link name="${side}_thigh">')):
         assert (BODY if line == 3 else LEG).split("\n")[line].strip() == text
