@@ -17,6 +17,9 @@ Here every frame ends, well-formed or not, and the next one is found:
   no valid JSON text can hold one (JSON has no bare words, and its strings hold no raw line
   breaks), so that is the next frame, and the declared length was too large.
 - A Content-Type whose charset is not UTF-8 (the only one LSP allows) refuses its frame.
+- A header line longer than MAX_LINE is no header line: the stream is read on to the next
+  header (a line is read in pieces of MAX_LINE bytes, each kept with the end of the one before,
+  so that a header that a piece's end cuts is still found).
 
 A refused frame comes out as a `Frame` with `problem` set, so that the server can say so.
 """
@@ -30,6 +33,7 @@ from typing import BinaryIO
 MAX_BODY = 256 * 2**20  # bytes: larger is taken for a damaged header, not read
 MAX_LINE = 8192  # bytes of a header line read at once
 CHUNK = 65536
+_KEEP = 64  # bytes of a line read in pieces kept with the next piece: a header line's start
 
 # The start of a Content-Length header, anywhere in a line.
 _LENGTH_START = re.compile(rb"content-length[ \t]*:", re.IGNORECASE)
@@ -56,26 +60,33 @@ class FrameReader:
 
     def next(self) -> Frame | None:
         problem: str | None = None
+        fields = False
         lengths: list[bytes] = []
         charset: str | None = None
         while True:
             line = self._line()
             if not line:
                 return None
+            if not line.endswith(b"\n"):  # longer than MAX_LINE: no header line is
+                self.pending = line[-_KEEP:]
+                self._skip_to_header()
+                return Frame(None, f"a header line longer than {MAX_LINE} bytes; the stream was "
+                                   "read on to the next header")
             found = _last_length_start(line)
             if found > 0:  # the tail of a damaged frame, then a new header
                 line = line[found:]
-                if lengths or charset:
+                if fields:
                     problem = problem or "a header broken off by another Content-Length"
-                lengths, charset = [], None
+                fields, lengths, charset = False, [], None
             if line in (b"\r\n", b"\n"):
-                if lengths or charset or problem:
+                if fields or problem:
                     break
                 continue  # blank lines between frames
             header = _HEADER.fullmatch(line)
             if header is None:  # a damaged line: the rest of the header may still be good
                 problem = problem or "a damaged header line"
                 continue
+            fields = True
             name, value = header.group(1).lower(), header.group(2)
             if name == b"content-length":
                 lengths.append(value)
@@ -110,13 +121,12 @@ class FrameReader:
     def _skip_to_header(self) -> None:
         """Read on to the next `Content-Length:`, which is left to be read; a piece of a long line
         keeps its last bytes, so that a header cut by the piece's end is still found."""
-        keep = 32
         while True:
             line = self._line()
             if not line:
                 return
             if not line.endswith(b"\n"):
-                self.pending = line[-keep:] + self.pending if len(line) > keep else b""
+                self.pending = line[-_KEEP:] if len(line) > _KEEP else b""
                 continue
             found = _last_length_start(line)
             if found >= 0:
