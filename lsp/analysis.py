@@ -13,6 +13,7 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from mpc.backends.xacro_origins import origins
 from mpc.compiler import front_end
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.options import Options
@@ -21,12 +22,16 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import describe
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.ops import Attach, LoadModel, Op
 from mpc.ir.program import Program
 from mpc.ir.refs import refs
 from mpc.ir.robot import Robot
+
+# backends/xacro_origins.py's answers, by (file, xacro args, modification time, size)
+_ORIGINS: dict[tuple[str, tuple[tuple[str, str], ...], int, int], dict[int, tuple[str, Span]]] = {}
 
 
 @dataclass(frozen=True)
@@ -114,6 +119,26 @@ class Analysis:
         if inside and child and nearest.child is not None:
             return nearest.child
         return nearest.before if inside else nearest.after
+
+    def xacro_origins(self, path: Path) -> dict[int, tuple[str, Span]]:
+        """Where the links and joints of the xacro input model at `path` are written, by their
+        line in its expansion (backends/xacro_origins.py). Expanded when first asked, then kept
+        while the file's modification time and size stay (as ModelCache keeps the model)."""
+        absolute = os.path.abspath(path)
+        inputs = self.program.inputs.values() if self.program is not None else ()
+        args = next((inp.xacro_args for inp in inputs
+                     if inp.path is not None and os.path.abspath(inp.path) == absolute), ())
+        try:
+            stat = os.stat(absolute)
+        except OSError:
+            return {}
+        key = (absolute, args, stat.st_mtime_ns, stat.st_size)
+        if key not in _ORIGINS:
+            resolver = self.loader.options.resolver if self.loader is not None else PackageResolver()
+            while len(_ORIGINS) >= 8:
+                del _ORIGINS[next(iter(_ORIGINS))]
+            _ORIGINS[key] = origins(path, resolver, args)
+        return _ORIGINS[key]
 
     def readers(self) -> dict[str, Span]:
         """The span of this buffer that reads each input model file, by absolute path."""

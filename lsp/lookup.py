@@ -85,12 +85,17 @@ _XACRO = " (expanded by xacro)"  # the file name the URDF reader gives a xacro's
 
 def written_at(analysis: Analysis, thing: Link | Joint) -> Span | None:
     """Where the link or joint is written. A xacro model's spans are lines of the URDF xacro
-    expanded it to (backends/xacro_reader.py), which is no file: there, the element in the
-    xacro file or a file it includes (lsp/xacro_sources.py), else the xacro file's first line."""
+    expanded it to (backends/xacro_reader.py), which is no file: there, the place xacro parsed
+    the element from (backends/xacro_origins.py; a renamed element too, by its line); if the
+    model does not expand again, the element found in the xacro file or a file it includes
+    (lsp/xacro_sources.py); else the xacro file's first line."""
     span = thing.span
     if span is None or not span.file.endswith(_XACRO):
         return span
     path = Path(span.file[:-len(_XACRO)])
-    resolver = analysis.loader.options.resolver if analysis.loader is not None else PackageResolver()
     kind = "joint" if isinstance(thing, Joint) else "link"
+    origin = analysis.xacro_origins(path).get(span.line)
+    if origin is not None and origin[0] == kind:
+        return origin[1]
+    resolver = analysis.loader.options.resolver if analysis.loader is not None else PackageResolver()
     return find_element(path, kind, thing.name, resolver) or Span(str(path), 1, 1, 1, 1)

@@ -5,7 +5,8 @@ through the real `mpc lsp` with the messages an editor sends:
   editing and cuts, with the children attached before), in block and in flow style;
 - a pose written as a flow mapping (`reach: {…}`) offers the robot's joints;
 - go to definition of a link or joint of a xacro model opens the file that writes it: an
-  included file (relative, `$(find pkg)`), a macro's element for a name the macro puts together.
+  included file (relative, `$(find pkg)`), the element of the macro that made it (not another
+  macro that could have), for a renamed element too.
 """
 
 from __future__ import annotations
@@ -82,6 +83,9 @@ LEG = """\
       </inertial>
     </link>
   </xacro:macro>
+  <xacro:macro name="spare" params="part">
+    <link name="${part}_thigh"/>
+  </xacro:macro>
 </robot>
 """
 BOT = """\
@@ -100,6 +104,9 @@ model:
   joints:
     right_hip:
       damping: 0.1
+  collisions:
+    left_thigh_x:
+      shape: box
 """
 
 
@@ -184,7 +191,9 @@ def test_definition_in_the_files_a_xacro_includes(server: Client, folder: Path) 
     body = (folder / "parts" / "body.xacro").as_uri()
     leg = (folder / "elsewhere" / "bot_parts" / "urdf" / "leg.xacro").as_uri()
     assert definition(server, uri, 10, 5) == (body, 3, 4)  # torso: written as it is
-    assert definition(server, uri, 8, 5) == (leg, 9, 4)  # left_thigh: "${side}_thigh"
+    # left_thigh: "${side}_thigh" of the macro that made it (an unused macro could make it too)
+    assert definition(server, uri, 8, 5) == (leg, 9, 4)
+    assert definition(server, uri, 16, 5) == (leg, 9, 4)  # the same link after its renaming
     assert definition(server, uri, 13, 5) == (leg, 3, 4)  # right_hip: "${side}_hip"
     hover = server.request("textDocument/hover", server.at(uri, 8, 5))["contents"]["value"]
     assert hover.startswith("**link left_thigh**\n\nmass: 1 kg") and hover.endswith("\n\nleg.xacro:10")
