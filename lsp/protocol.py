@@ -8,8 +8,10 @@ Here (JSON-RPC 2.0, section 5.1):
 - a body that is JSON but not a message (not an object, no `"jsonrpc": "2.0"`, a method that is
   not a string, an id that is neither a number nor a string, neither method nor result) gets an
   invalid request (-32600), with its id when it has a valid one, else null;
-- a request whose params do not fit its method gets invalid params (-32602) with its id; such a
-  notification is dropped (logged), as a notification has no one to answer;
+- a request whose params do not fit its method gets invalid params (-32602) with its id, the
+  message saying which fields (cattrs's words); such a notification is dropped (logged), as a
+  notification has no one to answer; a request of a method the server does not have gets
+  method not found (-32601), as from pygls, but without a traceback in the log;
 - a frame the reader refused (lsp/framing.py) gets a parse error, id null.
 The server goes on serving after each.
 """
@@ -20,13 +22,23 @@ import json
 import logging
 from typing import Any
 
-from pygls.exceptions import JsonRpcException, JsonRpcInternalError
-from pygls.protocol import LanguageServerProtocol
+from cattrs import transform_error
+from cattrs.errors import ClassValidationError
+from lsprotocol.types import ResponseErrorMessage
+from pygls.exceptions import JsonRpcInternalError
+from pygls.protocol import (
+    JsonRPCNotification,
+    JsonRPCRequestMessage,
+    JsonRPCResponseMessage,
+    LanguageServerProtocol,
+)
 
 from mpc.lsp.framing import Frame
 
 PARSE_ERROR = -32700
 INVALID_REQUEST = -32600
+INVALID_PARAMS = -32602
+METHOD_NOT_FOUND = -32601
 
 logger = logging.getLogger(__name__)
 
@@ -53,21 +65,42 @@ class MpcProtocol(LanguageServerProtocol):
         if problem is not None:
             self.refuse(_valid_id(data), INVALID_REQUEST, problem)
             return
-        if "method" in data:
-            data.setdefault("params", None)  # JSON-RPC lets it out; pygls's untyped message needs it
         try:
-            message = self._deserialize_message(data)
-        except JsonRpcException as e:
+            message = self._structured(data)
+        except Exception as e:  # cattrs's errors: the params do not fit the method's type
+            why = "; ".join(transform_error(e)) if isinstance(e, ClassValidationError) else str(e)
             if "method" in data and "id" in data:
-                self.refuse(data["id"], e.code, f"{e.message} of {data['method']}")
+                self.refuse(data["id"], INVALID_PARAMS, f"invalid params of {data['method']}: {why}")
             else:
-                logger.warning("dropped a %s: %s", data.get("method", "response"), e)
+                logger.warning("dropped a %s: %s", data.get("method", "response"), why)
+            return
+        if "method" in data and "id" in data and not self._handles(data["method"]):
+            self.refuse(data["id"], METHOD_NOT_FOUND, f"method not found: {data['method']}")
             return
         try:
             self._procedure_handler(message)
         except Exception as error:  # a handler's fault must not end the server (as in pygls)
             logger.exception("error handling a message")
             self._server._report_server_error(error, JsonRpcInternalError)
+
+    def _structured(self, data: dict[str, Any]) -> Any:
+        """The message as pygls's handlers take it: lsprotocol's type for its method (pygls's
+        generic one for a method it does not know), or the answer to one of the server's
+        requests. (pygls's `_deserialize_message` does the same, but logs every message that
+        does not fit with a traceback.)"""
+        if "method" in data:
+            data.setdefault("params", None)  # JSON-RPC lets it out; pygls's generic message needs it
+            generic = JsonRPCRequestMessage if "id" in data else JsonRPCNotification
+            return self._converter.structure(data, self.get_message_type(data["method"]) or generic)
+        if "error" in data:
+            return self._converter.structure(data, ResponseErrorMessage)
+        answer = self._result_types.pop(data["id"], None) or JsonRPCResponseMessage
+        return self._converter.structure(data, answer)
+
+    def _handles(self, method: str) -> bool:
+        """Whether a request of `method` has a handler (pygls answers one that has none, but
+        logs it with a traceback)."""
+        return method in self.fm.builtin_features or method in self.fm.features
 
     def refuse(self, message_id: int | str | None, code: int, text: str) -> None:
         """Answer a message that cannot be served; the server goes on."""

@@ -93,6 +93,9 @@ def served(tmp_path_factory: pytest.TempPathFactory) -> tuple[Client, str]:
     yield client, uri
     client.send_raw(framed(SHUTDOWN) + framed(body({"jsonrpc": "2.0", "method": "exit"})))
     assert client.proc.wait(timeout=30) == 0
+    assert client.proc.stderr is not None
+    log = client.proc.stderr.read().decode()
+    assert "Traceback" not in log and "a message is a JSON object, not null" in log
 
 
 def test_there_are_twenty_kinds_of_malformed_frame() -> None:
