@@ -90,6 +90,8 @@ def context(lines: Lines, line: int, col: int) -> Context:
     stripped = text.lstrip()
     item = stripped.startswith("- ")
     own = _KEY.match(text)
+    if own and own.group(2).startswith(("{", "[")):
+        own = None  # the line's value is a flow collection (`- {model: arm, joint: {…`): below
     inner: list[str] = []
     if own:
         key = own.group(2).strip("'\"")
@@ -103,6 +105,10 @@ def context(lines: Lines, line: int, col: int) -> Context:
             key = flow[1]
     elif item:
         keys.append("-")
+    if not own:
+        flow = _open_flow(stripped[2:] if item else stripped)
+        if flow is not None:
+            inner, key, in_list = flow
     # the keys of the lines above with less indentation
     limit = len(text) - len(text.lstrip(" ")) if own or item else indent
     for number in range(line - 1, -1, -1):

@@ -170,6 +170,15 @@ def test_child_of_a_child_joint(server: Client, folder: Path) -> None:
     assert labels(server, uri, 18, 40) == ["h_finger_left", "h_finger_right", "h_palm", "h_tcp"]
 
 
+def test_a_child_entry_written_as_one_flow_mapping(server: Client, folder: Path) -> None:
+    entry = '      - {model: grip, name_editing: {prefix: "g_"}, joint: {parent: p_base, child: g_palm}}\n'
+    text = TWO.split("    children:\n")[0] + "    children:\n" + entry
+    uri = opened(server, folder / "item.yml", text)
+    assert labels(server, uri, 11, entry.index("p_base")) == ["p_base", "p_upper"]
+    assert labels(server, uri, 11, entry.index("g_palm")) == ["g_finger_left", "g_finger_right", "g_palm",
+                                                              "g_tcp"]
+
+
 JOINTS = ["g_finger_left_joint", "g_finger_right_joint", "g_tcp_joint", "h_finger_left_joint",
           "h_finger_right_joint", "h_tcp_joint", "p_base2g_palm", "p_shoulder", "second"]
 
