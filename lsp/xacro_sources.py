@@ -7,7 +7,8 @@ the element in the sources instead:
 1. the files: the xacro file, then each file it includes (`<xacro:include filename=…>`, in the
    order written, depth first), with the filename resolved as xacro resolves it — relative to
    the including file, `$(find pkg)/…` and `package://pkg/…` by the server's PackageResolver;
-   a filename that other substitutions build (`$(arg …)`, `${…}`) is not followed;
+   a filename that other substitutions build (`$(arg …)`, `${…}`) is not followed, nor one
+   that the rule of every file mpc reads refuses (PackageResolver.refusal);
 2. the element whose name is written as it is (`<link name="base">`), in the first file that
    has one;
 3. else the element whose name a macro puts together (`<link name="${name}_link">`), when
@@ -49,7 +50,9 @@ def _sources(top: Path, resolver: PackageResolver) -> list[tuple[Path, str]]:
     out: list[tuple[Path, str]] = []
     seen: set[Path] = set()
 
-    def visit(path: Path) -> None:
+    def visit(path: Path, folder: Path) -> None:
+        if resolver.refusal(path, folder) is not None:  # the rule of every file mpc reads
+            return
         path = path.resolve()
         if path in seen or str(path).startswith(_NOT_FILES) or not path.is_file():
             return
@@ -62,9 +65,9 @@ def _sources(top: Path, resolver: PackageResolver) -> list[tuple[Path, str]]:
         for match in _INCLUDE.finditer(text):
             included = _resolve(match.group(1) or match.group(2) or "", path.parent, resolver)
             if included is not None:
-                visit(included)
+                visit(included, path.parent)
 
-    visit(top)
+    visit(top, top.parent)
     return out
 
 
