@@ -13,6 +13,7 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from mpc.backends.xacro_origins import origins
 from mpc.compiler import front_end
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.options import Options
@@ -21,21 +22,27 @@ from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import describe
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.names import Names
-from mpc.ir.ops import Op
+from mpc.ir.ops import Attach, LoadModel, Op
 from mpc.ir.program import Program
 from mpc.ir.refs import refs
 from mpc.ir.robot import Robot
 
+# backends/xacro_origins.py's answers, by (file, xacro args, modification time, size)
+_ORIGINS: dict[tuple[str, tuple[tuple[str, str], ...], int, int], dict[int, tuple[str, Span]]] = {}
+
 
 @dataclass(frozen=True)
 class Step:
-    """An op that ran on known names, with its part's names before and after it."""
+    """An op that ran on known names, with its part's names before and after it (and, for an
+    attach, the child part's names as it joins)."""
 
     op: Op
     before: Names
     after: Names
+    child: Names | None = None
 
 
 @dataclass(frozen=True)
@@ -78,15 +85,24 @@ class Analysis:
         if self._steps is None:
             steps: list[Step] = []
             if self.passed is not None and self.loader is not None:
-                symbolic(self.passed, PassContext(Sink(), self.loader.names, Severity.WARNING),
-                         lambda op, before, after: steps.append(Step(op, before, after)))
+                program, names = self.passed, self.loader.names
+                parts = {op.part: names(program.inputs[op.input])
+                         for op in program.ops if isinstance(op, LoadModel)}
+
+                def trace(op: Op, before: Names, after: Names) -> None:
+                    child = parts.get(op.child) if isinstance(op, Attach) else None
+                    parts[op.part] = after
+                    steps.append(Step(op, before, after, child))
+
+                symbolic(program, PassContext(Sink(), names, Severity.WARNING), trace)
             self._steps = steps
         return self._steps
 
-    def names_at(self, line: int, col: int, indent: int) -> Names | None:
+    def names_at(self, line: int, col: int, indent: int, child: bool = False) -> Names | None:
         """The names of the robot where the cursor is (1-based line, col; `indent` of its line):
         before the op whose entry holds the cursor, else after the last op written above it.
-        Ops written in other files (a defaults file) count where they run, not where they are."""
+        Ops written in other files (a defaults file) count where they run, not where they are.
+        `child`: in a child's `joint`, the child part's names (those of its `child` link)."""
         steps = self.steps()
         here = [s for s in steps if s.op.span.file == str(self.path)]
         if not here:
@@ -99,8 +115,30 @@ class Analysis:
         if not above:
             return min(here, key=where).before
         nearest = max(above, key=where)
-        return nearest.before if nearest.op.span.line == line or nearest.op.span.col - 1 < indent \
-            else nearest.after
+        inside = nearest.op.span.line == line or nearest.op.span.col - 1 < indent
+        if inside and child and nearest.child is not None:
+            return nearest.child
+        return nearest.before if inside else nearest.after
+
+    def xacro_origins(self, path: Path) -> dict[int, tuple[str, Span]]:
+        """Where the links and joints of the xacro input model at `path` are written, by their
+        line in its expansion (backends/xacro_origins.py). Expanded when first asked, then kept
+        while the file's modification time and size stay (as ModelCache keeps the model)."""
+        absolute = os.path.abspath(path)
+        inputs = self.program.inputs.values() if self.program is not None else ()
+        args = next((inp.xacro_args for inp in inputs
+                     if inp.path is not None and os.path.abspath(inp.path) == absolute), ())
+        try:
+            stat = os.stat(absolute)
+        except OSError:
+            return {}
+        key = (absolute, args, stat.st_mtime_ns, stat.st_size)
+        if key not in _ORIGINS:
+            resolver = self.loader.options.resolver if self.loader is not None else PackageResolver()
+            while len(_ORIGINS) >= 8:
+                del _ORIGINS[next(iter(_ORIGINS))]
+            _ORIGINS[key] = origins(path, resolver, args)
+        return _ORIGINS[key]
 
     def readers(self) -> dict[str, Span]:
         """The span of this buffer that reads each input model file, by absolute path."""

@@ -41,7 +41,8 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
     where = lsp.Range(start=start, end=position)
     named = analysis if analysis.passed is not None or good is None else good
     indent = len(lines.line(position.line)) - len(lines.line(position.line).lstrip(" -"))
-    names = named.names_at(position.line + 1, col, indent)
+    child = ctx.key == "child" and ctx.keys[-3:] == ("children", "-", "joint")  # an attach's child link
+    names = named.names_at(position.line + 1, col, indent, child)
     items: list[lsp.CompletionItem] = []
     if ctx.key is None and ctx.keys[-1:] == ("-",):  # an item of a block list: a name or a test
         key = ctx.keys[-2] if len(ctx.keys) > 1 else ""

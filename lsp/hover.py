@@ -12,12 +12,13 @@ from lsprotocol import types as lsp
 
 from mpc.compiler.expr import evaluate
 from mpc.core.diagnostics import Sink
+from mpc.core.span import Span
 from mpc.ir.kinematics import link_in_root, matrix_pose
 from mpc.ir.robot import Joint, Link, Robot
 from mpc.ir.tree import joints_up
 from mpc.lsp import schema_data
 from mpc.lsp.analysis import Analysis
-from mpc.lsp.lookup import element, target
+from mpc.lsp.lookup import element, target, written_at
 from mpc.lsp.text import Lines, contains
 
 
@@ -31,7 +32,7 @@ def hover(analysis: Analysis, position: lsp.Position) -> lsp.Hover | None:
     if found.kinds:
         hit = element(analysis, found.word, found.kinds)
         if hit is not None:
-            text = describe(*hit)
+            text = describe(*hit, written_at(analysis, hit[1]))
     if text is None and found.on_key:
         text = schema_data.description(found.keys, found.word)
         text = f"**{found.word}**\n\n{text}" if text else None
@@ -43,9 +44,9 @@ def hover(analysis: Analysis, position: lsp.Position) -> lsp.Hover | None:
                      range=lines.range(found.span))
 
 
-def describe(robot: Robot, thing: Link | Joint) -> str:
-    """Markdown about a link or a joint of `robot`."""
-    where = f"\n\n{thing.span.file.rsplit('/', 1)[-1]}:{thing.span.line}" if thing.span else ""
+def describe(robot: Robot, thing: Link | Joint, span: Span | None) -> str:
+    """Markdown about a link or a joint of `robot`, written at `span`."""
+    where = f"\n\n{span.file.rsplit('/', 1)[-1]}:{span.line}" if span else ""
     if isinstance(thing, Joint):
         out = [f"**joint {thing.name}** ({thing.type}): {thing.parent} → {thing.child}"]
         if thing.axis is not None:

@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
+from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.robot import Joint, Link, Robot
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.completion import KEYED_BY, VALUE_NAMES
 from mpc.lsp.text import Lines, contains, context
+from mpc.lsp.xacro_sources import find_element
 
 _WORD = re.compile(r"[^\s:\[\],{}\"'#]+")
 
@@ -75,3 +78,24 @@ def element(analysis: Analysis, name: str, kinds: tuple[str, ...]) -> tuple[Robo
                 if kind == "joint" and name in robot.joints:
                     return robot, robot.joints[name]
     return None
+
+
+_XACRO = " (expanded by xacro)"  # the file name the URDF reader gives a xacro's expansion
+
+
+def written_at(analysis: Analysis, thing: Link | Joint) -> Span | None:
+    """Where the link or joint is written. A xacro model's spans are lines of the URDF xacro
+    expanded it to (backends/xacro_reader.py), which is no file: there, the place xacro parsed
+    the element from (backends/xacro_origins.py; a renamed element too, by its line); if the
+    model does not expand again, the element found in the xacro file or a file it includes
+    (lsp/xacro_sources.py); else the xacro file's first line."""
+    span = thing.span
+    if span is None or not span.file.endswith(_XACRO):
+        return span
+    path = Path(span.file[:-len(_XACRO)])
+    kind = "joint" if isinstance(thing, Joint) else "link"
+    origin = analysis.xacro_origins(path).get(span.line)
+    if origin is not None and origin[0] == kind:
+        return origin[1]
+    resolver = analysis.loader.options.resolver if analysis.loader is not None else PackageResolver()
+    return find_element(path, kind, thing.name, resolver) or Span(str(path), 1, 1, 1, 1)

@@ -7,16 +7,14 @@ What this does not do: find what is under the cursor (lookup.py).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from lsprotocol import types as lsp
 
 from mpc.core.span import Span
-from mpc.ir.robot import Joint
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.diagnostics import DID_YOU_MEAN, location, uri_of
-from mpc.lsp.lookup import element, target
+from mpc.lsp.lookup import element, target, written_at
 from mpc.lsp.text import Lines
 
 _FILE_KEYS = ("derived_base", "defaults", "basefile")
@@ -31,34 +29,19 @@ def definition(analysis: Analysis, position: lsp.Position) -> lsp.Location | Non
         return _file(analysis, found.key, found.word, found.span.line)
     if found.kinds:
         hit = element(analysis, found.word, found.kinds)
-        if hit is not None and hit[1].span is not None:
-            return _in_source(hit[1].span, "joint" if isinstance(hit[1], Joint) else "link", found.word)
+        span = written_at(analysis, hit[1]) if hit is not None else None
+        if span is not None:
+            return _location(span)
     return None
 
 
-_XACRO = " (expanded by xacro)"
-
-
-def _in_source(span: Span, kind: str, name: str) -> lsp.Location:
-    """Where the element is written. A xacro model's spans are lines of the URDF xacro expanded
-    it to (backends/xacro_reader.py): there, the line of the xacro file that writes the element
-    with that very name, else the file's first line (a name that a macro puts together)."""
-    if not span.file.endswith(_XACRO):
-        return location(span)
-    path = Path(span.file[:-len(_XACRO)])
-    pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name)}[\"']")
+def _location(span: Span) -> lsp.Location:
+    """The place of a span in a file on disk (a tag may span lines: the file's text is read)."""
     try:
-        text = path.read_text(encoding="utf-8")
+        lines = Lines(Path(span.file).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError):
-        text = ""
-    match = pattern.search(text)
-    if match is None:
-        return location(Span(str(path), 1, 1, 1, 1))
-    lines = Lines(text)
-    line = text.count("\n", 0, match.start()) + 1
-    col = match.start() - (text.rfind("\n", 0, match.start()) + 1) + 1
-    return lsp.Location(uri=uri_of(str(path)), range=lines.range(Span(str(path), line, col, line,
-                                                                      col + len(match.group()))))
+        return location(span)
+    return lsp.Location(uri=uri_of(span.file), range=lines.range(span))
 
 
 def _file(analysis: Analysis, key: str, written: str, line: int) -> lsp.Location | None:

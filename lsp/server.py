@@ -14,11 +14,14 @@ import asyncio
 import contextlib
 import gc
 import os
+import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from lsprotocol import types as lsp
-from pygls.server import LanguageServer
+from pygls.server import LanguageServer, StdOutTransportAdapter
 from pygls.uris import to_fs_path
 
 from mpc.compiler.options import ModelCache, Options
@@ -27,6 +30,8 @@ from mpc.core.version import mpc_version
 from mpc.lsp import completion, hover, navigation
 from mpc.lsp.analysis import Analysis, analyse
 from mpc.lsp.diagnostics import convert
+from mpc.lsp.framing import FrameReader
+from mpc.lsp.protocol import MpcProtocol
 from mpc.lsp.text import Lines
 
 
@@ -47,13 +52,38 @@ class MpcServer(LanguageServer):
     """The open buffers' analyses and what is waiting to be checked."""
 
     def __init__(self, packages: dict[str, Path] | None = None) -> None:
-        super().__init__("mpc", mpc_version())
+        super().__init__("mpc", mpc_version(), protocol_cls=MpcProtocol)
         resolver = PackageResolver(package_map=dict(packages or {}))
         self.options = Options(resolver=resolver, models=ModelCache())
         self.analyses: dict[str, Analysis] = {}
         self.named: dict[str, Analysis] = {}  # the last analysis of each buffer that got a program
         self.pending: dict[str, asyncio.TimerHandle] = {}
         self.debounce = 0.005
+
+    def start_io(self, stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> None:
+        """Serve the frames of stdin until the client says exit or stdin ends. pygls's own
+        loop, with mpc's reader (lsp/framing.py) and protocol (lsp/protocol.py), which stay in
+        step with the client whatever it sends."""
+        rfile, wfile = stdin or sys.stdin.buffer, stdout or sys.stdout.buffer
+        self._stop_event = threading.Event()
+        self.lsp.connection_made(StdOutTransportAdapter(rfile, wfile))  # type: ignore[arg-type]
+        try:
+            self.loop.run_until_complete(self._serve_frames(FrameReader(rfile)))
+        except BrokenPipeError:
+            pass  # the client has gone
+        except (KeyboardInterrupt, SystemExit):
+            pass  # `exit` ends the server by SystemExit, as pygls does
+        finally:
+            self.shutdown()
+
+    async def _serve_frames(self, reader: FrameReader) -> None:
+        protocol = self.lsp
+        assert isinstance(protocol, MpcProtocol) and self._stop_event is not None
+        while not self._stop_event.is_set():
+            frame = await self.loop.run_in_executor(self.thread_pool_executor, reader.next)
+            if frame is None:
+                return
+            protocol.receive(frame)
 
     def path(self, uri: str) -> Path:
         return Path(to_fs_path(uri) or uri)

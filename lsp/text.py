@@ -90,14 +90,25 @@ def context(lines: Lines, line: int, col: int) -> Context:
     stripped = text.lstrip()
     item = stripped.startswith("- ")
     own = _KEY.match(text)
+    if own and own.group(2).startswith(("{", "[")):
+        own = None  # the line's value is a flow collection (`- {model: arm, joint: {…`): below
+    inner: list[str] = []
     if own:
         key = own.group(2).strip("'\"")
         rest = text[own.end():]
         in_list = "[" in rest and "]" not in rest
         if item:
             keys.append("-")
+        flow = _open_flow(rest)
+        if flow is not None:  # `key: {a: …, b: |`: the cursor is inside a flow mapping
+            inner, in_list = [key, *flow[0]], flow[2]
+            key = flow[1]
     elif item:
         keys.append("-")
+    if not own:
+        flow = _open_flow(stripped[2:] if item else stripped)
+        if flow is not None:
+            inner, key, in_list = flow
     # the keys of the lines above with less indentation
     limit = len(text) - len(text.lstrip(" ")) if own or item else indent
     for number in range(line - 1, -1, -1):
@@ -118,4 +129,50 @@ def context(lines: Lines, line: int, col: int) -> Context:
         if spaces == 0:
             break
     keys.reverse()
-    return Context(tuple(keys), key, word, in_list)
+    return Context((*keys, *inner), key, word, in_list)
+
+
+def _open_flow(text: str) -> tuple[list[str], str | None, bool] | None:
+    """Where the end of `text`, a value written after a key, is inside flow collections that
+    are still open: the keys of the open mappings that lead there (outermost first), the key
+    whose value is being written in the innermost mapping (None: a key is being written), and
+    whether the innermost collection is a list. None when no flow collection is open.
+
+        {parent: base, name: |     → ([], "name", False)
+        {a: {b: [x, |              → (["a"], "b", True)
+    """
+    frames: list[list] = []  # [bracket, the key being written or None]
+    token = ""
+    quote = ""
+    for at, char in enumerate(text):
+        if quote:
+            token += char
+            quote = "" if char == quote else quote
+        elif char in "'\"":
+            quote, token = char, token + char
+        elif char in "{[":
+            frames.append([char, None])
+            token = ""
+        elif char in "}]":
+            if frames:
+                frames.pop()
+            token = ""
+        elif char == "," and frames:
+            if frames[-1][0] == "{":
+                frames[-1][1] = None
+            token = ""
+        elif char == ":" and frames and frames[-1][0] == "{" and text[at + 1:at + 2] in ("", " "):
+            frames[-1][1] = token.strip().strip("'\"") or None
+            token = ""
+        else:
+            token += char
+    if not any(bracket == "{" for bracket, _ in frames):
+        return None  # no mapping open (a flow list alone is the caller's `in_list`)
+    path: list[str] = []
+    for bracket, key in frames[:-1]:
+        if bracket == "{" and key is not None:
+            path.append(key)
+    bracket, key = frames[-1]
+    if bracket == "[":  # a list item: the key of the mapping the list is the value of
+        return path[:-1] if path else path, path[-1] if path else None, True
+    return path, key, False

@@ -44,6 +44,8 @@ def symbolic(program: Program, ctx: PassContext, trace: Trace | None = None) -> 
             if names is not None and child is not None and _reads_ok(op, names, ctx):
                 parts[op.part] = op.merge(names, child, effects,
                                           (origins[op.part], origins.pop(op.child, "?")))
+                if trace is not None:  # the parent part's names before the child joins it
+                    trace(op, names, parts[op.part])  # type: ignore[arg-type]
             else:
                 parts[op.part] = None
             continue

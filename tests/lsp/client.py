@@ -54,9 +54,23 @@ class Client:
 
     def _send(self, message: dict[str, Any]) -> None:
         body = json.dumps(message).encode("utf-8")
+        self.send_raw(b"Content-Length: %d\r\n\r\n" % len(body) + body)
+
+    def send_raw(self, data: bytes) -> None:
+        """Bytes as they are, framed or not."""
         assert self.proc.stdin is not None
-        self.proc.stdin.write(b"Content-Length: %d\r\n\r\n" % len(body) + body)
+        self.proc.stdin.write(data)
         self.proc.stdin.flush()
+
+    def answered(self, number: int | str | None) -> list[dict[str, Any]]:
+        """The answers with this id received so far (id None: the server's refusals of frames
+        it could not read)."""
+        with self.lock:
+            box = self.answers.setdefault(number, queue.Queue())
+        found = []
+        while not box.empty():
+            found.append(box.get_nowait())
+        return found
 
     def notify(self, method: str, params: dict[str, Any] | None = None) -> None:
         self._send({"jsonrpc": "2.0", "method": method, "params": params or {}})

@@ -192,10 +192,11 @@ def test_definition_into_a_xacro_file(server: Client, folder: Path) -> None:
     assert diagnostics == []
     xacro = (folder / "arm.urdf.xacro").as_uri()
     assert server.request("textDocument/definition", server.at(uri, 10, 15)) == {  # parent: base
-        "uri": xacro, "range": {"start": {"line": 4, "character": 2}, "end": {"line": 4, "character": 19}}}
-    # a joint a macro names: the file
+        "uri": xacro, "range": {"start": {"line": 4, "character": 2}, "end": {"line": 4, "character": 7}}}
+    # a joint a macro names: the macro's element, in the included file
     macro = server.request("textDocument/definition", server.at(uri, 13, 5))
-    assert (macro["uri"], macro["range"]["start"]) == (xacro, {"line": 0, "character": 0})
+    assert (macro["uri"], macro["range"]["start"]) == ((folder / "arm_segment.xacro").as_uri(),
+                                                       {"line": 3, "character": 4})
 
 
 def test_rename_across_the_definition(server: Client, folder: Path) -> None:

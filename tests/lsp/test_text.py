@@ -9,7 +9,7 @@ from pathlib import Path
 from mpc.core import yaml_source
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
-from mpc.lsp.text import Lines, context
+from mpc.lsp.text import Context, Lines, context
 
 
 def test_columns_are_utf16_code_units() -> None:
@@ -75,3 +75,19 @@ def test_the_fast_path_keeps_the_depth_and_alias_limits() -> None:
         assert slow.diagnostics == fast.diagnostics, text
         assert (a is None) == (b is None) and (a is None or (a.data, a.values) == (b.data, b.values)), text
     assert sum(1 for text in texts if not yaml_source.loads(text, "f.yml", Sink(), limits)) >= 10
+
+
+def test_context_inside_flow_mappings() -> None:
+    text = ("model:\n  assemble:\n    children:\n      - {model: grip, joint: {parent: ba, name: j}}\n"
+            "  poses:\n    reach: {shoulder: 0.5, el}\n    rest: {a: [x, y], b: {c: ")
+    lines = Lines(text)
+
+    def at(line: int, after: str) -> Context:
+        """The context just after the first `after` on the line."""
+        return context(lines, line, lines.line(line).index(after) + len(after) + 1)
+
+    assert at(3, "parent: ba") == Context(("model", "assemble", "children", "-", "joint"), "parent", "ba")
+    assert at(5, "el") == Context(("model", "poses", "reach"), None, "el")
+    assert at(6, "[x, ") == Context(("model", "poses", "rest"), "a", "", True)
+    assert at(6, "{c: ") == Context(("model", "poses", "rest", "b"), "c", "")
+    assert at(3, "}}") == Context(("model", "assemble", "children", "-"), None, "")
