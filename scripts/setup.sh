@@ -66,7 +66,8 @@ if [ -n "$dev" ] && [ -z "${MPC_SETUP_NO_APT:-}" ]; then
 fi
 if [ "${#npm_packages[@]}" -gt 0 ]; then
   echo "setup: npm install -g ${npm_packages[*]}" >&2
-  # npm, like uv, trusts the system's certificate store (Debian's Node reads it with this option)
+  # npm, like uv, trusts the system's certificate store (Node reads it with this option; Debian's own
+  # Node does anyway)
   $sudo env NODE_OPTIONS="--use-openssl-ca" npm install -g --silent "${npm_packages[@]}" >/dev/null
 fi
 
