@@ -22,6 +22,7 @@ from __future__ import annotations
 import functools
 import os
 import re
+import stat
 import sys
 import sysconfig
 from collections.abc import Iterator
@@ -59,12 +60,20 @@ _MAX_DEPTH = 100  # rospack stops at 1000; no package tree is that deep, a link 
 
 
 def package_name(folder: Path | str) -> str | None:
-    """The `<name>` of `folder/package.xml`, or None (no such file, no name in it)."""
+    """The `<name>` of `folder/package.xml`, or None (no such file, not a regular file, no
+    name in it). Opened without blocking: a FIFO of that name must not hang the lookup."""
     try:
-        with open(os.path.join(folder, "package.xml"), "rb") as f:
-            text = f.read(1 << 16)  # the name comes first; a package.xml is a few kB
+        fd = os.open(os.path.join(folder, "package.xml"), os.O_RDONLY | os.O_NONBLOCK)
     except OSError:
         return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        text = os.read(fd, 1 << 16)  # the name comes first; a package.xml is a few kB
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
     found = _NAME.search(_COMMENT.sub(b"", text))
     return found.group(1).decode("utf-8", "replace") if found else None
 
@@ -248,8 +257,9 @@ class PackageResolver:
 
         assert self.search_path is not None
         # A package found on the search path is a root wherever its folder links to: the
-        # environment named it, as `--package` names one.
-        found = (f for f in (*self._cache.values(), *self._near.values()) if f is not None)
+        # environment named it, as `--package` names one. (Not one found above the model: a
+        # model may name any folder above it.)
+        found = (f for f in self._cache.values() if f is not None)
         folders = (*self.package_map.values(), *self.search_path, *found, *self.roots,
                    *([base_dir] if base_dir else []))
         if folders not in self._real_roots:

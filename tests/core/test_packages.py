@@ -159,3 +159,12 @@ def test_a_package_not_found_is_one_error_naming_how_many_files_need_it(
     assert notes[:2] == [  # in the model's order (visuals then collisions)
             ((5, 42), "also mesh 'package://gone_description/meshes/base.dae' of a collision of link 'base'"),
             ((9, 39), "also mesh 'package://gone_description/meshes/leg.dae' of a visual of link 'leg'")]
+
+
+def test_a_fifo_named_package_xml_above_the_model_names_nothing_and_does_not_hang(tmp_path: Path) -> None:
+    """Reading a FIFO would wait for a writer forever; a device or a folder is no package.xml."""
+    os.mkfifo(tmp_path / "package.xml")
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models/package.xml").mkdir()
+    resolver = PackageResolver(search_path=[])
+    assert resolver.find("arm_description", tmp_path / "models") is None
