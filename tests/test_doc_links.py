@@ -1,7 +1,7 @@
 """The project's documentation stands alone: README.md and the pages of specs/ (and
 bench/README.md) link only to files of the repository, which exist, and name no path out of
 it. (A relative path written as text, such as `../meshes/stl` in an output, may name a file
-that is not in the repository; it must not lead out of it.)"""
+that is not in the repository, unless it names a page (`.md`); it must not lead out of it.)"""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ def _problems(page: Path) -> list[str]:
         path = (page.parent / target.split("#")[0]).resolve()
         if not path.is_relative_to(ROOT):
             out.append(f"{target}: outside the repository")
-        elif target in links and not path.exists():
+        elif (target in links or target.endswith(".md")) and not path.exists():  # a page it names
             out.append(f"{target}: no such file")
     out += [f"names {m.group()!r}" for m in OUTSIDE.finditer(text)]
     return out
