@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mpc.backends.missing_packages import unfound_packages
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
@@ -84,14 +85,16 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
     """
     ok = True
     wanted: dict[MeshKey, str] = {}
-    for use in mesh_uses(robot):
+    uses = list(mesh_uses(robot))
+    if any(use.mesh.source.path is None for use in uses):  # a package not found: once each
+        for diagnostic in unfound_packages(((u.link, u.element, u.mesh) for u in uses), export_span):
+            if diagnostic not in sink.diagnostics:  # said once, not once per export
+                sink.report(diagnostic)
+            ok = False
+    for use in uses:
         src = use.mesh.source
         span = use.mesh.span or export_span
-        if src.path is None:
-            sink.error(span, "E0602", f"mesh '{src.uri}' of a {use.element} of link '{use.link}' "
-                       f"cannot be found: {src.unresolved}",
-                       hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH")
-            ok = False
+        if src.path is None:  # its package was not found (reported above)
             continue
         k = key(use.mesh)
         if k in wanted:

@@ -17,7 +17,8 @@ if TYPE_CHECKING:  # the rest is imported by `run`: building the parser of `mpc`
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of `mpc deploy`."""
+    """The options of `mpc deploy` (`--package`, `--format` and `--werror` come from
+    cli/main.py, as every command's that reads definitions)."""
     parser.add_argument("definition", type=Path,
                         help="the model definition (YAML) whose build is deployed")
     parser.add_argument("--built", type=Path, required=True, metavar="DIR",
@@ -39,20 +40,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workdir", type=Path,
                         help="where mpc keeps its clones (default: <pipeline root>/.mpc-deploy, "
                              "else build/.deploy)")
-    parser.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                        help="how to print diagnostics (default: human)")
 
 
 def run(args: argparse.Namespace) -> int:
+    from mpc.cli.output import resolver_of, sink_of
     from mpc.compiler.driver import Options
     from mpc.compiler.front_end import load_program
-    from mpc.core.diagnostics import Severity, Sink
+    from mpc.core.diagnostics import Severity
     from mpc.core.render import print_diagnostics
     from mpc.deploy.model import deploy_model
 
-    sink = Sink()
+    sink = sink_of(args)
     # A build exists already: what `compile` does not support yet is no reason to refuse it.
-    program = load_program(args.definition, sink, Options(), Severity.WARNING)
+    program = load_program(args.definition, sink, Options(resolver=resolver_of(args)), Severity.WARNING)
     settings = _settings(args, sink)
     protocol = None if args.protocol is None else _read_protocol(args.protocol, sink)
     result = None

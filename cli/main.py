@@ -27,13 +27,18 @@ def _package(text: str) -> tuple[str, Path]:
     return name, Path(folder).resolve()
 
 
-def _diagnostic_options(parser: argparse.ArgumentParser) -> None:
-    """--package, --format and --werror: the options of every command that reads definitions."""
-    parser.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
-                        help="where the ROS package NAME is (for package:// paths); repeatable")
-    parser.add_argument("--format", choices=("human", "gcc", "json"), default="human",
-                        help="how to print diagnostics (default: human)")
-    parser.add_argument("--werror", action="store_true", help="treat warnings as errors")
+def _input_parents() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
+    """The options of every command that reads definitions, as argparse parents: how packages
+    are found (`--package`: every such command, `mpc lsp` too) and how diagnostics are printed
+    and judged (`--format`, `--werror`: every such command that prints them)."""
+    packages = argparse.ArgumentParser(add_help=False)
+    packages.add_argument("--package", type=_package, action="append", default=[], metavar="NAME=DIR",
+                          help="where the ROS package NAME is (for package:// paths); repeatable")
+    diagnostics = argparse.ArgumentParser(add_help=False)
+    diagnostics.add_argument("--format", choices=("human", "gcc", "json"), default="human",
+                             help="how to print diagnostics (default: human)")
+    diagnostics.add_argument("--werror", action="store_true", help="treat warnings as errors")
+    return packages, diagnostics
 
 
 class _Version(argparse.Action):
@@ -53,7 +58,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
     parser.add_argument("--version", action=_Version, help="print mpc's version and exit")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    comp = sub.add_parser("compile", help="compile a model definition into model files")
+    packages, diagnostics = _input_parents()
+    inputs = [packages, diagnostics]
+    comp = sub.add_parser("compile", parents=inputs, help="compile a model definition into model files")
     comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
     comp.add_argument("--emit", choices=("files", "ir", "ir-lowered"), default="files",
@@ -62,7 +69,8 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--force", action="store_true",
                       help="build anew even when nothing the last build read has changed (its kept "
                            "outputs are not used; the mesh cache is)")
-    check = sub.add_parser("check", help="check definitions (or pipeline files) without building")
+    check = sub.add_parser("check", parents=inputs,
+                           help="check definitions (or pipeline files) without building")
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")
     schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
@@ -70,15 +78,17 @@ def _parser() -> argparse.ArgumentParser:
     # mpc deploy (cli/deploy.py)
     from mpc.cli.deploy import add_arguments as deploy_arguments
 
-    deploy_arguments(sub.add_parser("deploy", help="deploy a built model to its git repository"))
+    deploy_arguments(sub.add_parser("deploy", parents=inputs,
+                                    help="deploy a built model to its git repository"))
     # -- mpc test (checks/) --
-    test = sub.add_parser("test", help="compile a model definition and run its model tests")
+    test = sub.add_parser("test", parents=inputs, help="compile a model definition and run its model tests")
     test.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
                       "--built: where the protocol goes (default: the --built folder)")
     # -- pipeline runs and CI generation (pipeline/) --
-    run = sub.add_parser("run", help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
+    run = sub.add_parser("run", parents=inputs,
+                         help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
     run.add_argument("pipeline", type=Path, help="the pipeline file")
     run.add_argument("--only", nargs="+", action="extend", default=[], metavar="MODEL",
                      help="build only these models (modelnames or definition files); others' outputs stay")
@@ -108,8 +118,8 @@ def _parser() -> argparse.ArgumentParser:
                          help="shell command that installs mpc in a job and puts it on PATH (default: "
                          "the install of this mpc, from the project's requirements.txt or how it was "
                          "installed)")
-    job = systems.add_parser("job", help="what a generated job runs: one model and stages, with the "
-                             "artifacts of earlier jobs")
+    job = systems.add_parser("job", parents=inputs, help="what a generated job runs: one model and "
+                             "stages, with the artifacts of earlier jobs")
     job.add_argument("pipeline", type=Path, help="the pipeline file")
     job.add_argument("model", help="the modelname")
     job.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
@@ -121,15 +131,14 @@ def _parser() -> argparse.ArgumentParser:
                          help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
     from mpc.cli.lsp import add_arguments as lsp_arguments
 
-    lsp_arguments(sub.add_parser("lsp", help="the language server for editors (LSP over stdio)"), _package)
-    view = sub.add_parser("view", help="show a model in the browser (a local web viewer)")
+    lsp_arguments(sub.add_parser("lsp", parents=[packages],
+                                 help="the language server for editors (LSP over stdio)"))
+    view = sub.add_parser("view", parents=inputs, help="show a model in the browser (a local web viewer)")
     view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
     view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
-    for p in (comp, check, test, run, view, job):
-        _diagnostic_options(p)
     return parser
 
 

@@ -150,24 +150,22 @@ class InputLoader:
 
 def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
     """`mpc check`: the input model's mesh files that do not exist (E0602, as writing them
-    would say); none is read. Every mesh of the input counts, also one a later edit removes.
-    The driver reports them after the names are checked, which they do not hinder."""
+    would say; E0654 once for a package not found); none is read. Every mesh of the input
+    counts, also one a later edit removes. The driver reports them after the names are
+    checked, which they do not hinder."""
     seen: set[Path] = set()
     out = []
-    for name, link in robot.links.items():
-        for element, items in (("visual", link.visuals), ("collision", link.collisions)):
-            for item in items:
-                mesh = item.geometry
-                if not isinstance(mesh, Mesh):
-                    continue
-                src, span = mesh.source, mesh.span or where
-                if src.path is None:
-                    out.append(Diagnostic(
-                        Severity.ERROR, "E0602", f"mesh '{src.uri}' of a {element} of link '{name}' "
-                        f"cannot be found: {src.unresolved}", span,
-                        hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH"))
-                elif src.path not in seen and not src.path.is_file():
-                    out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{src.path}' of a "
-                                          f"{element} of link '{name}' does not exist", span))
-                    seen.add(src.path)
+    uses = [(name, element, item.geometry) for name, link in robot.links.items()
+            for element, items in (("visual", link.visuals), ("collision", link.collisions))
+            for item in items if isinstance(item.geometry, Mesh)]
+    if any(mesh.source.path is None for _, _, mesh in uses):  # a package not found: once each
+        from mpc.backends.missing_packages import unfound_packages
+
+        out += unfound_packages(uses, where)
+    for name, element, mesh in uses:
+        path = mesh.source.path  # None: its package was not found (reported above)
+        if path is not None and path not in seen and not path.is_file():
+            out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{path}' of a {element} of "
+                                  f"link '{name}' does not exist", mesh.span or where))
+            seen.add(path)
     return out

@@ -9,12 +9,20 @@ AMENT_PREFIX_PATH (a sourced ROS 2 workspace), in the `share/` folders of the Py
 environment (where pip-installed robot packages such as example-robot-data live,
 under `cmeel.prefix/share`), and last among the folders above the model file
 (the way PyBullet finds them). Each package name is looked up once.
+
+A package is named as rospack and ament name it, by the `<name>` of its `package.xml`, so a
+clone under another name (GitHub's `…-master` archive folder) is found; a folder named
+after the package also counts (a package without a package.xml, or a folder name the model's
+paths use, as `package://example-robot-data` does). ROS_PACKAGE_PATH's folders are crawled as
+rospack crawls them (`crawl`); the share folders hold their packages directly below them.
 """
 
 from __future__ import annotations
 
 import functools
 import os
+import re
+import stat
 import sys
 import sysconfig
 from collections.abc import Iterator
@@ -45,6 +53,108 @@ def _environment_share_dirs() -> list[Path]:
     return seen
 
 
+_IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
+_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
+_COMMENT = re.compile(rb"<!--.*?-->", re.S)
+_MAX_DEPTH = 100  # rospack stops at 1000; no package tree is that deep, a link loop may be
+
+
+def package_name(folder: Path | str) -> str | None:
+    """The `<name>` of `folder/package.xml`, or None (no such file, not a regular file, no
+    name in it). Opened without blocking: a FIFO of that name must not hang the lookup."""
+    try:
+        fd = os.open(os.path.join(folder, "package.xml"), os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        text = os.read(fd, 1 << 16)  # the name comes first; a package.xml is a few kB
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+    found = _NAME.search(_COMMENT.sub(b"", text))
+    return found.group(1).decode("utf-8", "replace") if found else None
+
+
+# Crawls and share folders' listings, by the folder's path: once per process (a workspace's
+# packages do not move while mpc runs; `mpc check` looks up a few names in each).
+_crawls: dict[str, dict[str, Path]] = {}
+_shares: dict[str, dict[str, Path]] = {}
+
+
+def crawl(root: Path) -> dict[str, Path]:
+    """Every package under `root` (ROS_PACKAGE_PATH's folders), name → folder, as rospack
+    crawls: a folder with a package.xml is a package and is not descended into; a folder
+    with CATKIN_IGNORE, COLCON_IGNORE or AMENT_IGNORE is skipped, one with
+    `rospack_nosubdirs` not descended into; hidden folders are skipped; links are followed
+    (each real folder once). Of two packages with one name, the first in sorted order wins.
+    Folders are named as reached (through the links), so a linked package is found where
+    the environment names it."""
+    key = str(root)
+    if key not in _crawls:
+        found: dict[str, Path] = {}
+        _visit(root, found, set(), 0)
+        _crawls[key] = found
+    return _crawls[key]
+
+
+def _visit(folder: Path, found: dict[str, Path], seen: set[str], depth: int) -> None:
+    real = os.path.realpath(folder)
+    if real in seen or depth > _MAX_DEPTH:
+        return
+    seen.add(real)
+    try:
+        with os.scandir(folder) as it:
+            entries = sorted(((e.name, e) for e in it), key=lambda pair: pair[0])
+    except OSError:
+        return
+    names = {name for name, _ in entries}
+    if any(marker in names for marker in _IGNORE_MARKERS):
+        return
+    if "package.xml" in names:
+        name = package_name(folder)
+        if name is not None:
+            found.setdefault(name, folder)
+            return
+    if "rospack_nosubdirs" in names:
+        return
+    for name, entry in entries:
+        try:
+            if name.startswith(".") or not entry.is_dir():
+                continue
+        except OSError:
+            continue
+        _visit(folder / name, found, seen, depth + 1)
+
+
+def share_packages(share: Path) -> dict[str, Path]:
+    """The packages right below a `share/` folder (an ament prefix's, the Python
+    environment's), name (of their package.xml) → folder."""
+    key = str(share)
+    if key not in _shares:
+        found: dict[str, Path] = {}
+        try:
+            with os.scandir(share) as it:
+                folders = sorted(e.name for e in it if not e.name.startswith(".") and e.is_dir())
+        except OSError:
+            folders = []
+        for folder in folders:
+            name = package_name(share / folder)
+            if name is not None:
+                found.setdefault(name, share / folder)
+        _shares[key] = found
+    return _shares[key]
+
+
+def package_of(uri: str) -> str | None:
+    """The package a `package://NAME/…` filename names, else None."""
+    if not uri.startswith("package://"):
+        return None
+    return uri[len("package://"):].partition("/")[0]
+
+
 def _path_list(variable: str) -> list[str]:
     return [p for p in os.environ.get(variable, "").split(os.pathsep) if p]
 
@@ -62,12 +172,16 @@ class PackageResolver:
     _real_roots: dict[tuple[Path, ...], tuple[Path, ...]] = field(default_factory=dict)
     _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
     _near: dict[tuple[str, Path], Path | None] = field(default_factory=dict)  # (package, near) → folder
+    # The search path's folders that are crawled as rospack does (ROS_PACKAGE_PATH's); the
+    # others are share/ folders, with their packages right below them.
+    _crawled: frozenset[Path] = frozenset()
 
     def __post_init__(self) -> None:
         if self.search_path is None:
             ros = [Path(p) for p in _path_list("ROS_PACKAGE_PATH")]
             ament = [Path(p) / "share" for p in _path_list("AMENT_PREFIX_PATH")]
             self.search_path = ros + ament + _environment_share_dirs()
+            self._crawled = frozenset(ros)
             # colcon's --symlink-install links a workspace's install/ into its src/ and build/:
             # inputs may link anywhere inside the workspace of a sourced prefix.
             for prefix in map(Path, _path_list("AMENT_PREFIX_PATH")):
@@ -91,17 +205,32 @@ class PackageResolver:
         if found is None and near is not None:
             key = (package, near)
             if key not in self._near:  # every mesh of a model asks: Path.parents is slow
-                self._near[key] = next((p for p in (near, *near.parents) if p.name == package), None)
+                self._near[key] = next((p for p in (near, *near.parents)
+                                        if p.name == package or package_name(p) == package), None)
             return self._near[key]
         return found
 
     def _search(self, package: str) -> Path | None:
+        """The first folder of the search path that holds `package`: named so by its
+        package.xml (crawled for in ROS_PACKAGE_PATH's folders, right below the share/
+        folders), else a folder of that name."""
         assert self.search_path is not None
         for root in self.search_path:
+            folder = root / package
+            if root in self._crawled:
+                if package_name(folder) == package:  # the usual layout: no crawl needed
+                    return folder
+                found = crawl(root).get(package)
+            elif folder.is_dir():
+                return folder
+            else:
+                found = share_packages(root).get(package)
+            if found is not None:
+                return found
             if root.name == package and root.is_dir():
                 return root
-            if (root / package).is_dir():
-                return root / package
+            if folder.is_dir():
+                return folder
         return None
 
     def add_root(self, folder: Path) -> None:
@@ -127,7 +256,11 @@ class PackageResolver:
         from mpc.core.files import package_roots
 
         assert self.search_path is not None
-        folders = (*self.package_map.values(), *self.search_path, *self.roots,
+        # A package found on the search path is a root wherever its folder links to: the
+        # environment named it, as `--package` names one. (Not one found above the model: a
+        # model may name any folder above it.)
+        found = (f for f in self._cache.values() if f is not None)
+        folders = (*self.package_map.values(), *self.search_path, *found, *self.roots,
                    *([base_dir] if base_dir else []))
         if folders not in self._real_roots:
             self._real_roots[folders] = package_roots(folders)
@@ -136,8 +269,9 @@ class PackageResolver:
     def locate(self, uri: str, base_dir: Path) -> tuple[Path | None, str]:
         """A filename as written in a file in `base_dir` → (the file, or None when its package
         cannot be found; why not, a sentence for a diagnostic, else "")."""
-        if uri.startswith("package://"):
-            package, _, rest = uri[len("package://"):].partition("/")
+        package = package_of(uri)
+        if package is not None:
+            rest = uri[len("package://") + len(package) + 1:]
             folder = self.find(package, base_dir)
             if folder is None:
                 return None, (f"package '{package}' was not found (searched the package map, "

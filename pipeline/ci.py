@@ -150,6 +150,11 @@ def _dump(doc: dict[str, Any]) -> str:
     return yaml.dump(doc, Dumper=_Dumper, sort_keys=False, width=1000)
 
 
+# uv trusts the certificates of the system's store (as pip and curl do), not only its own bundled
+# roots: a runner behind a TLS-inspecting proxy has that proxy's CA there.
+SYSTEM_CERTS = {"UV_SYSTEM_CERTS": "1"}
+
+
 # -- GitLab --------------------------------------------------------------------------------------
 
 
@@ -161,7 +166,8 @@ def gitlab(plan: Plan, s: Setup) -> str:
     uv_key = "mpc-uv-" + _install_digest(s)
     doc: dict[str, Any] = {"stages": [*s.stages, "summary"], "variables": {
         "MPC_VERSION": s.version, "MPC_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/mpc",
-        "UV_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/uv", "PIP_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/pip"}}
+        "UV_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/uv", "PIP_CACHE_DIR": f"$CI_PROJECT_DIR/{CACHE}/pip",
+        **SYSTEM_CERTS}}
     default: dict[str, Any] = {}
     if s.image:
         default["image"] = s.image
@@ -284,6 +290,6 @@ def github(plan: Plan, s: Setup) -> str:
     doc = {"name": "mpc models", "on": {"workflow_dispatch": {}, "workflow_call": {}},
            "env": {"MPC_VERSION": s.version, "MPC_CACHE_DIR": f"${{{{ github.workspace }}}}/{CACHE}/mpc",
                    "UV_CACHE_DIR": f"${{{{ github.workspace }}}}/{CACHE}/uv",
-                   "PIP_CACHE_DIR": f"${{{{ github.workspace }}}}/{CACHE}/pip"},
+                   "PIP_CACHE_DIR": f"${{{{ github.workspace }}}}/{CACHE}/pip", **SYSTEM_CERTS},
            "jobs": jobs}
     return _header(s) + _dump(doc)

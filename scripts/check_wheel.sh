@@ -5,6 +5,7 @@
 # must have triangles. Run by .ci/run after the suite.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export UV_SYSTEM_CERTS=1  # the system's certificate store, as scripts/setup.sh says
 repo=$(pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -4,9 +4,9 @@
 # (e.g. `--upgrade-package trimesh` to move one package only; the default moves all).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export UV_SYSTEM_CERTS=1  # the system's certificate store, as scripts/setup.sh says
 UV_VERSION=$(sed -n 's/^UV_VERSION=//p' scripts/setup.sh)
 uv="${XDG_CACHE_HOME:-$HOME/.cache}/mpc/uv-$UV_VERSION/bin/uv"
-[ -x "$uv" ] || bash scripts/setup.sh
+[ -x "$uv" ] || bash scripts/setup.sh --dev
 UV_PYTHON_DOWNLOADS=never "$uv" lock "${@:---upgrade}"
-bash scripts/setup.sh
-.venv/bin/python -m pytest -n auto -q
+bash scripts/test.sh

@@ -231,9 +231,12 @@ def test_missing_mesh(tmp_path: Path, diags: Diags) -> None:
 
 def test_unknown_package(tmp_path: Path, diags: Diags) -> None:
     _urdf(tmp_path, diags, ARM_URDF.replace("meshes/tetra.stl", "package://nowhere/tetra.stl"))
-    d = diags.take_error("E0602")
-    assert d.message.startswith("mesh 'package://nowhere/tetra.stl' of a visual of link 'base' "
-                                "cannot be found: package 'nowhere' was not found")
+    d = diags.take_error("E0654")
+    assert d.message == ("package 'nowhere' was not found (searched the package map, ROS_PACKAGE_PATH, "
+                         "AMENT_PREFIX_PATH, the Python environment and the folders above the model); "
+                         "1 mesh file needs it, the first mesh 'package://nowhere/tetra.stl' of a "
+                         "visual of link 'base'")
+    assert d.notes == ()
 
 
 def test_mesh_format_that_cannot_be_written(tmp_path: Path, diags: Diags) -> None:

@@ -71,3 +71,20 @@ def test_cli_refuses_pipeline_and_remote_together(model: Model) -> None:
     run = mpc("deploy", model.definition, "--built", "b", "--pipeline", "p.yml", "--remote", "r")
     assert run.returncode == 2
     assert "argument --remote: not allowed with argument --pipeline" in run.stderr
+
+
+def test_deploy_takes_package_as_every_command_that_reads_definitions(
+        model: Model, server: Server, tmp_path: Path) -> None:
+    """Its hint names `--package`: `mpc deploy` takes it (and `--werror`), as compile does."""
+    model.compile()
+    model.definition.write_text(definition_text().replace("basefile: arm.urdf",
+                                                          "basefile: package://arm_pkg/arm.urdf"))
+    git(model.folder, "commit", "-qam", "the arm from its package")
+    deploy = ("deploy", model.definition, "--built", model.built, "--remote", server.url, "--dry-run",
+              "--workdir", tmp_path / "work")
+    missing = mpc(*deploy)
+    assert missing.returncode == 1
+    assert "hint: map the package with --package NAME=DIR or ROS_PACKAGE_PATH" in missing.stderr
+    found = mpc(*deploy, "--package", f"arm_pkg={model.folder}")
+    assert found.returncode == 0, found.stderr
+    assert found.stdout.startswith(f"dry run: would push to branch 'master' of '{server.url}':")

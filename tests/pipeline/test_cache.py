@@ -169,6 +169,35 @@ def test_where_ros_package_path_finds_a_package_is_part_of_the_fingerprint(proje
         ["package://example-robot-data\0models", PACKAGE, 0, found]]
 
 
+def test_where_a_package_xml_name_finds_a_package_is_part_of_the_fingerprint(project: Path,
+                                                                            tmp_path: Path) -> None:
+    """A package found by its package.xml's name in a crawled ROS_PACKAGE_PATH (a clone under
+    another folder name) is recorded where it was found; once that package.xml names another
+    package, the copy found next rebuilds the models that used it."""
+    clone = tmp_path / "a/group/erd-master"
+    shutil.copytree(project / "erd", clone)
+    write(clone / "package.xml", "<package format='3'><name>example-robot-data</name></package>\n")
+    shutil.copytree(project / "erd", tmp_path / "b/example-robot-data")
+    pipeline, cache = project / "ci/pipeline.yml", tmp_path / "cache"
+
+    def rebuilt() -> set[str]:
+        run = run_json(pipeline, cache=cache, environ={
+            "ROS_PACKAGE_PATH": f"{tmp_path / 'a'}{os.pathsep}{tmp_path / 'b'}", "AMENT_PREFIX_PATH": ""})
+        assert run.returncode == 0, run.stderr
+        return _rebuilt(run.states())
+
+    def found() -> set[str]:
+        state = json.loads((project / "build/.mpc/state/base.json").read_text())
+        return {d[3] for d in state["deps"] if d[1] == PACKAGE}
+
+    assert rebuilt() == ALL
+    assert rebuilt() == set()
+    assert found() == {str(clone)}
+    _edit(clone / "package.xml", "<name>example-robot-data</name>", "<name>erd_fork</name>")
+    assert rebuilt() == {"base", "child"}
+    assert found() == {str(tmp_path / "b/example-robot-data")}
+
+
 def test_touching_every_file_or_running_from_another_folder_rebuilds_nothing(project: Path,
                                                                             tmp_path: Path) -> None:
     for path in project.rglob("*"):

@@ -84,7 +84,9 @@ def test_gitlab_child_pipeline(fleet: Path) -> None:
         "build/quad_pair/", "build/.mpc/state/quad_pair.json", "build/.mpc/ci/quad_pair/"]}
     assert doc["variables"] == {"MPC_VERSION": VERSION, "MPC_CACHE_DIR": "$CI_PROJECT_DIR/.cache/mpc",
                                 "UV_CACHE_DIR": "$CI_PROJECT_DIR/.cache/uv",
-                                "PIP_CACHE_DIR": "$CI_PROJECT_DIR/.cache/pip"}
+                                "PIP_CACHE_DIR": "$CI_PROJECT_DIR/.cache/pip",
+                                # uv trusts the system's certificates (a TLS-inspecting proxy's CA)
+                                "UV_SYSTEM_CERTS": "1"}
     assert doc["default"]["before_script"][:-1] == INSTALL
     # model jobs only pull the caches; the summary job, the single writer, pushes them
     [uv, meshes] = jobs["build:arm"]["cache"]
@@ -174,6 +176,7 @@ def test_github_workflow(fleet: Path, tmp_path: Path) -> None:
     assert sorted(summary["needs"]) == sorted(k for k in jobs if k != "summary")
     assert any('--markdown "$GITHUB_STEP_SUMMARY"' in s.get("run", "") for s in summary["steps"])
     assert doc["env"]["MPC_VERSION"] == VERSION
+    assert doc["env"]["UV_SYSTEM_CERTS"] == "1"
 
 
 def test_an_image_with_mpc_needs_no_install(fleet: Path) -> None:

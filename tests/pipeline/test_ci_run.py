@@ -66,8 +66,9 @@ def team(tmp_path_factory: pytest.TempPathFactory) -> Path:
     top = tmp_path_factory.mktemp("team")
     fleet(top / "fleet")
     source = _tracked_files(top.parent / f"{top.name}-src")
-    built = subprocess.run([str(UV), "build", "--wheel", "--quiet", "--out-dir", str(top / "wheels"),
-                            str(source)], capture_output=True, text=True)
+    # uv fetches setuptools trusting the system's certificates, as scripts/setup.sh has it do
+    built = subprocess.run([str(UV), "build", "--system-certs", "--wheel", "--quiet", "--out-dir",
+                            str(top / "wheels"), str(source)], capture_output=True, text=True)
     assert built.returncode == 0, built.stderr
     (top / "wheels" / ".gitignore").unlink(missing_ok=True)  # uv build ignores its output folder
     [wheel] = (top / "wheels").glob("*.whl")
