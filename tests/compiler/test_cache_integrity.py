@@ -1,0 +1,171 @@
+"""What a kept build (compiler/build_cache.py) may do to its user: nothing from the cache runs,
+and the delivered outputs share no storage with it.
+
+Whoever can write `$MPC_CACHE_DIR` (a CI cache shared with merge-request pipelines) may put
+anything there: a pickle that would run code when read, an entry of mpc's own form edited to
+lead elsewhere. The next `mpc compile` reads none of it as code, says which entry it refused
+(W0650), and builds again. A file delivered by `-o` and the kept copy of it are two files: a
+write into one, in place, leaves the other as it was.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import pickle
+import shutil
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from mpc.cli.main import main
+from mpc.compiler.driver import Options, compile_model
+from mpc.core.diagnostics import Sink
+from tests.conftest import definition, write
+from tests.fixtures import arm
+
+
+@pytest.fixture
+def spec(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The arm's definition (a URDF and an STL mesh)."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    arm(tmp_path / "model")
+    spec = write(tmp_path / "model/arm.yml", definition("arm.urdf", mesh_format="stl"))
+    time.sleep(0.05)  # past the file system's clock tick: a build of files just written is not kept
+    return spec
+
+
+def _first_build(spec: Path, tmp_path: Path) -> None:
+    """Compile into `out1`, keeping the build (in the test itself: the environment of a
+    fixture, PYTEST_CURRENT_TEST, is another build's)."""
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out1")]) == 0
+
+
+def _entry(tmp_path: Path) -> Path:
+    (entry,) = (tmp_path / "cache/builds").glob("*/*/entry")
+    return entry
+
+
+def _replace(entry: Path, data: bytes) -> None:
+    """Write `data` as the entry, with the hash beside it that makes it look sound."""
+    entry.write_bytes(data)
+    entry.with_name("entry.sha256").write_text(hashlib.sha256(data).hexdigest() + "\n")
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _warning(spec: Path, entry: Path, why: str) -> str:
+    return (f"{spec}:1:1: warning[W0650]: the kept build '{entry}' is unusable ({why}); it is removed "
+            "and the model is built again")
+
+
+class _Payload:
+    """What a pickle runs when it is read: here, it creates the canary file."""
+
+    def __init__(self, canary: Path) -> None:
+        self.canary = canary
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return open, (str(self.canary), "w")
+
+
+def test_a_kept_build_crafted_as_a_pickle_runs_nothing_and_is_built_again(
+        tmp_path: Path, spec: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _first_build(spec, tmp_path)
+    entry, canary = _entry(tmp_path), tmp_path / "canary"
+    capsys.readouterr()
+    _replace(entry, pickle.dumps({"key": "?", "entry": _Payload(canary)}))
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
+    err = capsys.readouterr().err
+    assert not canary.exists()
+    assert _warning(spec, entry, "it is not a kept build: not JSON") in err
+    assert "Traceback" not in err
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+    assert entry.read_bytes().startswith(b'{"') and not canary.exists()  # built again, and kept
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out3")]) == 0
+    assert "W0650" not in capsys.readouterr().err
+
+
+def _retagged(old: bytes, new: bytes) -> Callable[[bytes], bytes]:
+    return lambda data: data.replace(old, new, 1)
+
+
+def _output_outside(data: bytes) -> bytes:
+    return data.replace(b'["urdf/robot.urdf"', b'["../../../../../model/arm.urdf"', 1)
+
+
+@pytest.mark.parametrize(("tamper", "why", "model_read"), [
+    (_retagged(b'"mpc.core.span:Span"', b'"os:system"'), "'os:system' names no class of mpc's IR", False),
+    (_retagged(b'"mpc.core.span:Span"', b'"mpc.core.span:Path"'),
+     "'mpc.core.span:Path' names no class of that module", False),
+    (_output_outside, "its output files are not as kept", False),
+    (_retagged(b'"form":"mpc kept build 2"', b'"form":"mpc kept build 3"'), "not the header of a kept build",
+     False),
+    (_retagged(b'{"r":["mpc.ir.program:Program",', b'{"r":["mpc.ir.program:Program",1,'),
+     "not one value for each field of 'mpc.ir.program:Program'", True),
+    (_retagged(b'{"r":["mpc.ir.program:Program",', b'{"x":["mpc.ir.program:Program",'),
+     "an object tagged 'x'", True),
+], ids=["another module's class", "a name imported by a module of mpc", "an output outside its folder",
+        "another form", "a field too many", "an unknown tag"])
+def test_a_tampered_kept_build_is_refused_cleanly_and_built_again(
+        tmp_path: Path, spec: Path, capsys: pytest.CaptureFixture[str],
+        tamper: Callable[[bytes], bytes], why: str, model_read: bool) -> None:
+    _first_build(spec, tmp_path)
+    entry = _entry(tmp_path)
+    tampered = tamper(entry.read_bytes())
+    assert tampered != entry.read_bytes()
+    _replace(entry, tampered)
+    if model_read:  # the kept outputs are gone: the build takes the kept program and robot
+        shutil.rmtree(next(entry.parent.glob("outputs-*")))
+    capsys.readouterr()
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
+    err = capsys.readouterr().err
+    assert _warning(spec, entry, f"it is not a kept build: {why}") in err
+    assert "Traceback" not in err
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+
+
+def test_a_tampered_program_of_a_build_that_wrote_its_kept_outputs_is_built_when_asked_for(
+        tmp_path: Path, spec: Path) -> None:
+    first = compile_model(spec, Sink(), Options(out=tmp_path / "a", force=True))
+    entry = _entry(tmp_path)
+    _replace(entry, entry.read_bytes().replace(b'{"r":["mpc.ir.program:Program",', b'{"r":["os:system",', 1))
+    again = compile_model(spec, Sink(), Options(out=tmp_path / "b"))
+    assert again.out == tmp_path / "b" and _files(tmp_path / "b") == _files(tmp_path / "a")
+    assert again.program == first.program and again.robot == first.robot
+
+
+# -- delivered outputs are copies --------------------------------------------------------------
+
+def _write_in_place(path: Path, data: bytes) -> None:
+    """As an editor that keeps the file's inode writes it: open, truncate, write."""
+    with open(path, "r+b") as f:
+        f.truncate(0)
+        f.write(data)
+
+
+def test_a_delivered_file_written_in_place_leaves_the_kept_build_and_the_next_delivery_as_they_were(
+        tmp_path: Path, spec: Path) -> None:
+    _first_build(spec, tmp_path)
+    delivered = _files(tmp_path / "out1")
+    kept = next(_entry(tmp_path).parent.glob("outputs-*"))
+    assert _files(kept) == delivered
+    for name in delivered:
+        _write_in_place(tmp_path / "out1" / name, b"edited")
+    assert _files(kept) == delivered
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
+    assert _files(tmp_path / "out2") == delivered
+
+
+def test_a_kept_file_written_in_place_leaves_the_delivered_files_as_they_were(
+        tmp_path: Path, spec: Path) -> None:
+    _first_build(spec, tmp_path)
+    delivered = _files(tmp_path / "out1")
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0  # delivered from the cache
+    kept = next(_entry(tmp_path).parent.glob("outputs-*"))
+    for name in _files(kept):
+        _write_in_place(kept / name, b"")
+    assert _files(tmp_path / "out1") == delivered == _files(tmp_path / "out2")
