@@ -66,32 +66,47 @@ def loads(data: bytes | str) -> Any:
         raise BadValue(f"not JSON ({str(e)[:60]})") from None
 
 
+_SCALARS = frozenset({str, int, float, bool, type(None)})  # written as they are
+
+
 class _Encoder:
+    """Each container's items are looked at in place when they are scalars (most are: names,
+    numbers), not through a call: that call per value was most of the time of keeping a build."""
+
     def __init__(self, paths: list[PurePath]) -> None:
         self.paths = paths
         self.by_type: dict[type, Callable[[Any], Any]] = {
-            str: _same, int: _same, float: _same, bool: _same, type(None): _same,
             tuple: self._tuple, list: self._list, frozenset: self._frozenset, dict: self._dict,
             PosixPath: self._path, PurePosixPath: self._path,
         }
 
     def encode(self, value: Any) -> Any:
-        how = self.by_type.get(type(value))
+        cls = type(value)
+        if cls in _SCALARS:
+            return value
+        how = self.by_type.get(cls)
         if how is None:
-            how = self._how(type(value))
+            how = self._how(cls)
         return how(value)
+
+    def _items(self, values: Any) -> list[Any]:
+        encode = self.encode
+        return [v if type(v) in _SCALARS else encode(v) for v in values]
 
     def _how(self, cls: type) -> Callable[[Any], Any]:
         kept = _KEPT_AS.get(cls, cls)
         tag = f"{kept.__module__}:{kept.__qualname__}"
         if not _MODULE.fullmatch(kept.__module__) or not _NAME.fullmatch(kept.__qualname__):
             raise TypeError(f"a value of type {tag} is not kept")
-        encode = self.encode
         how: Callable[[Any], Any]
         if is_record(kept):
+            items = self._items
+
             def how(obj: Any) -> Any:
-                return {"r": [tag, *[encode(v) for v in record_values(obj)]]}
+                return {"r": [tag, *items(record_values(obj))]}
         elif issubclass(kept, Enum):
+            encode = self.encode
+
             def how(member: Any) -> Any:
                 return {"e": [tag, encode(member.value)]}
         else:
@@ -100,16 +115,13 @@ class _Encoder:
         return how
 
     def _tuple(self, value: tuple[Any, ...]) -> Any:
-        encode = self.encode
-        return {"t": [encode(v) for v in value]}
+        return {"t": self._items(value)}
 
     def _list(self, value: list[Any]) -> Any:
-        encode = self.encode
-        return [encode(v) for v in value]
+        return self._items(value)
 
     def _frozenset(self, value: frozenset[Any]) -> Any:
-        encode = self.encode
-        return {"s": [encode(v) for v in value]}
+        return {"s": self._items(value)}
 
     def _dict(self, value: dict[Any, Any]) -> Any:
         encode, out = self.encode, []
@@ -120,10 +132,6 @@ class _Encoder:
     def _path(self, value: PurePath) -> Any:
         self.paths.append(value)
         return {"p": str(value)}
-
-
-def _same(value: Any) -> Any:
-    return value
 
 
 class _Decoder:
