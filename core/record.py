@@ -13,7 +13,9 @@ the slot's own setter (`_fast_init`): dataclass's frozen one goes through object
 for every field, which takes twice as long. Code that makes thousands of records (a reader)
 asks for a `maker`, which skips the class call too: a quarter of its time. A record with
 slots also pickles its fields as a tuple, in order, as dataclass's own `__getstate__` does,
-without looking the fields up for each object (the build cache pickles thousands).
+without looking the fields up for each object. The build cache writes records as their field
+values (`record_values`) and reads them back without running their code (`from_values`:
+compiler/kept_values.py); only classes made here (`is_record`) are read back.
 """
 
 from __future__ import annotations
@@ -249,7 +251,7 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) ->
         written = "__init__" in c.__dict__
         out = dataclass(c, frozen=True, repr=False, eq=False, slots=slots, kw_only=kw_only)
         methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
-        if slots:  # dataclass's own look each field up anew for every object pickled (build cache)
+        if slots:  # dataclass's own look each field up anew for every object pickled
             methods += [("__getstate__", _values), ("__setstate__", _setstate)]
         for name, method in methods:
             if name not in c.__dict__:
