@@ -11,19 +11,21 @@ write into one, in place, leaves the other as it was.
 from __future__ import annotations
 
 import hashlib
+import os
 import pickle
 import shutil
+import subprocess
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
-from mpc.cli.main import main
 from mpc.compiler.driver import Options, compile_model
 from mpc.core.diagnostics import Sink
 from tests.conftest import definition, write
 from tests.fixtures import arm
+from tests.mpc_command import mpc
 
 
 @pytest.fixture
@@ -39,7 +41,7 @@ def spec(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def _first_build(spec: Path, tmp_path: Path) -> None:
     """Compile into `out1`, keeping the build (in the test itself: the environment of a
     fixture, PYTEST_CURRENT_TEST, is another build's)."""
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out1")]) == 0
+    assert mpc("compile", spec, "-o", tmp_path / "out1").returncode == 0
 
 
 def _entry(tmp_path: Path) -> Path:
@@ -73,20 +75,19 @@ class _Payload:
 
 
 def test_a_kept_build_crafted_as_a_pickle_runs_nothing_and_is_built_again(
-        tmp_path: Path, spec: Path, capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, spec: Path) -> None:
     _first_build(spec, tmp_path)
     entry, canary = _entry(tmp_path), tmp_path / "canary"
-    capsys.readouterr()
     _replace(entry, pickle.dumps({"key": "?", "entry": _Payload(canary)}))
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
-    err = capsys.readouterr().err
-    assert not canary.exists()
+    done = mpc("compile", spec, "-o", tmp_path / "out2")
+    err = done.stderr
+    assert not canary.exists() and done.returncode == 0
     assert _warning(spec, entry, "it is not a kept build: not JSON") in err
     assert "Traceback" not in err
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
     assert entry.read_bytes().startswith(b'{"') and not canary.exists()  # built again, and kept
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out3")]) == 0
-    assert "W0650" not in capsys.readouterr().err
+    done = mpc("compile", spec, "-o", tmp_path / "out3")
+    assert done.returncode == 0 and "W0650" not in done.stderr
 
 
 def _retagged(old: bytes, new: bytes) -> Callable[[bytes], bytes]:
@@ -111,7 +112,7 @@ def _output_outside(data: bytes) -> bytes:
 ], ids=["another module's class", "a name imported by a module of mpc", "an output outside its folder",
         "another form", "a field too many", "an unknown tag"])
 def test_a_tampered_kept_build_is_refused_cleanly_and_built_again(
-        tmp_path: Path, spec: Path, capsys: pytest.CaptureFixture[str],
+        tmp_path: Path, spec: Path,
         tamper: Callable[[bytes], bytes], why: str, model_read: bool) -> None:
     _first_build(spec, tmp_path)
     entry = _entry(tmp_path)
@@ -120,9 +121,9 @@ def test_a_tampered_kept_build_is_refused_cleanly_and_built_again(
     _replace(entry, tampered)
     if model_read:  # the kept outputs are gone: the build takes the kept program and robot
         shutil.rmtree(next(entry.parent.glob("outputs-*")))
-    capsys.readouterr()
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
-    err = capsys.readouterr().err
+    done = mpc("compile", spec, "-o", tmp_path / "out2")
+    err = done.stderr
+    assert done.returncode == 0
     assert _warning(spec, entry, f"it is not a kept build: {why}") in err
     assert "Traceback" not in err
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
@@ -156,7 +157,7 @@ def test_a_delivered_file_written_in_place_leaves_the_kept_build_and_the_next_de
     for name in delivered:
         _write_in_place(tmp_path / "out1" / name, b"edited")
     assert _files(kept) == delivered
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0
+    assert mpc("compile", spec, "-o", tmp_path / "out2").returncode == 0
     assert _files(tmp_path / "out2") == delivered
 
 
@@ -164,8 +165,46 @@ def test_a_kept_file_written_in_place_leaves_the_delivered_files_as_they_were(
         tmp_path: Path, spec: Path) -> None:
     _first_build(spec, tmp_path)
     delivered = _files(tmp_path / "out1")
-    assert main(["compile", str(spec), "-o", str(tmp_path / "out2")]) == 0  # delivered from the cache
+    assert mpc("compile", spec, "-o", tmp_path / "out2").returncode == 0  # delivered from the cache
     kept = next(_entry(tmp_path).parent.glob("outputs-*"))
     for name in _files(kept):
         _write_in_place(kept / name, b"")
     assert _files(tmp_path / "out1") == delivered == _files(tmp_path / "out2")
+
+
+# -- git's clones in the cache -----------------------------------------------------------------
+
+def _git(cwd: Path, *args: str) -> None:
+    subprocess.run(["git", *args], cwd=cwd, check=True, capture_output=True,
+                   env={**os.environ, "GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t",
+                        "GIT_COMMITTER_NAME": "t", "GIT_COMMITTER_EMAIL": "t@t"})
+
+
+def test_a_clone_whose_config_would_make_git_run_a_command_is_cloned_again_and_runs_nothing(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    repo, canary = tmp_path / "models", tmp_path / "canary"
+    arm(repo)
+    for args in (["init", "-q", "-b", "main"], ["add", "-A"], ["commit", "-q", "-m", "arm"]):
+        _git(repo, *args)
+    spec = write(tmp_path / "m.yml", f"""
+        model:
+          robotname: arm
+          modelname: arm-from-git
+          input_models:
+            arm: {{repo: {{git: "file://{repo}", branch: main, model_in_repo: arm.urdf}}}}
+          assemble: {{model: arm}}
+        """)
+    assert mpc("compile", spec, "-o", tmp_path / "out1").returncode == 0
+    (mirror,) = (tmp_path / "cache/repos").glob("*/mirror.git")
+    # A fetch of the branch (every build) would run `touch canary` through git's ext:: transport.
+    _git(mirror, "config", "protocol.ext.allow", "always")
+    _git(mirror, "config", f"url.ext::sh -c touch% {canary}.insteadOf", f"file://{repo}")
+    done = mpc("compile", spec, "-o", tmp_path / "out2")
+    err = done.stderr
+    assert not canary.exists() and done.returncode == 0
+    assert (f"{spec}:5:17: warning[W0650]: the cache's clone '{mirror}' of repository 'file://{repo}' is "
+            "unusable (its config sets 'protocol.ext.allow'); it is removed and cloned again") in err
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+    done = mpc("compile", spec, "-o", tmp_path / "out3")  # the new clone is mpc's
+    assert done.returncode == 0 and "W0650" not in done.stderr and not canary.exists()
