@@ -7,8 +7,9 @@ one-line file, the whole file for every element, so time grew with the square of
 count (issue 29). The span finder (backends/xml.py) now scans a long line's start tags once.
 Ten times the elements should take about ten times as long, minified or not.
 
-The URDF is a chain of N links (inertial, a box visual, a cylinder collision) and N-1 revolute
-joints, written by this script; compiled to URDF in a fresh cache. Figures are the best of a
+The URDF is a binary tree of N links (inertial, a box visual, a cylinder collision) and N-1
+revolute joints, written by this script (a tree, not a chain: what grows with a chain's depth
+is not what this measures); compiled to URDF in a fresh cache. Figures are the best of a
 few runs (a loaded machine only slows a run down).
 
 Run: python bench/bench_minified.py [--links 1000 10000] [--runs N]
@@ -37,8 +38,8 @@ DEFINITION = """model:
 """
 
 
-def chain(links: int, separator: str) -> str:
-    """A URDF of `links` links in a chain, its elements joined by `separator` ("": minified)."""
+def tree(links: int, separator: str) -> str:
+    """A URDF of `links` links in a binary tree, its elements joined by `separator` ("": minified)."""
     parts = ['<?xml version="1.0"?>', '<robot name="chain">']
     for i in range(links):
         parts.append(
@@ -48,7 +49,7 @@ def chain(links: int, separator: str) -> str:
             '<collision><geometry><cylinder radius="0.05" length="0.2"/></geometry></collision></link>')
         if i:
             parts.append(
-                f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+                f'<joint name="j{i}" type="revolute"><parent link="l{(i - 1) // 2}"/><child link="l{i}"/>'
                 '<origin xyz="0 0 0.2"/><axis xyz="0 0 1"/>'
                 '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
     parts.append("</robot>")
@@ -87,14 +88,14 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="mpc-bench-minified-") as tmp:
         warm = Path(tmp) / "warm-up"  # imports and first calls, not counted
         warm.mkdir()
-        (warm / "chain.urdf").write_text(chain(3, ""))
+        (warm / "chain.urdf").write_text(tree(3, ""))
         (warm / "chain.yml").write_text(DEFINITION)
         compile_seconds(warm)
         for links in args.links:
             for kind, separator in (("minified", ""), ("pretty", "\n")):
                 folder = Path(tmp) / f"{kind}-{links}"
                 folder.mkdir()
-                (folder / "chain.urdf").write_text(chain(links, separator))
+                (folder / "chain.urdf").write_text(tree(links, separator))
                 (folder / "chain.yml").write_text(DEFINITION)
                 time.sleep(0.05)  # a build of files just written is not kept
                 read = min(spans(folder / "chain.urdf") for _ in range(args.runs))

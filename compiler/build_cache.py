@@ -191,13 +191,17 @@ class KeptBuild:
         kept = self.folder / self.header["outputs"]["folder"]
         for folder in self.header["outputs"]["folders"]:
             (staging / folder).mkdir(parents=True, exist_ok=True)
+        if kept.is_symlink():
+            return False  # a link put into the cache: never read through
         inside = os.path.realpath(kept) + os.sep
         for name, digest in self.header["outputs"]["files"]:
             source = kept / name
             try:
-                if not os.path.realpath(source).startswith(inside) or source.is_symlink():
+                if not os.path.realpath(source).startswith(inside):
                     return False  # a link put into the cache: never read through
-                with open(source, "rb") as f:
+                # not through a link, and without waiting on a FIFO put in a file's place
+                fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+                with open(fd, "rb") as f:
                     if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
                         return False
                     data = f.read()

@@ -15,6 +15,7 @@ import os
 import pickle
 import shutil
 import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -137,6 +138,33 @@ def test_a_tampered_program_of_a_build_that_wrote_its_kept_outputs_is_built_when
     again = compile_model(spec, Sink(), Options(out=tmp_path / "b"))
     assert again.out == tmp_path / "b" and _files(tmp_path / "b") == _files(tmp_path / "a")
     assert again.program == first.program and again.robot == first.robot
+
+
+@pytest.mark.parametrize("kind", ["a link out of the cache", "a FIFO"])
+def test_a_kept_output_that_is_no_file_of_the_cache_is_never_delivered(
+        tmp_path: Path, spec: Path, kind: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Whoever wrote the entry knows the digest of what they put in the output's place: a
+    secret file elsewhere is not read into the outputs, and a FIFO is not waited on (a process
+    of its own, which a wait would time out)."""
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
+    _first_build(spec, tmp_path)
+    entry = _entry(tmp_path)
+    (kept,) = entry.parent.glob("outputs-*/urdf/robot.urdf")
+    secret = write(tmp_path / "secret.txt", "the user's secret")
+    kept.unlink()
+    if kind == "a FIFO":
+        os.mkfifo(kept)
+    else:
+        kept.symlink_to(secret)
+    old = hashlib.sha256((tmp_path / "out1/urdf/robot.urdf").read_bytes()).hexdigest().encode()
+    _replace(entry, entry.read_bytes().replace(old, hashlib.sha256(secret.read_bytes()).hexdigest().encode()))
+    done = subprocess.run([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o",
+                           str(tmp_path / "out2")], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
+    events = [" ".join(line.split()[1:3]) for line in (tmp_path / "trace").read_text().splitlines()
+              if " build " in line]
+    assert events == ["keep build", "reuse build", "keep build"]  # its outputs were refused
 
 
 # -- delivered outputs are copies --------------------------------------------------------------
