@@ -84,6 +84,9 @@ class _Encoder:
         cls = type(value)
         if cls in _SCALARS:
             return value
+        if cls is tuple:  # the most frequent container: written here, without a call
+            encode = self.encode
+            return {"t": [v if type(v) in _SCALARS else encode(v) for v in value]}
         how = self.by_type.get(cls)
         if how is None:
             how = self._how(cls)
@@ -100,13 +103,13 @@ class _Encoder:
             raise TypeError(f"a value of type {tag} is not kept")
         how: Callable[[Any], Any]
         if is_record(kept):
-            items = self._items
-
-            def how(obj: Any) -> Any:
-                return {"r": [tag, *items(record_values(obj))]}
-        elif issubclass(kept, Enum):
             encode = self.encode
 
+            def how(obj: Any) -> Any:
+                out = [tag]
+                out += [v if type(v) in _SCALARS else encode(v) for v in record_values(obj)]
+                return {"r": out}
+        elif issubclass(kept, Enum):
             def how(member: Any) -> Any:
                 return {"e": [tag, encode(member.value)]}
         else:
