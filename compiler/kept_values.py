@@ -102,9 +102,8 @@ class _Encoder:
         if not _MODULE.fullmatch(kept.__module__) or not _NAME.fullmatch(kept.__qualname__):
             raise TypeError(f"a value of type {tag} is not kept")
         how: Callable[[Any], Any]
+        encode = self.encode
         if is_record(kept):
-            encode = self.encode
-
             def how(obj: Any) -> Any:
                 out = [tag]
                 out += [v if type(v) in _SCALARS else encode(v) for v in record_values(obj)]
