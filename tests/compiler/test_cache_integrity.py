@@ -18,12 +18,15 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
+from math import inf, nan
+from pathlib import Path, PosixPath
 
 import pytest
 
 from mpc.compiler.driver import Options, compile_model
-from mpc.core.diagnostics import Sink
+from mpc.compiler.kept_values import BadValue, dumps, loads
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.span import Span
 from tests.conftest import definition, write
 from tests.fixtures import arm
 from tests.mpc_command import mpc
@@ -236,3 +239,35 @@ def test_a_clone_whose_config_would_make_git_run_a_command_is_cloned_again_and_r
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
     done = mpc("compile", spec, "-o", tmp_path / "out3")  # the new clone is mpc's
     assert done.returncode == 0 and "W0650" not in done.stderr and not canary.exists()
+
+
+# -- the form itself -----------------------------------------------------------------------------
+
+def test_kept_values_read_back_as_the_values_written() -> None:
+    span = Span("a.yml", 3, 5, 3, 9)
+    value = {("x", 1): frozenset({"a", "b"}), "path": PosixPath("meshes/m.stl"), "floats": (0.1, nan, -inf),
+             "diagnostic": Diagnostic(Severity.WARNING, "W0401", "m", span, ((None, "n"), (span, "o")), "h"),
+             "list": [True, None, 2**70]}
+    back = loads(dumps(value))
+    assert repr(back) == repr(value) and back["diagnostic"] == value["diagnostic"]
+    assert type(back["floats"]) is tuple and type(back["list"]) is list
+
+
+@pytest.mark.parametrize(("text", "why"), [
+    (b"[" * 100_000 + b"]" * 100_000, "values nested too deeply"),
+    (b'{"d": [[1], 2]}', "an unhashable key of a dict"),
+    (b'{"s": [{"d": []}]}', "an unhashable member of a set"),
+    (b'{"r": ["mpc.core.span:Span", "a.yml", 1]}', "not one value for each field of 'mpc.core.span:Span'"),
+    (b'{"r": ["mpc.core.diagnostics:Severity"]}', "'mpc.core.diagnostics:Severity' is not a record"),
+    (b'{"e": ["mpc.core.diagnostics:Severity", "fatal"]}',
+     "no member of 'mpc.core.diagnostics:Severity' has the value 'fatal'"),
+    (b'{"r": ["mpc.nowhere:X"]}', "'mpc.nowhere:X' names no class of mpc's IR"),
+    (b'{"r": ["mpc.ir.nowhere:X"]}', "'mpc.ir.nowhere' is no module of mpc"),
+    (b'{"t": [1], "s": [2]}', "an object of 2 members"),
+    (b'{"p": 7}', "a path that is no string"),
+    (b"\x80\x05K\x01.", "not JSON"),
+])
+def test_what_kept_values_never_write_is_refused(text: bytes, why: str) -> None:
+    with pytest.raises(BadValue) as refused:
+        loads(text)
+    assert str(refused.value).startswith(why)
