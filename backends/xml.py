@@ -34,6 +34,9 @@ _ODD_START = re.compile(r"<(?![!?/]|[A-Za-z_][\w:.\-]*[ \t\r\n/>])")
 _PLAIN_ENCODINGS = frozenset({"utf-8", "utf8", "us-ascii", "ascii", "iso-8859-1", "latin1", "latin-1"})
 _DELIMITERS = frozenset(" \t\r\n/>")  # what may follow an element's name in its start tag
 _LOOK_BACK = 50  # lines above an element's last line that may hold the `<` of its start tag
+# A line longer than this (a minified file: the whole text on one line) is not searched for each
+# element, which would take time in the square of its length: the scan finds every start tag once.
+_LONG_LINE = 2000
 
 
 class XmlError(Exception):
@@ -101,26 +104,27 @@ class XmlSource:
             where = self._scanned(el)
             if where is None:
                 return self._new_span(self.file, el.sourceline or 1, 1)
-        number, chunk, start, name = where
+        number, chunk, start, name, base = where
         if attr is not None:
             end = chunk.find(">", start)
             m = _attribute_pattern(attr).search(chunk, start, end + 1 if end >= 0 else len(chunk))
             if m:
-                line, col = _position(chunk, number, m.start(m.lastindex))  # type: ignore[arg-type]
-                end_line, end_col = _position(chunk, number, m.end(m.lastindex))  # type: ignore[arg-type]
+                line, col = _position(chunk, number, m.start(m.lastindex), base)  # type: ignore[arg-type]
+                end_line, end_col = _position(chunk, number, m.end(m.lastindex), base)  # type: ignore[arg-type]
                 return self._new_span(self.file, line, col, end_line, end_col)
-        return self._new_span(self.file, number, start + 1, number, start + 2 + name)  # "<" and the name
+        col = base + start + 1
+        return self._new_span(self.file, number, col, number, col + 1 + name)  # "<" and the name
 
     def lazy_span(self, el: etree._Element, attr: str | None = None) -> Span:
         """`span(el, attr)`, found when first asked for (core/span.py: LazySpan): for the
         spans of what a reader makes, which only a diagnostic or the language server reads."""
         return lazy_span(self.file, functools.partial(self.span, el, attr))
 
-    def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int] | None:
+    def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int, int] | None:
         """Where `el`'s start tag begins, read from the line where it ends (lxml's sourceline)
         and the lines above: (the number of the line it begins on, the text from there to the
-        line where it ends, the index of its `<` in that text, the length of its local name),
-        or None when they do not tell.
+        line where it ends, the index of its `<` in that text, the length of its local name, 0:
+        the text begins its line), or None when they do not tell (or a line is too long to ask).
 
         Why the lines tell: a tag that begins on an earlier line leaves on its last line only
         the end of its attributes (which hold no `<`) and its `>`, before any `<`, and began
@@ -130,7 +134,7 @@ class XmlSource:
         none, at the last `<` above.
         """
         number, lines = el.sourceline, self._lines
-        if not number or number > len(lines):
+        if not number or number > len(lines) or len(lines[number - 1]) > _LONG_LINE:
             return None
         line, tag = lines[number - 1], el.tag
         if tag[0] == "{":
@@ -145,7 +149,7 @@ class XmlSource:
         if start >= 0 and line.find(needle, start + 1) < 0:  # most tags: alone on one line
             end = start + len(needle)
             if (end == len(line) or line[end] in _DELIMITERS) and line.find(">", 0, line.find("<")) < 0:
-                return number, line, start, len(local)
+                return number, line, start, len(local), 0
         here = _starts(line, needle)
         if len(here) == 1 and line.find(">", 0, line.find("<")) < 0:
             where = number, line, here[0]
@@ -164,20 +168,23 @@ class XmlSource:
                 where = first, chunk, start
             else:
                 return None
-        return (*where, len(local))
+        return (*where, len(local), 0)
 
     def _above(self, number: int) -> tuple[int, int] | None:
         """(line number, index) of the last `<` above line `number`, when one of the few lines
         right above it has one."""
         lines = self._lines
         for k in range(number - 2, max(number - 2 - _LOOK_BACK, -1), -1):
+            if len(lines[k]) > _LONG_LINE:
+                return None
             i = lines[k].rfind("<")
             if i >= 0:
                 return k + 1, i
         return None
 
-    def _scanned(self, el: etree._Element) -> tuple[int, str, int, int] | None:
-        """Where the scan found `el`'s start tag (as `_on_lines` says it), or None."""
+    def _scanned(self, el: etree._Element) -> tuple[int, str, int, int, int] | None:
+        """Where the scan found `el`'s start tag (as `_on_lines` says it, the text beginning at
+        the tag: its column less one last), or None."""
         if self._offsets is None:
             self._scan()
         offset = self._offsets.get(el)  # type: ignore[union-attr]
@@ -186,8 +193,8 @@ class XmlSource:
         number = bisect.bisect_right(self._line_starts, offset)
         line_start = self._line_starts[number - 1]
         end = self.text.find(">", offset)
-        return (number, self.text[line_start:end + 1 if end >= 0 else len(self.text)], offset - line_start,
-                len(_localname(el)))
+        return (number, self.text[offset:end + 1 if end >= 0 else len(self.text)], 0, len(_localname(el)),
+                offset - line_start)
 
     def _scan(self) -> None:
         """The offset of every element's start tag, from one pass over the whole text."""
@@ -242,9 +249,11 @@ def _starts(text: str, needle: str) -> list[int]:
     return out
 
 
-def _position(chunk: str, number: int, index: int) -> tuple[int, int]:
-    """The line and column of `chunk[index]`, `chunk` beginning at the start of line `number`."""
-    return number + chunk.count("\n", 0, index), index - chunk.rfind("\n", 0, index)
+def _position(chunk: str, number: int, index: int, base: int) -> tuple[int, int]:
+    """The line and column of `chunk[index]`, `chunk` beginning on line `number` after `base`
+    characters of it."""
+    newline = chunk.rfind("\n", 0, index)
+    return number + chunk.count("\n", 0, index), index - newline if newline >= 0 else base + index + 1
 
 
 def _localname(el: etree._Element) -> str:

@@ -26,38 +26,41 @@ while it ran, and the builds of `mpc run` (whose fingerprints skip whole models)
 `mpc lsp` (which keeps its input models itself).
 
 One entry per definition (its path as given and the working folder), replaced by its next
-build, in `$MPC_CACHE_DIR/builds/`: a verified entry (core/cache.py) holding the
-dependencies and, pickled apart so that a stale entry imports nothing, the program, the
-robot and the diagnostics; beside it, a copy of the outputs, each file checked against its
-SHA-256 when it is written out again. The cache is the user's own, as the mesh cache is.
+build, in `$MPC_CACHE_DIR/builds/`: a verified entry (core/cache.py) of two lines of JSON,
+the dependencies, outputs and diagnostics, then the program and the robot (compiler/
+kept_values.py: data that no reading of it can make run). Beside it, a copy of the outputs
+(never the delivered files themselves: a clone or a copy), each file checked against its
+SHA-256 when it is written out again. Anyone who can write the cache can change what a
+build delivers, but not make mpc run anything: an entry that is not of this form (a pickle
+of an earlier mpc, a crafted one) is refused unread with a warning (W0650), and the build
+runs.
 """
 
 from __future__ import annotations
 
 import contextlib
-import copyreg
 import hashlib
-import io
 import json
 import os
-import pickle
 import shutil
 import stat
 import sys
 import tempfile
 import time
 from collections.abc import Iterator
-from pathlib import Path, PosixPath, PurePath
+from pathlib import Path, PurePath
 from typing import TYPE_CHECKING, Any
 
+from mpc.compiler.kept_values import BadValue, dumps, loads
 from mpc.core import cache
 from mpc.core.blas import user_environment
 from mpc.core.diagnostics import Diagnostic, Sink
+from mpc.core.files import clone_file, name_problem
 from mpc.core.packages import interpreter_sites
 from mpc.core.reads import ReadRecorder, recording
 from mpc.core.span import Span
 
-if TYPE_CHECKING:  # the program and robot are pickled and unpickled, never imported here
+if TYPE_CHECKING:  # the program and robot are kept as values, their modules imported when read
     from mpc.compiler.options import Options
     from mpc.ir.program import Program
     from mpc.ir.robot import Robot
@@ -97,6 +100,9 @@ class KeptBuild:
         self.header: dict[str, Any] | None = None  # the kept build, its model's dependencies hold
         self.outputs_hold = False  # … and those of its outputs
         self.model_used = False  # this build took the kept program and robot
+        self.refused: str | None = None  # why the entry found was not read (W0650), if it was not
+        self._model_json = b""  # the kept program and robot as the entry holds them, and read:
+        self._model: tuple[Program, Robot] | None = None
         self.recorder = ReadRecorder(ignore=[cache.cache_dir("")])  # derived data, commits' checkouts
         self.front_reads: int | None = None  # how many of the files recorded the front end opened
         self.started = time.time_ns()
@@ -124,26 +130,54 @@ class KeptBuild:
             kept._load()
         return kept
 
+    def report_refused(self, sink: Sink, span: Span) -> None:
+        """Say (W0650, at `span`: the definition) that the entry found was refused, if it was."""
+        if self.refused is not None:
+            sink.warning(span, "W0650", f"the kept build '{self.entry}' is unusable ({self.refused}); "
+                         "it is removed and the model is built again")
+            self.refused = None
+
     # -- what is kept ----------------------------------------------------------------------------
 
     @property
     def modelname(self) -> str:
         assert self.header is not None
-        return self.header["modelname"]
+        return self.header["modelname"]  # type: ignore[no-any-return]
 
     @property
     def span(self) -> Span:
         assert self.header is not None
-        return self.header["span"]
+        return self.header["span"]  # type: ignore[no-any-return]
 
     def model(self) -> tuple[Program, Robot]:
-        """The kept program and robot."""
+        """The kept program and robot, read when first asked for (a build that writes its kept
+        outputs seldom needs them); raises BadValue when the entry does not hold them."""
         assert self.header is not None
-        return pickle.loads(self.header["model"])
+        if self._model is None:
+            model = loads(self._model_json)
+            from mpc.ir.program import Program
+            from mpc.ir.robot import Robot
+
+            _check(type(model) is tuple and len(model) == 2 and isinstance(model[0], Program)
+                   and isinstance(model[1], Robot), "program and robot")
+            self._model = model
+        return self._model
+
+    def model_holds(self, sink: Sink, span: Span) -> bool:
+        """Whether the kept program and robot can be read; when not, the entry is refused
+        (W0650 into `sink`, at `span`) and forgotten: the front end runs."""
+        try:
+            self.model()
+        except BadValue as e:
+            self._refuse(f"it is not a kept build: {e}")
+            self.header, self.outputs_hold = None, False
+            self.report_refused(sink, span)
+            return False
+        return True
 
     def replay_model(self, sink: Sink) -> tuple[Program, Robot] | tuple[None, None]:
-        """The kept program and robot, their diagnostics reported into `sink` again;
-        (None, None) when `sink` makes one of them an error (--werror)."""
+        """The kept program and robot (`model_holds` said they can be read), their diagnostics
+        reported into `sink` again; (None, None) when `sink` makes one of them an error (--werror)."""
         assert self.header is not None
         self.model_used = True
         _report(sink, self.header["diagnostics"])
@@ -151,14 +185,26 @@ class KeptBuild:
 
     def write_outputs(self, staging: Path) -> bool:
         """Copy the kept outputs into `staging`; False (nothing reported) when one is not the
-        file that was kept. Raises OSError when `staging` cannot be written."""
+        file that was kept, or not a regular file inside the kept folder. Raises OSError when
+        `staging` cannot be written."""
         assert self.header is not None and self.outputs_hold
         kept = self.folder / self.header["outputs"]["folder"]
         for folder in self.header["outputs"]["folders"]:
             (staging / folder).mkdir(parents=True, exist_ok=True)
+        if kept.is_symlink():
+            return False  # a link put into the cache: never read through
+        inside = os.path.realpath(kept) + os.sep
         for name, digest in self.header["outputs"]["files"]:
+            source = kept / name
             try:
-                data = (kept / name).read_bytes()
+                if not os.path.realpath(source).startswith(inside):
+                    return False  # a link put into the cache: never read through
+                # not through a link, and without waiting on a FIFO put in a file's place
+                fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+                with open(fd, "rb") as f:
+                    if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                        return False
+                    data = f.read()
             except OSError:
                 return False
             if hashlib.sha256(data).hexdigest() != digest:
@@ -197,35 +243,40 @@ class KeptBuild:
         header: dict[str, Any]
         if self.header is not None and self.model_used:
             header = {**self.header, "outputs": None}
+            model_json = self._model_json
         else:
             model_files = _digests(self.recorder.inputs(first=self.front_reads), self.started)
             if model_files is None:
                 return
-            buffer, paths = io.BytesIO(), list[PurePath]()
+            paths = list[PurePath]()
             try:
-                _PathCollector(buffer, paths).dump((program, robot))
-                diagnostics = _pickled(model_diagnostics)
-            except (pickle.PicklingError, TypeError, AttributeError, RecursionError):
+                model_json = dumps((program, robot), paths)
+                diagnostics = _kept_diagnostics(model_diagnostics)
+            except (TypeError, ValueError, RecursionError):
                 return  # a value that cannot be kept: the next build runs in full
             opened = {f for f, _ in model_files}
             header = {"key": self.key, "files": model_files,
                       "named": [(p, *_where(p)) for p in sorted(set(map(str, paths)) - opened)],
                       "packages": sorted((p, n, f) for (p, n), f in self.recorder.packages.items()),
-                      "model": buffer.getvalue(), "diagnostics": diagnostics,
-                      "modelname": program.modelname, "span": program.span, "outputs": None}
+                      "diagnostics": diagnostics, "modelname": program.modelname, "span": program.span,
+                      "outputs": None}
         with contextlib.suppress(OSError):
             if out is not None and all(e.type in _KEPT_EXPORTS for e in program.exports):
                 opened = {f for f, _ in header["files"]}
                 header["outputs"] = self._keep_outputs(out, output_diagnostics, opened)
+            try:
+                data = _entry_bytes(header, model_json)
+            except (TypeError, ValueError, RecursionError):
+                return
             self.folder.mkdir(parents=True, exist_ok=True)
-            cache.store_entry(self.entry, pickle.dumps(header, protocol=pickle.HIGHEST_PROTOCOL))
+            cache.store_entry(self.entry, data)
             cache.trace(f"keep build {self.folder.name}")
             self._remove_old_outputs(header["outputs"])
 
     def _keep_outputs(self, out: Path, diagnostics: list[Diagnostic],
                       model_files: set[str]) -> dict[str, Any] | None:
-        """A copy of the outputs in `out` (hard links where the cache is on the same file system:
-        a file changed in place through one is found by its digest when it is written out)."""
+        """A copy of the outputs in `out`: clones where the file system makes them (they share
+        no storage: a write into one leaves the other as it was), else copies."""
         files = _digests([p for p in self.recorder.inputs() if str(p) not in model_files], self.started)
         if files is None:
             return None
@@ -242,14 +293,11 @@ class KeptBuild:
                 if source.is_symlink() or not source.is_file():
                     shutil.rmtree(copy, ignore_errors=True)
                     return None
-                try:
-                    os.link(source, target)
-                except OSError:
-                    shutil.copyfile(source, target)
+                clone_file(source, target)
                 with open(target, "rb") as f:
                     names.append((str(rel / name), hashlib.file_digest(f, "sha256").hexdigest()))
         return {"folder": copy.name, "files": sorted(names), "folders": sorted(folders), "read": files,
-                "diagnostics": _pickled(diagnostics)}
+                "diagnostics": _kept_diagnostics(diagnostics)}
 
     def _remove_old_outputs(self, kept: dict[str, Any] | None) -> None:
         for folder in self.folder.glob("outputs-*"):
@@ -262,19 +310,26 @@ class KeptBuild:
         data, why = cache.load_entry(self.entry)
         if data is None:
             if why is not None:
-                with contextlib.suppress(OSError):
-                    cache.remove_entry(self.entry)
+                self._refuse(why)
             return
         try:
-            header = pickle.loads(data)
-            if header["key"] != self.key or not _files_hold(header["files"]) or not self._names_hold(header):
-                return
-        except Exception:  # an entry of another make: unpickling it runs its classes' code
+            header, self._model_json = _read_entry(data)
+        except BadValue as e:
+            self._refuse(f"it is not a kept build: {e}")
+            return
+        if header["key"] != self.key or not _files_hold(header["files"]) or not self._names_hold(header):
             return
         self.header = header
         outputs = header["outputs"]
         self.outputs_hold = outputs is not None and _files_hold(outputs["read"])
         cache.trace(f"reuse build {self.folder.name}" + (" with its outputs" if self.outputs_hold else ""))
+
+    def _refuse(self, why: str) -> None:
+        """The entry must not be used: say why (`report_refused`) and remove it."""
+        self.refused = why
+        cache.trace(f"refuse build {self.folder.name}")
+        with contextlib.suppress(OSError):
+            cache.remove_entry(self.entry)
 
     def _names_hold(self, header: dict[str, Any]) -> bool:
         if any(_where(p) != (dev, ino, kind) for p, dev, ino, kind in header["named"]):
@@ -286,15 +341,89 @@ class KeptBuild:
         return True
 
 
-def _report(sink: Sink, pickled: bytes) -> None:
-    for diagnostic in pickle.loads(pickled):
+# -- the entry's form ----------------------------------------------------------------------------
+# Three lines of JSON (JSON escapes every newline in a string): the header, as JSON's own
+# values; the span and the diagnostics of the header, and the program and the robot, each
+# written by compiler/kept_values.py. The program and the robot are read when first asked for.
+_FORM = "mpc kept build 2"
+_HEADER_KEYS = frozenset({"form", "key", "files", "named", "packages", "modelname", "outputs"})
+_OUTPUT_KEYS = frozenset({"folder", "files", "folders", "read"})
+_VALUES = ("span", "diagnostics")  # of the header, on the second line
+
+
+def _entry_bytes(header: dict[str, Any], model_json: bytes) -> bytes:
+    out = header["outputs"]
+    plain = {**{k: header[k] for k in _HEADER_KEYS - {"form"}}, "form": _FORM,
+             "outputs": None if out is None else {k: out[k] for k in _OUTPUT_KEYS}}
+    values = [*(header[k] for k in _VALUES), None if out is None else out["diagnostics"]]
+    return json.dumps(plain, separators=(",", ":")).encode() + b"\n" + dumps(values) + b"\n" + model_json
+
+
+def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes]:
+    """The header (its values read) and the model's JSON of an entry; raises BadValue when it is
+    not an entry of this form, each part of the shape `keep` writes."""
+    first, _, rest = data.partition(b"\n")
+    second, newline, model_json = rest.partition(b"\n")
+    try:
+        header = json.loads(first)
+    except (ValueError, RecursionError):  # a pickle of an earlier mpc, say: never unpickled
+        raise BadValue("not JSON") from None
+    if (type(header) is not dict or header.get("form") != _FORM or header.keys() != _HEADER_KEYS
+            or not newline):
+        raise BadValue("not the header of a kept build")
+    _check(type(header["key"]) is str and type(header["modelname"]) is str, "key, model name")
+    _check_files(header["files"])
+    _check(_rows(header["named"], (str, int, int, str)), "named files")
+    _check(_rows(header["packages"], (str, str, (str, type(None)))), "packages")
+    out = header["outputs"]
+    if out is not None:
+        _check(type(out) is dict and out.keys() == _OUTPUT_KEYS, "outputs")
+        _check(type(out["folder"]) is str and out["folder"].startswith("outputs-")
+               and name_problem(out["folder"]) is None, "outputs' folder")
+        _check(_rows(out["files"], (str, str)) and all(name_problem(n, folders=True) is None
+                                                         for n, _ in out["files"]), "output files")
+        _check(type(out["folders"]) is list and all(type(n) is str and name_problem(n, folders=True) is None
+                                                    for n in out["folders"]), "output folders")
+        _check_files(out["read"])
+    values = loads(second)
+    _check(type(values) is list and len(values) == 3 and isinstance(values[0], Span)
+           and _are_diagnostics(values[1])
+           and (values[2] is None if out is None else _are_diagnostics(values[2])), "span and diagnostics")
+    header["span"], header["diagnostics"] = values[0], values[1]
+    if out is not None:
+        out["diagnostics"] = values[2]
+    return header, model_json
+
+
+def _check(holds: bool, what: str) -> None:
+    if not holds:
+        raise BadValue(f"its {what} are not as kept")
+
+
+def _rows(rows: Any, kinds: tuple[type | tuple[type, ...], ...]) -> bool:
+    """Whether `rows` is a list of lists of len(kinds) items, each of its kind."""
+    return type(rows) is list and all(
+        type(row) is list and len(row) == len(kinds)
+        and all(isinstance(v, k) and type(v) is not bool for v, k in zip(row, kinds, strict=True))
+        for row in rows)
+
+
+def _check_files(files: Any) -> None:
+    _check(_rows(files, (str, (str, type(None)))), "files read")
+
+
+def _are_diagnostics(value: Any) -> bool:
+    return type(value) is list and all(type(d) is Diagnostic for d in value)
+
+
+def _report(sink: Sink, diagnostics: list[Diagnostic]) -> None:
+    for diagnostic in diagnostics:
         sink.report(diagnostic)
 
 
-def _pickled(diagnostics: list[Diagnostic]) -> bytes:
+def _kept_diagnostics(diagnostics: list[Diagnostic]) -> list[Diagnostic]:
     """The diagnostics to say again when the build is reused."""
-    kept = [d for d in diagnostics if d.code not in _OF_THE_CACHE]
-    return pickle.dumps(kept, protocol=pickle.HIGHEST_PROTOCOL)
+    return [d for d in diagnostics if d.code not in _OF_THE_CACHE]
 
 
 def _digests(paths: list[Path], started: int) -> Files | None:
@@ -356,18 +485,3 @@ def _distributions() -> list[str]:
         with contextlib.suppress(OSError):
             out += sorted(n for n in os.listdir(folder) if n.endswith(".dist-info"))
     return out
-
-
-class _PathCollector(pickle.Pickler):
-    """Pickles, noting every path among the values: the files the program and robot name.
-    Only paths go through Python (the pickler's dispatch table); everything else is pickled
-    at C speed."""
-
-    def __init__(self, file: io.BytesIO, paths: list[PurePath]) -> None:
-        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
-        self.paths = paths
-        self.dispatch_table = {**copyreg.dispatch_table, PosixPath: self._path}
-
-    def _path(self, path: PosixPath) -> Any:
-        self.paths.append(path)
-        return path.__reduce__()

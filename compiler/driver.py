@@ -11,6 +11,7 @@ previous outputs untouched.
 from __future__ import annotations
 
 import contextlib
+import functools
 import glob
 import os
 import shutil
@@ -35,8 +36,8 @@ class Result:
     """What a compilation produced: the program, the robot and the output folder. A build that
     wrote its kept outputs (compiler/build_cache.py) reads its program and robot when asked."""
 
-    def __init__(self, program: Program | None = None, robot: Robot | None = None,
-                 out: Path | None = None, model: Callable[[], tuple[Program, Robot]] | None = None) -> None:
+    def __init__(self, program: Program | None = None, robot: Robot | None = None, out: Path | None = None,
+                 model: Callable[[], tuple[Program | None, Robot | None]] | None = None) -> None:
         self._program, self._robot, self.out, self._model = program, robot, out, model
 
     def _load(self) -> None:
@@ -212,14 +213,17 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
 
     with stage("lower"):
         kept = KeptBuild.open(path, options)                   # the last build, if it still holds
+    if kept is not None:
+        kept.report_refused(sink, Span.of_file(str(path)))     # an entry not read (W0650)
     if kept is not None and kept.outputs_hold and not sink.werror:
-        done = _write_kept(kept, sink, options)                 # its outputs, as they were
+        done = _write_kept(kept, path, sink, options)           # its outputs, as they were
         if done is not None:
             return done
     before = len(sink.diagnostics)
     with kept.recording() if kept is not None else contextlib.nullcontext():
         with stage("lower"):
-            if kept is not None and kept.header is not None:
+            definition = Span.of_file(str(path))
+            if kept is not None and kept.header is not None and kept.model_holds(sink, definition):
                 program, robot = kept.replay_model(sink)       # its program and robot
             else:
                 program, robot = _program_and_robot(path, sink, options)  # front end, ops
@@ -243,7 +247,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     return Result(program, robot, out)
 
 
-def _write_kept(kept: KeptBuild, sink: Sink, options: Options) -> Result | None:
+def _write_kept(kept: KeptBuild, path: Path, sink: Sink, options: Options) -> Result | None:
     """The kept outputs written into place, their diagnostics said again; None (nothing said)
     when one of them is damaged: the build runs."""
     out = _out(options, kept.modelname)
@@ -257,7 +261,18 @@ def _write_kept(kept: KeptBuild, sink: Sink, options: Options) -> Result | None:
         kept.replay_outputs(sink)
     for diagnostic in own.diagnostics:  # E0660: the output folder cannot be written
         sink.report(diagnostic)
-    return Result(out=out, model=kept.model) if written else Result()
+    return Result(out=out, model=functools.partial(_kept_model, kept, path, options)) if written else Result()
+
+
+def _kept_model(kept: KeptBuild, path: Path, options: Options) -> tuple[Program | None, Robot | None]:
+    """The program and robot of a build that wrote its kept outputs; the front end's, its
+    diagnostics already said, when the entry does not hold them (one changed in the cache)."""
+    from mpc.compiler.kept_values import BadValue
+
+    try:
+        return kept.model()
+    except BadValue:
+        return _program_and_robot(path, Sink(), options)
 
 
 def _out(options: Options, modelname: str) -> Path:

@@ -5,6 +5,12 @@ Cache: `$MPC_CACHE_DIR/repos`, else `$XDG_CACHE_HOME/mpc/repos`, else `~/.cache/
 one folder per URL (without credentials) and commit, so two definitions at different commits never disturb
 each other and a pinned commit is cloned once. A branch is fetched on every use and
 resolved to its current commit.
+
+Whoever can write the cache can write the mirror's config, and git runs what a config tells
+it to (a URL rewritten to `ext::<command>`, `core.sshCommand`, a hook). Before each fetch the
+mirror's config is read as a plain file: one holding anything but what `git clone --bare`
+and `git remote set-url` write is not mpc's, and the mirror is cloned anew (W0650); no hook
+of the mirror runs (`core.hooksPath` is /dev/null for each git run in it).
 """
 
 from __future__ import annotations
@@ -29,6 +35,15 @@ def _slot(url: str) -> Path:
     return cache_dir("repos") / hashlib.sha256(without_credentials(url).encode()).hexdigest()[:16]
 
 
+# What `git clone --bare` and `git remote set-url` write into a mirror's config (on any
+# platform); anything else was written by someone else.
+_MIRROR_KEYS = frozenset({
+    "core.repositoryformatversion", "core.filemode", "core.bare", "core.ignorecase",
+    "core.precomposeunicode", "core.symlinks", "core.logallrefupdates", "remote.origin.url",
+    "extensions.objectformat"})
+_NO_HOOKS = ("-c", "core.hooksPath=/dev/null")
+
+
 def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path | None:
     """The work tree of `repo` at its commit (or branch); None after reporting why.
 
@@ -43,7 +58,7 @@ def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path 
             return slot / repo.commit
         if not fetch:
             return None
-        return _checkout(repo, ref, slot)
+        return _checkout(repo, ref, slot, sink, span)
     except GitFailed as e:
         sink.error(span, "E0604", f"cannot get '{ref}' of repository '{scrub(repo.git)}': {e.message}")
     except OSError as e:
@@ -52,18 +67,27 @@ def checkout(repo: RepoRef, sink: Sink, span: Span, fetch: bool = True) -> Path 
     return None
 
 
-def _checkout(repo: RepoRef, ref: str, slot: Path) -> Path:
+def _checkout(repo: RepoRef, ref: str, slot: Path, sink: Sink, span: Span) -> Path:
     """Fetch into the slot's mirror and check `ref` out into its own folder; raises
     GitFailed or OSError."""
     slot.mkdir(parents=True, exist_ok=True)
     mirror = slot / "mirror.git"
+    if mirror.is_dir() or mirror.is_symlink():
+        strange = _not_mpcs(mirror)
+        if strange is not None:
+            sink.warning(span, "W0650", f"the cache's clone '{mirror}' of repository '{scrub(repo.git)}' is "
+                         f"unusable ({strange}); it is removed and cloned again")
+            if mirror.is_symlink() or not mirror.is_dir():
+                mirror.unlink()
+            else:
+                shutil.rmtree(mirror)
     if mirror.is_dir():
-        git("fetch", "--quiet", repo.git, "+refs/heads/*:refs/heads/*", cwd=mirror)
+        git(*_NO_HOOKS, "fetch", "--quiet", repo.git, "+refs/heads/*:refs/heads/*", cwd=mirror)
     else:
-        git("clone", "--quiet", "--bare", "--", repo.git, str(mirror))
+        git(*_NO_HOOKS, "clone", "--quiet", "--bare", "--", repo.git, str(mirror))
         # no token in the cache's config: fetches name the URL of the day
-        git("remote", "set-url", "origin", without_credentials(repo.git), cwd=mirror)
-    sha = git("rev-parse", "--verify", "--end-of-options", f"{ref}^{{commit}}", cwd=mirror)
+        git(*_NO_HOOKS, "remote", "set-url", "origin", without_credentials(repo.git), cwd=mirror)
+    sha = git(*_NO_HOOKS, "rev-parse", "--verify", "--end-of-options", f"{ref}^{{commit}}", cwd=mirror)
     tree = slot / sha
     if not tree.is_dir():
         staging = Path(tempfile.mkdtemp(prefix=".checkout-", dir=slot))
@@ -77,3 +101,17 @@ def _checkout(repo: RepoRef, ref: str, slot: Path) -> Path:
     if repo.commit and repo.commit != sha and not (slot / repo.commit).exists():
         (slot / repo.commit).symlink_to(sha)  # an abbreviated commit finds the tree next time
     return tree
+
+
+def _not_mpcs(mirror: Path) -> str | None:
+    """Why the mirror is not one mpc made (a link, a config key git would act on), or None.
+    The config is read as a file (`--file`: no includes followed), nothing run from it."""
+    if mirror.is_symlink():
+        return "it is a link"
+    try:
+        listed = git("config", "--file", str(mirror / "config"), "--null", "--name-only", "--list")
+    except GitFailed as e:
+        return f"its config cannot be read: {e.message}"
+    keys = {k.lower() for k in listed.split("\0") if k}
+    strange = sorted(keys - {k.lower() for k in _MIRROR_KEYS})
+    return f"its config sets '{strange[0]}'" if strange else None

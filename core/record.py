@@ -13,7 +13,9 @@ the slot's own setter (`_fast_init`): dataclass's frozen one goes through object
 for every field, which takes twice as long. Code that makes thousands of records (a reader)
 asks for a `maker`, which skips the class call too: a quarter of its time. A record with
 slots also pickles its fields as a tuple, in order, as dataclass's own `__getstate__` does,
-without looking the fields up for each object (the build cache pickles thousands).
+without looking the fields up for each object. The build cache writes records as their field
+values (`record_values`) and reads them back without running their code (`from_values`:
+compiler/kept_values.py); only classes made here (`is_record`) are read back.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ R = TypeVar("R")
 
 _NAMES: dict[type, tuple[str, ...]] = {}
 _VALUES: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
+_RECORDS: set[type] = set()  # every class made by @record
 
 
 def _names(cls: type) -> tuple[str, ...]:
@@ -49,6 +52,56 @@ def _values(obj: Any) -> tuple[Any, ...]:
             (lambda o, n=names[0]: (getattr(o, n),)) if names else (lambda o: ()))
         _VALUES[cls] = get
     return get(obj)
+
+
+def is_record(cls: type) -> bool:
+    """Whether `cls` was made by @record (not a subclass of one that was not)."""
+    return cls in _RECORDS
+
+
+def record_fields(cls: type) -> tuple[str, ...]:
+    """A record class's field names, in order."""
+    return _names(cls)
+
+
+def record_values(obj: Any) -> tuple[Any, ...]:
+    """A record's field values, in the order of `record_fields`."""
+    return _values(obj)
+
+
+def from_values(cls: type[R], values: list[Any]) -> R:
+    """The record `cls` with these field values, set as unpickling sets them: neither
+    `__init__` nor `__post_init__` runs. Raises ValueError when there is not one value per
+    field."""
+    build = _BUILDERS.get(cls)
+    if build is None:
+        build = _BUILDERS[cls] = _builder(cls)
+    return build(values)  # type: ignore[no-any-return]
+
+
+_BUILDERS: dict[type, Callable[[list[Any]], Any]] = {}
+
+
+def _builder(cls: type) -> Callable[[list[Any]], Any]:
+    """`from_values` of `cls`: for a record with slots, a function that sets each slot through
+    its own setter (the build cache reads thousands of records; a loop of object.__setattr__
+    takes three times as long)."""
+    names = _names(cls)
+    setters = [getattr(cls, name, None) for name in names]
+    if not all(isinstance(s, types.MemberDescriptorType) for s in setters):
+        def build(values: list[Any]) -> Any:
+            obj = object.__new__(cls)
+            _setstate(obj, tuple(values))
+            return obj
+        return build
+    env: dict[str, Any] = {"_new": object.__new__, "_cls": cls, "_n": len(names)}
+    lines = ["def build(v):\n", "    if len(v) != _n:\n",
+             "        raise ValueError(f'{len(v)} values for {_n} fields')\n", "    o = _new(_cls)\n"]
+    for i, setter in enumerate(setters):
+        env[f"_s{i}"] = setter.__set__  # type: ignore[union-attr]
+        lines.append(f"    _s{i}(o, v[{i}])\n")
+    lines.append("    return o\n")
+    return _compiled("".join(lines), env, "build")
 
 
 def _repr(self: Any) -> str:
@@ -198,13 +251,14 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) ->
         written = "__init__" in c.__dict__
         out = dataclass(c, frozen=True, repr=False, eq=False, slots=slots, kw_only=kw_only)
         methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
-        if slots:  # dataclass's own look each field up anew for every object pickled (build cache)
+        if slots:  # dataclass's own look each field up anew for every object pickled
             methods += [("__getstate__", _values), ("__setstate__", _setstate)]
         for name, method in methods:
             if name not in c.__dict__:
                 setattr(out, name, method)
         if slots and not written:  # dataclass wrote it
             out.__init__ = _first_init(out, out.__init__)  # type: ignore[misc]
+        _RECORDS.add(out)
         return out
 
     return wrap if cls is None else wrap(cls)

@@ -68,7 +68,7 @@ class LazySpan(Span):
     """A Span whose position is found when it is first asked for (`lazy_span`).
 
     A reader knows where each element is but seldom needs to say so: only a diagnostic, the
-    language server or a kept build (which pickles it) asks. Finding the column of a start
+    language server or a kept build (which writes it) asks. Finding the column of a start
     tag or an attribute is most of what a span costs (about 8% of TALOS's URDF read, 330
     spans). Until then it holds the finder, and with it the parsed file; afterwards it is a
     Span in all but its class, and it pickles and copies as one.

@@ -45,7 +45,7 @@ def parts(mesh: Mesh, build: Callable[[Mesh], trimesh.Trimesh]) -> list[trimesh.
         data = None
     if data is not None:
         touch_entry(entry)
-        arrays = np.load(io.BytesIO(data))
+        arrays = np.load(io.BytesIO(data), allow_pickle=False)  # a cache entry: data, never code
         return [trimesh.Trimesh(arrays[f"v{i}"], arrays[f"f{i}"], process=False)
                 for i in range(int(arrays["n"]))]
     import coacd
