@@ -228,10 +228,12 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         if program is None or robot is None:
             return Result(program)
         model_end = len(sink.diagnostics)
+        from mpc.backends.empty_meshes import check_empty
         from mpc.backends.solid_checks import check_closed
 
         with stage("apply ops"):
             check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
+            check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
         out = _out(options, program.modelname)
         with stage("write"):
             written = emit(program, robot, out, sink, options.target)  # emit, rename into place
