@@ -40,7 +40,8 @@ def test_an_empty_mesh_is_warned_about_naming_the_file_and_its_links(tmp_path: P
               b"endloop\nendfacet\nendsolid x\n", False),
     ("c.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", True),
     ("d.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", False),
-    ("e.dae", b"<COLLADA><library_geometries><geometry><mesh/></geometry></library_geometries></COLLADA>", True),
+    ("e.dae", b"<COLLADA><library_geometries><geometry><mesh/></geometry></library_geometries>"
+              b"</COLLADA>", True),
     ("f.dae", b"<COLLADA><mesh><triangles count='1'><p>0 1 2</p></triangles></mesh></COLLADA>", False),
 ])
 def test_each_format_is_told_empty_or_not(tmp_path: Path, name: str, text: bytes, empty: bool) -> None:

@@ -20,7 +20,9 @@ IGN = shutil.which("ign")
 # link 'flat': principal moments 0.1, 0.1, 0.5 (0.1 + 0.1 < 0.5), which SDFormat refuses.
 URDF = """\
 <robot name="r">
-  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+  </link>
   <joint name="j" type="revolute"><parent link="base"/><child link="flat"/><axis xyz="0 0 1"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
   <link name="flat">
@@ -49,8 +51,9 @@ def _take_refusal(diags: Diags, tmp_path: Path) -> None:
     error = diags.take_error("E0504")
     assert error.message == ("link 'flat' has an inertial SDFormat refuses: its principal moments "
                              "violate A + B ≥ C (0.1 + 0.1 < 0.5)")
-    assert (Path(error.span.file).name, error.span.line, error.span.col) == ("r.urdf", 5, 3)
-    assert error.hint == "set `correct_inertials: true` on the export to make it physical, or fix its inertial"
+    assert (Path(error.span.file).name, error.span.line, error.span.col) == ("r.urdf", 7, 3)
+    assert error.hint == ("set `correct_inertials: true` on the export to make it physical, or fix its "
+                          "inertial")
     assert [(Path(s.file).name, s.line, s.col, text) for s, text in error.notes if s] == [
         ("m.yml", 7, 7, "the sdf export that would write it")]
 
