@@ -102,7 +102,8 @@ class AnnotationsSection(Node):
 
     SECTION: ClassVar[str] = "annotations"
     named_annotations: dict[str, dict[str, Any]] = {}
-    general_annotations: dict[str, Any] = {}
+    # a mapping (the category `annotations`), or Phobos's list of [category, content] pairs
+    general_annotations: one_of(dict[str, Any], list[Annotated[list[Any], Length(2, 2)]]) = {}
 
 
 class PostProcessing(Node):

@@ -89,11 +89,14 @@ class EditCollisions(Op):
         convex hull. `remove`: as remove: true. `mesh`: unchanged.
     join: merge the link's collisions into one: True their convex hull, "union" their solid
         union (one closed mesh, concave where they are).
+    phobos_default: the entry is `default`, which Phobos hands to its auto_bitmask (which
+        ignores it): without a link or collision of that name it does nothing (W0263).
     """
 
     PHASE = Phase.COLLISIONS
 
     target: str = ""
+    phobos_default: bool = False
     exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
     shape: str | None = None
@@ -105,7 +108,11 @@ class EditCollisions(Op):
     annotations: Annotations = field(default_factory=dict)
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        if self.target:
+        if self.phobos_default and self.target not in names.links | names.all("collision"):
+            effects.warning("W0263", f"collisions: '{self.target}' names no link or collision, so the entry "
+                            "has no effect (Phobos hands it to its auto_bitmask, which ignores it); "
+                            "'$default' edits every link's collisions", "target")
+        elif self.target:
             _link_or_collision(names, self.target, effects, "target")
         return names
 
