@@ -196,7 +196,7 @@ def _join(op: EditCollisions, link: str, collisions: list[Collision], effects: E
     """One collision: the convex hull of all of them (`join: true`) or their solid union
     (`join: union`, its repairs and convex-hull stand-ins reported now), in the frame of the
     first mesh."""
-    from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh
+    from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, generated_source
     from mpc.ir.kinematics import compose_poses, inverse_pose
     from mpc.ir.ops.frames import collision_solid
 
@@ -204,21 +204,21 @@ def _join(op: EditCollisions, link: str, collisions: list[Collision], effects: E
     if union and collision_solid(op, link, collisions, effects, "target") is None:
         return None
 
-    first = next((c for c in collisions if isinstance(c.geometry, Mesh)), None)
-    if first is None:
-        effects.error("E0322", f"join on link '{link}' needs at least one mesh collision to name the "
-                      "joined mesh", "target")
-        return None
-    assert isinstance(first.geometry, Mesh)
+    meshes = [c for c in collisions if isinstance(c.geometry, Mesh)]
+    # The first mesh names the result and gives its frame; of primitives alone, mpc makes a
+    # mesh named after the link, in the frame of the first of them.
+    first = meshes[0] if meshes else collisions[0]
+    source = first.geometry.source if isinstance(first.geometry, Mesh) else generated_source(link)
     X_inv = inverse_pose(first.origin)
     parts = []
     for c in collisions:  # each part keeps its own scale (as_trimesh applies it)
         X = compose_poses(X_inv, c.origin)
         parts.append((c.geometry, X.xyz, X.rpy))
-    mesh = Mesh(source=first.geometry.source, span=first.geometry.span,
+    mesh = Mesh(source=source, span=first.geometry.span if isinstance(first.geometry, Mesh) else None,
                 ops=(JoinShapes(tuple(parts), solid=True),) if union
                 else (JoinShapes(tuple(parts)), ConvexHull()))
-    return replace(first, name=first.name or f"{link}_joined", geometry=mesh,
+    name = first.name if meshes else None
+    return replace(first, name=name or f"{link}_joined", geometry=mesh,
                    annotations={k: v for c in collisions for k, v in c.annotations.items()})
 
 
