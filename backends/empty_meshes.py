@@ -3,7 +3,7 @@ that use it; it changes nothing.
 
 A mesh without triangles draws nothing and collides with nothing, and a consumer may refuse
 it (MuJoCo does). Copied meshes are not read to write them, so the test is a cheap look at
-the file by its format: a binary STL's triangle count, an ASCII STL's or an OBJ's faces, a
+the file by its format: a binary STL's triangle count, a whole ASCII STL's or an OBJ's faces, a
 COLLADA file's primitive index lists (`<p>`). Formats it cannot tell cheaply are not judged;
 a mesh that cannot be read is left to the mesh export (E0602, E0603).
 """
@@ -32,7 +32,8 @@ def has_no_triangles(path: Path) -> bool:
     if suffix == ".stl":
         if len(data) >= 84 and len(data) == 84 + 50 * struct.unpack_from("<I", data, 80)[0]:
             return struct.unpack_from("<I", data, 80)[0] == 0  # binary: the count fits the size
-        return data.lstrip().startswith(b"solid") and b"facet" not in data
+        # ASCII: whole (it ends) but without a facet; a file that is neither is left to reading it
+        return data.lstrip().startswith(b"solid") and b"endsolid" in data and b"facet" not in data
     if suffix == ".obj":
         return _OBJ_FACE.search(data) is None
     if suffix == ".dae":

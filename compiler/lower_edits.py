@@ -459,17 +459,10 @@ def poses(ctx: LowerContext) -> list[Op]:
     movable joints it does not list, unless the pose has a `$default` of its own."""
     out: list[Op] = []
     section = ctx.model.poses
-    default = None
-    for name, pose in section.items():
-        if not isinstance(pose, Node):
-            if name == "$default":
-                default = ctx.num_value(pose, ctx.model.value_span("poses", name), "poses' $default")
-            else:
-                ctx.sink.error(ctx.model.value_span("poses", name), "E0203", f"pose '{name}' must be a "
-                               "mapping of joints to positions (only '$default' takes a number)")
-    for name, pose in section.items():
-        if not isinstance(pose, Node):
-            continue
+    if section is None:
+        return out
+    default = ctx.num(section, "default", "poses' $default")
+    for name, pose in section.entries.items():
         positions = {j: ctx.num_value(v, pose.value_span(j), f"pose '{name}' joint '{j}'")
                      for j, v in pose.entries.items()}
         own = ctx.num(pose, "default", f"pose '{name}' $default")

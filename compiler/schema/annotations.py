@@ -59,6 +59,16 @@ class PoseDef(Node):
     default: Expr | None = Field(None, alias="$default")
 
 
+class PosesSection(Node):
+    """`poses`: named poses; a number for `$default` (Phobos's form) is every pose's
+    position of the movable joints it does not list, where the pose has no `$default`."""
+
+    SECTION: ClassVar[str] = "poses"
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, PoseDef] = Field(init=False)
+    default: Expr | None = Field(None, alias="$default")
+
+
 class LoopConstraint(Node):
     SECTION: ClassVar[str] = "a loop constraint"
     cut_joint: str

@@ -5,13 +5,13 @@ from typing import Annotated, Any, ClassVar
 from mpc.compiler.schema.annotations import (
     AnnotationsSection,
     Exoskeleton,
-    PoseDef,
+    PosesSection,
     PostProcessing,
     SensorsSection,
     Submechanism,
 )
 from mpc.compiler.schema.assembly import Assemble, InputModel
-from mpc.compiler.schema.base import Expr, FileName, Length, Node, OneOrMore, one_of, validate_as
+from mpc.compiler.schema.base import Expr, FileName, Length, Node, OneOrMore, validate_as
 from mpc.compiler.schema.editing import (
     CollisionsSection,
     FramesSection,
@@ -54,7 +54,7 @@ class ModelSection(Node):
     exoskeletons: list[Exoskeleton] | None = None
     submechanisms_file: str | None = None
     sensors: SensorsSection | None = None
-    poses: dict[str, one_of(PoseDef, Expr)] = {}  # a number: Phobos's section-level `$default`
+    poses: PosesSection = None  # type: ignore[assignment]  # not given: none; `poses:` with nothing: E0203
     annotations: AnnotationsSection | None = None
     post_processing: list[PostProcessing] = []
     add_lfs_track: OneOrMore | None = None
