@@ -60,21 +60,22 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
 
 def check_inertials(program: Program, loader: InputLoader, sink: Sink) -> None:
     """`mpc check`: what an sdf or mjcf export without `correct_inertials` would refuse (E0504),
-    on the inertials of the input models as they are read. Only links that keep their name
+    on the inertials of the input model files as they are read. Only links that keep their name
     are seen, and none when an op combines or estimates inertias (removing a joint,
     estimate_missing_inertia): those need the built robot, which compiling checks."""
     from mpc.ir.program import MjcfExport, SdfExport
 
-    exports = [e for e in program.exports
-               if isinstance(e, SdfExport | MjcfExport) and not e.correct_inertials]
+    exports = [e for e in program.exports  # a submodel's inertias are merged ones: compiling checks them
+               if isinstance(e, SdfExport | MjcfExport) and not e.correct_inertials and not e.submodel]
     # by their kinds: importing the op classes would import modules `mpc check` need not load
     if not exports or any(op.kind in ("estimate_missing_inertia", "remove_joint") for op in program.ops):
         return
     names = symbolic(program, PassContext(Sink(), loader.names, Severity.WARNING))
     if names is None:
         return
+    # files read for their names already; not a derived_base (built) or a repository (cloned)
     inputs = [program.inputs[op.input] for op in program.ops if isinstance(op, LoadModel)]
-    for robot in (loader.robot(inp) for inp in inputs):
+    for robot in (loader.robot(inp) for inp in inputs if inp.kind == "basefile"):
         if robot is None:
             continue
         for export in exports:
