@@ -1,7 +1,10 @@
 """ir.Robot → a ROCK joint-limits file (YAML), for the joints an export selects.
 
 Format (Phobos's): `{limits: {names: [...], elements: [{max: {position, speed, effort},
-min: {position}}]}}`. Fixed joints are never listed; a missing limit is written as 0.
+min: {position}}]}}`. Fixed joints are never listed; a missing limit is written as 0. A
+continuous joint has no position limit: its min and max position are `.nan`, which ROCK's
+typelib YAML reads as NaN, base's "unset" (`base::JointLimitRange` checks a position only
+against a bound that `hasPosition()`); 0..0 would read as a locked joint.
 Selections: ALL (every movable joint), ACTIVE and INDEPENDENT (the submechanisms'
 `jointnames_active` / `jointnames_independent`), ABSTRACT (the movable joints of the
 abstract model, ir/submodel.py), ACTUATED (joints with a motor), or a list of joint names;
@@ -19,6 +22,8 @@ from mpc.core.files import confined
 from mpc.ir.program import JointLimitsExport
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first
+
+UNSET = float("nan")  # base::unset<double>(): no bound
 
 
 def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:
@@ -58,8 +63,11 @@ def to_yaml(robot: Robot, names: list[str]) -> str:
     for name in names:
         joint = robot.joints[name]
         lim = joint.limit
-        lower = (lim.lower if lim and lim.lower is not None else 0.0) if joint.type != "continuous" else 0.0
-        upper = (lim.upper if lim and lim.upper is not None else 0.0) if joint.type != "continuous" else 0.0
+        if joint.type == "continuous":  # no position limit: unset, as ROCK's base::JointState says it
+            lower = upper = UNSET
+        else:
+            lower = lim.lower if lim and lim.lower is not None else 0.0
+            upper = lim.upper if lim and lim.upper is not None else 0.0
         elements.append({"max": {"position": upper, "speed": lim.velocity if lim and lim.velocity else 0.0,
                                  "effort": lim.effort if lim and lim.effort else 0.0},
                          "min": {"position": lower}})

@@ -23,8 +23,10 @@ from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
 from mpc.core.numbers import zero_small
+from mpc.core.packages import package_of
 from mpc.core.span import Span
 from mpc.ir.geometry import (
+    GENERATED,
     ConvexHull,
     ConvexPart,
     JoinShapes,
@@ -34,6 +36,7 @@ from mpc.ir.geometry import (
     ReduceMesh,
     ReflectMesh,
     ScaleMesh,
+    is_generated,
 )
 from mpc.ir.robot import Robot
 from mpc.ir.tree import depth_first
@@ -49,8 +52,17 @@ MeshKey = tuple[Path, tuple[MeshOp, ...]]
 
 
 def key(mesh: Mesh) -> MeshKey:
+    """The file and ops of a mesh; a mesh mpc makes from shapes (ir/geometry.py `is_generated`)
+    has no file: its name stands for it, as a relative path (a file's path is absolute)."""
+    if is_generated(mesh.source):
+        return (Path(mesh.source.uri.removeprefix(GENERATED)), mesh.ops)
     assert mesh.source.path is not None
     return (mesh.source.path, mesh.ops)
+
+
+def _made(path: Path) -> bool:
+    """Whether a MeshKey's path names a mesh mpc makes from shapes (no file)."""
+    return not path.is_absolute()
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,9 +106,19 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
     for use in uses:
         src = use.mesh.source
         span = use.mesh.span or export_span
-        if src.path is None:  # its package was not found (reported above)
+        k = key(use.mesh) if src.path is not None or is_generated(src) else None
+        if k is not None and _made(k[0]):
+            fmt = "stl" if mesh_format == KEEP_FORMAT else mesh_format  # made by mpc: no format of its own
+            stem = k[0].stem + _suffix(use.mesh.ops)
+            wanted.setdefault(k, f"meshes/{fmt}/{stem}.{EXTENSIONS.get(fmt, fmt)}")
             continue
-        k = key(use.mesh)
+        if src.path is None:
+            if package_of(src.uri) is None:  # else its package was not found (reported above)
+                sink.error(span, "E0602", f"mesh '{src.uri}' of a {use.element} of link '{use.link}' "
+                           f"cannot be found: {src.unresolved}")
+                ok = False
+            continue
+        assert k is not None
         if k in wanted:
             continue
         if not src.path.is_file():
@@ -147,7 +169,7 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
         paths = {p for p, _ in keys}
         first = keys[0][0]
         # The same bytes: by their digests, which a warm build knows without reading the files.
-        if len(set(ops for _, ops in keys)) == 1 and all(
+        if len(set(ops for _, ops in keys)) == 1 and not any(_made(p) for p in paths) and all(
                 file_digest(first) == file_digest(p) for p in paths):
             continue
         stem, ext = name.rsplit(".", 1)
@@ -157,7 +179,7 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
 
 
 def _digest(k: MeshKey) -> str:
-    h = hashlib.sha256(k[0].read_bytes())
+    h = hashlib.sha256(str(k[0]).encode() if _made(k[0]) else k[0].read_bytes())
     h.update(repr(k[1]).encode())
     return h.hexdigest()[:10]
 
@@ -245,8 +267,10 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     from mpc.core.cache import cache_dir, file_digest
 
-    # The name too: an OBJ names its object after the file (mesh_source.entry_of).
-    digest = hashlib.sha256(f"{file_digest(src)}|{src.name}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
+    # The name too: an OBJ names its object after the file (mesh_source.entry_of). A mesh made
+    # from shapes has no file: its ops are all of it.
+    content = "made" if _made(src) else file_digest(src)
+    digest = hashlib.sha256(f"{content}|{src.name}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from pathlib import Path
 
 import numpy as np
@@ -116,11 +116,12 @@ def _mass_ok(inertial: Inertial | None) -> bool:
     return inertial is not None and inertial.mass >= MJMINVAL and min(principal(inertial)[0]) >= MJMINVAL
 
 
-def check(robot: Robot, sink: Sink, span: Span) -> bool:
+def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = None) -> bool:
     """Report (E0504) each link whose mass properties MuJoCo would refuse or change, by its
     rules: mass and principal moments not negative (MuJoCo clamps them to 0), moments
     satisfying A + B ≥ C (on every body), and a moving body's mass and moments at least
-    mjMINVAL unless a body welded below it has both. The MJCF is written anyway."""
+    mjMINVAL unless a body welded below it has both. only: the links to report (`mpc
+    check`: those the finished robot keeps)."""
     children, ok = child_joints(robot), True
     moving = {j.child for j in robot.joints.values() if j.type != "fixed"}
     order = [link for _, link in depth_first(robot)]
@@ -149,9 +150,12 @@ def check(robot: Robot, sink: Sink, span: Span) -> bool:
         if link in moving and not _mass_ok(inertial) and not welded_mass[link]:
             problems.append(f"it moves but its mass or a principal moment is below mjMINVAL "
                             f"({MJMINVAL:g}) and no link welded to it carries mass")
-        if problems:
+        if problems and (only is None or link in only):
             sink.error(robot.links[link].span or span, "E0504", f"link '{link}' has mass properties "
-                       f"MuJoCo refuses or changes: {'; '.join(problems)}", hint="fix its inertial")
+                       f"MuJoCo refuses or changes: {'; '.join(problems)}",
+                       hint="set `correct_inertials: true` on the export to make it physical, or fix its "
+                       "inertial",
+                       notes=((span, "the export that would write it"),) if robot.links[link].span else ())
             ok = False
     return ok
 

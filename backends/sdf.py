@@ -11,7 +11,7 @@ motors, sensors, cut joints, …) is left out and named in one W0500 warning.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from pathlib import Path
 
 from mpc.backends import meshes, xml_escape
@@ -368,10 +368,34 @@ def model_config(robot: Robot, version: str = "1.9") -> str:
             f"{IND}<description>The robot '{name}', written by mpc.</description>\n</model>\n")
 
 
+HINT_CORRECT = "set `correct_inertials: true` on the export to make it physical, or fix its inertial"
+
+
+def check_inertials(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = None) -> bool:
+    """Report (E0504) each link whose inertial SDFormat refuses ("A link named … has invalid
+    inertia", ir/physical.py `sdformat_problems`), at the link; whether there was none.
+    only: the links to report (`mpc check`: those the finished robot keeps)."""
+    from mpc.ir.physical import sdformat_problems
+
+    ok = True
+    for name, link in robot.links.items():
+        if only is not None and name not in only:
+            continue
+        problems = sdformat_problems(link.inertial) if link.inertial is not None else []
+        if problems:
+            sink.error(link.span or span, "E0504", f"link '{name}' has an inertial SDFormat refuses: "
+                       f"{'; '.join(problems)}", hint=HINT_CORRECT,
+                       notes=((span, "the sdf export that would write it"),) if link.span else ())
+            ok = False
+    return ok
+
+
 def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
     """Write `out/sdf/<filename or robot.name>.sdf` and `out/sdf/model.config`, meshes under
-    `out/meshes/`."""
+    `out/meshes/`; nothing with an inertial SDFormat refuses (E0504)."""
     warn(robot, export.span, sink, export.version, export.include_cut_joints)
+    if not check_inertials(robot, sink, export.span):
+        return
     prepared = meshes.for_export(robot, export, out, sink)
     if prepared is None:
         return

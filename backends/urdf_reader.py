@@ -9,6 +9,7 @@ they mention. Comments are kept. Mesh files are resolved to paths, never opened.
 from __future__ import annotations
 
 import functools
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -41,6 +42,8 @@ from mpc.ir.robot import (
     Visual,
 )
 from mpc.ir.tree import check_tree
+
+NONE_MATERIAL = "None"  # Phobos's name for no material
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 _UNREAD = object()  # _Reader.numbers: a text not read yet
@@ -289,6 +292,7 @@ class _Reader:
             self.error(root, "E0415", f"robot '{name or '?'}' in '{file}' has no links")
             return None
         robot_span = self.src.lazy_span(root)
+        links = self.without_none_material(links, materials)
         root_link = check_tree(links, joints, self.sink, robot_span, name)
         if root_link is None or not name:
             return None
@@ -439,6 +443,31 @@ class _Reader:
             elif tag.__class__ is str:
                 extras.append(self.fragment(child))
         return origin, geometry, material, tuple(extras) if extras else ()
+
+    def without_none_material(self, links: dict[str, Link],
+                              materials: dict[str, Material]) -> dict[str, Link]:
+        """`links` without Phobos's colourless material 'None' (which Phobos writes for visuals
+        without a material, and check_urdf calls undefined); W0621 names it and its links."""
+        none = materials.get(NONE_MATERIAL)
+        if none is not None and (none.rgba is not None or none.texture):
+            return links  # a material of that name, with a colour: the user's
+        users = {name: link for name, link in links.items()
+                 if any(v.material == NONE_MATERIAL and v.inline_material is None for v in link.visuals)}
+        if not users and none is None:
+            return links
+        if none is not None:
+            del materials[NONE_MATERIAL]
+        first = none.span if none is not None else next(
+            v.span for v in next(iter(users.values())).visuals if v.material == NONE_MATERIAL)
+        shown = ", ".join(f"'{n}'" for n in list(users)[:8])
+        shown += f" and {len(users) - 8} more" if len(users) > 8 else ""
+        assert first is not None  # the reader gives every element its span
+        self.sink.warning(first, "W0621", f"material '{NONE_MATERIAL}' has no colour (Phobos writes it for "
+                          "visuals without a material); it is left out"
+                          + (f", from the visuals of link{'s' * (len(users) > 1)} {shown}" if users else ""))
+        return {**links, **{name: replace(link, visuals=tuple(
+            replace(v, material=None) if v.material == NONE_MATERIAL and v.inline_material is None else v
+            for v in link.visuals)) for name, link in users.items()}}
 
     def visual(self, el: etree._Element, where: str) -> Visual | None:
         origin_el, geometry_el, material_el, extras = self.shape_children(el, True)

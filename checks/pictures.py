@@ -23,7 +23,7 @@ import numpy as np
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
-from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
+from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere, is_generated
 from mpc.ir.program import RenderExport, Tolerances
 from mpc.ir.robot import Joint, Link, Pose, Robot
 
@@ -73,6 +73,8 @@ def _turned(a: Pose | None, b: Pose | None) -> tuple[float, float]:
 
 def _mesh_digest(mesh: Mesh) -> str:
     path = mesh.source.path
+    if is_generated(mesh.source):  # made from shapes: its ops are all of it
+        return mesh.source.uri + repr(mesh.ops)
     if path is None or not Path(path).is_file():
         return f"missing:{mesh.source.uri}"
     return hashlib.sha256(Path(path).read_bytes()).hexdigest() + repr(mesh.ops)

@@ -170,20 +170,20 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
 
 def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
     """`robot` with a floating base (ir/floating.py), or None with E0505."""
-    from mpc.ir.floating import with_floating_base
+    from mpc.ir.floating import FLOATING_HINT, clash, with_floating_base
 
     floating = with_floating_base(robot)
-    if floating is None:
-        sink.error(export.span, "E0505", "add_floating_base needs the names 'world' and "
-                   "'floating_base', which the robot uses already")
+    if floating is None and export.type != "smurf":  # a SMURF's flag is its model's, which said it
+        sink.error(export.span, "E0505", clash(robot.links, robot.joints) or "", hint=FLOATING_HINT)
     return floating
 
 
 def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
-    """`robot` with its non-physical inertials made physical (ir/physical.py); W0530 names them."""
+    """`robot` with its non-physical inertials made physical (ir/physical.py); W0530 names them.
+    SDFormat and MuJoCo forgive no rounding: for their exports the correction is exact."""
     from mpc.ir.physical import correct_inertials
 
-    robot, changed = correct_inertials(robot)
+    robot, changed = correct_inertials(robot, exact=export.type in ("sdf", "mjcf"))
     if changed:
         more = f" and {len(changed) - 8} more" if len(changed) > 8 else ""
         shown = ", ".join(f"'{n}'" for n in changed[:8]) + more
@@ -232,10 +232,12 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         if program is None or robot is None:
             return Result(program)
         model_end = len(sink.diagnostics)
+        from mpc.backends.empty_meshes import check_empty
         from mpc.backends.solid_checks import check_closed
 
         with stage("apply ops"):
             check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
+            check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
         out = _out(options, program.modelname)
         with stage("write"):
             written = emit(program, robot, out, sink, options.target)  # emit, rename into place

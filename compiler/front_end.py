@@ -58,6 +58,37 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     return None if sink.has_errors() else program
 
 
+def check_inertials(program: Program, loader: InputLoader, sink: Sink) -> None:
+    """`mpc check`: what an sdf or mjcf export without `correct_inertials` would refuse (E0504),
+    on the inertials of the input model files as they are read. Only links that keep their name
+    are seen, and none when an op combines or estimates inertias (removing a joint,
+    estimate_missing_inertia): those need the built robot, which compiling checks."""
+    from mpc.ir.program import MjcfExport, SdfExport
+
+    exports = [e for e in program.exports  # a submodel's inertias are merged ones: compiling checks them
+               if isinstance(e, SdfExport | MjcfExport) and not e.correct_inertials and not e.submodel]
+    # by their kinds: importing the op classes would import modules `mpc check` need not load
+    if not exports or any(op.kind in ("estimate_missing_inertia", "remove_joint") for op in program.ops):
+        return
+    names = symbolic(program, PassContext(Sink(), loader.names, Severity.WARNING))
+    if names is None:
+        return
+    # files read for their names already; not a derived_base (built) or a repository (cloned)
+    inputs = [program.inputs[op.input] for op in program.ops if isinstance(op, LoadModel)]
+    for robot in (loader.robot(inp) for inp in inputs if inp.kind == "basefile"):
+        if robot is None:
+            continue
+        for export in exports:
+            if isinstance(export, SdfExport):
+                from mpc.backends.sdf import check_inertials as sdformat
+
+                sdformat(robot, sink, export.span, only=names.links)
+            else:
+                from mpc.backends.mjcf import check as mujoco
+
+                mujoco(robot, sink, export.span, only=names.links)
+
+
 def load_program(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
                  loader: InputLoader | None = None, passes: bool = True) -> Program | None:
     """The program of a definition (YAML) or of an IR file (`.ir`, as `--emit ir` prints);
@@ -166,6 +197,9 @@ def check_file(path: Path, sink: Sink, options: Options, doc: source.Document | 
             return
         doc = doc or source.load(path, sink)
         if doc is not None:
-            front_end(path, sink, options, Severity.WARNING, doc=doc)
+            loader = input_loader(sink, options, (path.resolve(),), symbolic=True)
+            program = front_end(path, sink, options, Severity.WARNING, loader, doc=doc)
+            if program is not None:
+                check_inertials(program, loader, sink)
     except OSError as e:
         sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))

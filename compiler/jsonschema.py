@@ -50,6 +50,7 @@ PAGES: dict[str, tuple[str, str | None, str]] = {
     "VisualsSection": ("visuals.md", None, ""),
     "VisualDef": ("visuals.md", None, ""),
     "SensorDef": ("sensors.md", None, ""),
+    "PosesSection": ("poses.md", None, ""),
     "PoseDef": ("poses.md", None, ""),
     "Submechanism": ("submechanisms.md", None, ""),
     "Exoskeleton": ("submechanisms.md", None, ""),
@@ -76,6 +77,8 @@ PAGES: dict[str, tuple[str, str | None, str]] = {
 
 # Keys whose meaning specs/ gives in prose rather than in a key table: the prose, condensed.
 PROSE: dict[tuple[str, str], str] = {
+    ("PosesSection", "default"): "Phobos's form: every pose's position of the movable joints it does not "
+    "list, where the pose has no $default of its own",
     ("Definition", "model"): "the model: its names, inputs, assembly, edits, exports, tests and deployment",
     ("Repo", "git"): "the repository's address",
     ("Repo", "commit"): "the commit to check out (exactly this one)",

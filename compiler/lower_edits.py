@@ -339,7 +339,8 @@ def collision_edits(ctx: LowerContext) -> list[Op]:
     for target, d in _defaults_then_entries(section):
         remove = removal(ctx, d, f"collisions of '{target or '$default'}'")
         out.append(ops.EditCollisions(
-            span=d.span, target=target, exclude=tuple(section.exclude) if not target else (),
+            span=d.span, target=target, phobos_default=target == "default",
+            exclude=tuple(section.exclude) if not target else (),
             remove=remove, shape=d.shape, oriented=d.oriented, replace=section.apply_primitives,
             scale=ctx.num(d, "scale", f"collision '{target}' scale") or 1.0, join=d.join,
             bitmask=d.bitmask,
@@ -411,7 +412,8 @@ def submechanisms(ctx: LowerContext) -> list[Op]:
                 joints += [j for j in getattr(s, key, []) if j not in joints]
             links = [b for lc in getattr(s, "loop_constraints", [])
                      for b in (lc.predecessor_body, lc.successor_body)]
-            links += [s.around] if getattr(s, "around", None) else []
+            # `around` names the human the exoskeleton is worn around (Phobos stores it as written,
+            # `around: human`), not necessarily a link: it is not checked
             out.append(ops.AddSubmechanism(span=s.span, name=s.name, exoskeleton=exo, joints=tuple(joints),
                                            links=tuple(dict.fromkeys(links)), definition=s.to_data()))
     if m.submechanisms or m.exoskeletons:
@@ -436,12 +438,16 @@ def sensors(ctx: LowerContext) -> list[Op]:
         if kind in SINGLE_LINK_SENSORS and d.link is None and d.joint is None:
             ctx.sink.error(d.span, "E0316", f"{kind} sensor '{d.name}' needs a 'link'")
             continue
-        if kind in MULTI_LINK_SENSORS and not d.targets:
-            ctx.sink.error(d.span, "E0316", f"{kind} sensor '{d.name}' needs 'targets' (a list, or All)")
-            continue
+        targets = tuple(d.targets or ())
+        if kind in MULTI_LINK_SENSORS and not targets:
+            ctx.sink.warning(d.span, "W0265", f"{kind} sensor '{d.name}' has no 'targets': it measures "
+                             "nothing (Phobos gives it an empty list of targets)",
+                             hint="give 'targets': a list of names, or All")
+        if len(targets) == 1 and targets[0].upper() == "ALL":
+            targets = ("All",)  # Phobos's word in any case: every movable joint
         out.append(ops.AddSensor(
             span=d.span, type=kind, name=d.name, link=d.link, joint=d.joint, frame=d.frame,
-            targets=tuple(d.targets or ()), targets_kind="link" if kind.startswith("Node") else "joint",
+            targets=targets, targets_kind="link" if kind.startswith("Node") else "joint",
             position_offset=ctx.vec(d, "position_offset", f"sensor '{d.name}' position_offset"),
             orientation_offset=ctx.vec(d, "orientation_offset", f"sensor '{d.name}' orientation"),
             annotations=d.entries, spans=_spans(d, "link", "joint", "frame", "targets")))
@@ -449,12 +455,19 @@ def sensors(ctx: LowerContext) -> list[Op]:
 
 
 def poses(ctx: LowerContext) -> list[Op]:
+    """One op per pose. A number for `$default` (Phobos's form) is every pose's value of the
+    movable joints it does not list, unless the pose has a `$default` of its own."""
     out: list[Op] = []
-    for name, pose in ctx.model.poses.items():
+    section = ctx.model.poses
+    if section is None:
+        return out
+    default = ctx.num(section, "default", "poses' $default")
+    for name, pose in section.entries.items():
         positions = {j: ctx.num_value(v, pose.value_span(j), f"pose '{name}' joint '{j}'")
                      for j, v in pose.entries.items()}
+        own = ctx.num(pose, "default", f"pose '{name}' $default")
         out.append(ops.AddPose(span=pose.span, name=name, positions=positions,  # type: ignore[arg-type]
-                               default=ctx.num(pose, "default", f"pose '{name}' $default"),
+                               default=own if own is not None else default,
                                spans={f"positions/{j}": pose.key_span(j) for j in positions}))
     return out
 
@@ -466,9 +479,37 @@ def annotations(ctx: LowerContext) -> list[Op]:
     out: list[Op] = [ops.AddAnnotations(span=section.key_span("named_annotations"), category=category,
                                         content=content)
                      for category, content in section.named_annotations.items()]
-    if section.general_annotations:
+    general = section.general_annotations
+    if isinstance(general, list):
+        return out + _annotation_pairs(ctx, section, general)
+    if general:
         out.append(ops.AddAnnotations(span=section.key_span("general_annotations"), category="annotations",
-                                      content=section.general_annotations))
+                                      content=general))
+    return out
+
+
+def _annotation_pairs(ctx: LowerContext, section: Node, pairs: list[list[Any]]) -> list[Op]:
+    """Phobos's `general_annotations`: [category, content] pairs, each the category's content
+    (`<robot>_<category>.yml`); the mappings of a category given twice are merged. A content
+    that is no mapping goes into the category `annotations` under its name (W0262)."""
+    categories: dict[str, dict[str, Any]] = {}
+    loose: dict[str, Any] = {}
+    for i, (category, content) in enumerate(pairs):
+        span = section.value_span("general_annotations", i)
+        if not isinstance(category, str) or not category:
+            ctx.sink.error(span, "E0203", "a general_annotations pair is [category, content], the category "
+                           f"a name; got {category!r}")
+        elif isinstance(content, dict):
+            categories.setdefault(category, {}).update(content)
+        else:
+            ctx.sink.warning(span, "W0262", f"general_annotations: the content of '{category}' is no "
+                             f"mapping; mpc writes it in the category 'annotations' as '{category}' "
+                             f"(Phobos writes it to its own file, <robot>_{category}.yml)")
+            loose[category] = content
+    span = section.key_span("general_annotations")
+    out: list[Op] = [ops.AddAnnotations(span=span, category=c, content=v) for c, v in categories.items()]
+    if loose:
+        out.append(ops.AddAnnotations(span=span, category="annotations", content=loose))
     return out
 
 

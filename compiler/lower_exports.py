@@ -111,6 +111,12 @@ class _Exports:
             return []
         if entry.type == "mjcf" and not inherited:  # the model's own use of the entry reported
             self.no_package_paths(entry)
+        if entry.provide_primitives and not inherited:
+            self.ctx.sink.warning(entry.key_span("provide_primitives"), "W0260", "'provide_primitives' has "
+                                  "no effect: Phobos's export reads it from no export entry (its default "
+                                  "preset sets it on sdf), and mpc writes the collisions as they are",
+                                  hint="collisions' `shape` with `apply_primitives: true` makes primitive "
+                                  "collisions")
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in self.written:
@@ -124,7 +130,7 @@ class _Exports:
         export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
                                            add_floating_base=entry.add_floating_base, submodel=submodel,
                                            filename=filename if filename != (submodel or robotname) else "")
-        package = self.ctx.model.ros_pkg_name or self.ctx.model.modelname
+        package = self.ctx.model.ros_pkg_name or ros_name(self.ctx.model.modelname)
         if entry.type in ("urdf", "sdf"):
             export = replace(export, ros_package=package if entry.ros_pathes else None,
                              copy_package=package if entry.copy_with_other_pathes else "")
@@ -268,12 +274,17 @@ class _Exports:
     def ros_package(self, package: str) -> RosPackageExport:
         """The ROS package files, for the package that `ros_pathes` exports refer to."""
         m = self.ctx.model
-        if not _ROS_NAME.fullmatch(package):
-            key = "ros_pkg_name" if m.ros_pkg_name else "modelname"
-            self.ctx.sink.error(m.value_span(key), "E0507",
+        if m.ros_pkg_name and not _ROS_NAME.fullmatch(package):
+            self.ctx.sink.error(m.value_span("ros_pkg_name"), "E0507",
                                 f"'{package}' is not a ROS package name (REP 144: "
-                                "lower-case letters, digits and '_', starting with a letter)",
-                                hint="set ros_pkg_name" if key == "modelname" else None)
+                                "lower-case letters, digits and '_', starting with a letter)")
+        elif not m.ros_pkg_name and package != m.modelname:
+            self.ctx.sink.warning(m.value_span("modelname"), "W0261",
+                                  f"modelname '{m.modelname}' is not a ROS package name (REP 144: lower-case "
+                                  "letters, digits and '_', starting with a letter); the ROS package that "
+                                  f"ros_pathes makes is named '{package}' (Phobos keeps the modelname, "
+                                  "which no ROS tool finds)",
+                                  hint="set ros_pkg_name to choose the package's name")
         version = m.version or "0.0.0"
         if not _ROS_VERSION.fullmatch(version):
             self.ctx.sink.error(m.value_span("version"), "E0507", f"version '{version}' is not "
@@ -305,6 +316,15 @@ class _Exports:
 
 
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
+
+
+def ros_name(modelname: str) -> str:
+    """`modelname` as a ROS package name (REP 144): lower case, each run of other characters
+    one '_', none at either end, `pkg_` before a first character that is no letter."""
+    if _ROS_NAME.fullmatch(modelname):
+        return modelname
+    name = re.sub(r"[^a-z0-9]+", "_", modelname.lower()).strip("_") or "model"
+    return name if name[0].isalpha() else f"pkg_{name}"
 # What a shell would read differently from a plain split into arguments: redirections, pipes,
 # `;`, `&&`, `&`, `$` expansions, back quotes, subshells, globs, quotes, escapes, and `~`.
 _SHELL_SYNTAX = re.compile(r"&&|\|\||[|;&<>$`()*?'\"\\]|\[.*\]|(?:^|\s)~")

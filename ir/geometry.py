@@ -62,6 +62,19 @@ class MeshSource:
         return name.rsplit(".", 1)[-1].lower() if "." in name else ""
 
 
+GENERATED = "mpc-generated:"  # the uri of a mesh mpc makes from shapes; no file holds it
+
+
+def generated_source(name: str) -> MeshSource:
+    """The source of a mesh mpc makes from shapes (a `join` of primitives), named `name`.stl."""
+    return MeshSource(uri=f"{GENERATED}{name}.stl", path=None)
+
+
+def is_generated(source: MeshSource) -> bool:
+    """Whether the mesh is made by mpc from shapes, not read from a file."""
+    return source.path is None and source.uri.startswith(GENERATED)
+
+
 def mesh_source(resolver: PackageResolver, uri: str, base_dir: Path) -> MeshSource:
     """The MeshSource of a filename written in a model file in `base_dir`."""
     path, unresolved = resolver.locate(uri, base_dir)

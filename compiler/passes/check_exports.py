@@ -12,9 +12,11 @@ body, which needs the geometry, is left to compiling.
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.names import Names
-from mpc.ir.program import JointLimitsExport, KccdExport, Program, SubmodelExport
+from mpc.ir.program import Export, JointLimitsExport, KccdExport, Program, SubmodelExport
 
 SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
 
@@ -22,6 +24,9 @@ SELECTIONS = ("ALL", "ACTIVE", "INDEPENDENT", "ACTUATED", "ABSTRACT")
 def check_exports(program: Program, names: Names, sink: Sink) -> None:
     submodels = {e.name for e in program.exports if isinstance(e, SubmodelExport)}
     for export in program.exports:
+        if getattr(export, "add_floating_base", False) and not getattr(export, "submodel", "") \
+                and export.type != "smurf":  # a SMURF's flag is the one of the model it links
+            _floating(export, names.links, names.joints, sink)
         if isinstance(export, SubmodelExport):
             _submodel(export, names, sink)
         elif isinstance(export, JointLimitsExport) and not export.submodel and not export.joints_of:
@@ -45,6 +50,8 @@ def _submodel(export: SubmodelExport, names: Names, sink: Sink) -> None:
         return
     kept = part[1]
     joints = {j for j, (p, c) in names.joints.items() if p in kept and c in kept}
+    if export.add_floating_base:
+        _floating(export, kept, joints, sink)
     gone: set[str] = set()
     for pattern in export.remove_joints:
         found = matching(pattern, joints)
@@ -62,6 +69,14 @@ def _submodel(export: SubmodelExport, names: Names, sink: Sink) -> None:
                            f"move_joint_axis_to_intersection names '{name}', which is not a joint "
                            f"of the submodel{did_you_mean(name, joints - gone)}")
                 return
+
+
+def _floating(export: Export, links: Collection[str], joints: Collection[str], sink: Sink) -> None:
+    """What compiling reports (E0505) of an add_floating_base on a robot with these names."""
+    from mpc.ir.floating import FLOATING_HINT, clash
+
+    if why := clash(links, joints):
+        sink.error(export.span, "E0505", why, hint=FLOATING_HINT)
 
 
 def _kccd(export: KccdExport, names: Names, sink: Sink) -> None:

@@ -59,6 +59,16 @@ class PoseDef(Node):
     default: Expr | None = Field(None, alias="$default")
 
 
+class PosesSection(Node):
+    """`poses`: named poses; a number for `$default` (Phobos's form) is every pose's
+    position of the movable joints it does not list, where the pose has no `$default`."""
+
+    SECTION: ClassVar[str] = "poses"
+    model_config = ConfigDict(extra="allow")
+    __pydantic_extra__: dict[str, PoseDef] = Field(init=False)
+    default: Expr | None = Field(None, alias="$default")
+
+
 class LoopConstraint(Node):
     SECTION: ClassVar[str] = "a loop constraint"
     cut_joint: str
@@ -102,7 +112,8 @@ class AnnotationsSection(Node):
 
     SECTION: ClassVar[str] = "annotations"
     named_annotations: dict[str, dict[str, Any]] = {}
-    general_annotations: dict[str, Any] = {}
+    # a mapping (the category `annotations`), or Phobos's list of [category, content] pairs
+    general_annotations: one_of(dict[str, Any], list[Annotated[list[Any], Length(2, 2)]]) = {}
 
 
 class PostProcessing(Node):

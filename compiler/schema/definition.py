@@ -1,11 +1,11 @@
 """AST roots: a model definition file (`model:`) and a pipeline file (`pipeline:`)."""
 
-from typing import Annotated, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from mpc.compiler.schema.annotations import (
     AnnotationsSection,
     Exoskeleton,
-    PoseDef,
+    PosesSection,
     PostProcessing,
     SensorsSection,
     Submechanism,
@@ -54,13 +54,20 @@ class ModelSection(Node):
     exoskeletons: list[Exoskeleton] | None = None
     submechanisms_file: str | None = None
     sensors: SensorsSection | None = None
-    poses: dict[str, PoseDef] = {}
+    poses: PosesSection = None  # type: ignore[assignment]  # not given: none; `poses:` with nothing: E0203
     annotations: AnnotationsSection | None = None
     post_processing: list[PostProcessing] = []
     add_lfs_track: OneOrMore | None = None
     swing_my_robot: bool = False
     test: TestSection | None = None
     deployment: DeploymentSection | None = None
+    export_total_submechanisms: Any = None  # Phobos's code for it is commented out (W0264)
+
+    def no_effect(self) -> list[tuple[str, str, str]]:
+        if "export_total_submechanisms" not in self.given:
+            return []
+        return [("W0264", "export_total_submechanisms", "'export_total_submechanisms' has no effect: "
+                 "Phobos's code for it (one submodel of all submechanisms) is commented out")]
 
 
 class Definition(Node):

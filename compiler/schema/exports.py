@@ -38,6 +38,7 @@ class _Kinematic(_Export):
     add_floating_base: bool = False
     correct_inertials: bool = False
     float_fmt_dict: dict[str, str] | None = None
+    provide_primitives: bool = False  # in Phobos's default preset; read by nothing (W0260)
 
 
 class UrdfExport(_Kinematic):

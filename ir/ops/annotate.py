@@ -89,11 +89,14 @@ class EditCollisions(Op):
         convex hull. `remove`: as remove: true. `mesh`: unchanged.
     join: merge the link's collisions into one: True their convex hull, "union" their solid
         union (one closed mesh, concave where they are).
+    phobos_default: the entry is `default`, which Phobos hands to its auto_bitmask (which
+        ignores it): without a link or collision of that name it does nothing (W0263).
     """
 
     PHASE = Phase.COLLISIONS
 
     target: str = ""
+    phobos_default: bool = False
     exclude: tuple[LinkRef, ...] = ()
     remove: bool | tuple[str, ...] = False
     shape: str | None = None
@@ -105,7 +108,11 @@ class EditCollisions(Op):
     annotations: Annotations = field(default_factory=dict)
 
     def effect(self, names: Names, effects: Effects) -> Names:
-        if self.target:
+        if self.phobos_default and self.target not in names.links | names.all("collision"):
+            effects.warning("W0263", f"collisions: '{self.target}' names no link or collision, so the entry "
+                            "has no effect (Phobos hands it to its auto_bitmask, which ignores it); "
+                            "'$default' edits every link's collisions", "target")
+        elif self.target:
             _link_or_collision(names, self.target, effects, "target")
         return names
 
@@ -189,7 +196,7 @@ def _join(op: EditCollisions, link: str, collisions: list[Collision], effects: E
     """One collision: the convex hull of all of them (`join: true`) or their solid union
     (`join: union`, its repairs and convex-hull stand-ins reported now), in the frame of the
     first mesh."""
-    from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh
+    from mpc.ir.geometry import ConvexHull, JoinShapes, Mesh, generated_source
     from mpc.ir.kinematics import compose_poses, inverse_pose
     from mpc.ir.ops.frames import collision_solid
 
@@ -197,21 +204,21 @@ def _join(op: EditCollisions, link: str, collisions: list[Collision], effects: E
     if union and collision_solid(op, link, collisions, effects, "target") is None:
         return None
 
-    first = next((c for c in collisions if isinstance(c.geometry, Mesh)), None)
-    if first is None:
-        effects.error("E0322", f"join on link '{link}' needs at least one mesh collision to name the "
-                      "joined mesh", "target")
-        return None
-    assert isinstance(first.geometry, Mesh)
+    meshes = [c for c in collisions if isinstance(c.geometry, Mesh)]
+    # The first mesh names the result and gives its frame; of primitives alone, mpc makes a
+    # mesh named after the link, in the frame of the first of them.
+    first = meshes[0] if meshes else collisions[0]
+    source = first.geometry.source if isinstance(first.geometry, Mesh) else generated_source(link)
     X_inv = inverse_pose(first.origin)
     parts = []
     for c in collisions:  # each part keeps its own scale (as_trimesh applies it)
         X = compose_poses(X_inv, c.origin)
         parts.append((c.geometry, X.xyz, X.rpy))
-    mesh = Mesh(source=first.geometry.source, span=first.geometry.span,
+    mesh = Mesh(source=source, span=first.geometry.span if isinstance(first.geometry, Mesh) else None,
                 ops=(JoinShapes(tuple(parts), solid=True),) if union
                 else (JoinShapes(tuple(parts)), ConvexHull()))
-    return replace(first, name=first.name or f"{link}_joined", geometry=mesh,
+    name = first.name if meshes else None
+    return replace(first, name=name or f"{link}_joined", geometry=mesh,
                    annotations={k: v for c in collisions for k, v in c.annotations.items()})
 
 

@@ -78,6 +78,9 @@ class Effects:
     def error(self, code: str, message: str, field: str = "") -> None:
         self.sink.error(self.op.span_of(field), code, message)
 
+    def warning(self, code: str, message: str, field: str = "") -> None:
+        self.sink.warning(self.op.span_of(field), code, message)
+
     def unsupported(self, what: str, field: str = "") -> None:
         if self.later_is_error:
             self.sink.error(self.op.span_of(field), "E0202", f"{what} is not supported yet")

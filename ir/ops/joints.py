@@ -156,6 +156,10 @@ class EditJoint(Op):
         return replace(robot, joints={**robot.joints, self.joint: joint})
 
 
+# A motor's settings that are its joint's limits: (motor key, Limit field).
+MOTOR_LIMITS = (("maxEffort", "effort"), ("maxSpeed", "velocity"))
+
+
 @record(kw_only=True)
 class SetMotor(Op):
     """Put a motor on `joint` (`active`, `motor`): name (default `<joint>_motor`) and settings."""
@@ -170,8 +174,25 @@ class SetMotor(Op):
     settings: Annotations = field(default_factory=dict)
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
+        """The motor; its `maxEffort` and `maxSpeed` become the joint's limit `effort` and
+        `velocity` too (Phobos's readers take a motor's from its joint), with W0504 where the
+        joint's said otherwise."""
         motor = Motor(name=self.name, joint=self.joint, settings=dict(self.settings))
-        return replace(robot, motors={**robot.motors, self.name: motor})
+        robot = replace(robot, motors={**robot.motors, self.name: motor})
+        joint = robot.joints[self.joint]
+        given = {attr: float(value) for key, attr in MOTOR_LIMITS
+                 if isinstance(value := self.settings.get(key), int | float) and not isinstance(value, bool)}
+        if not given or joint.type == "fixed":
+            return robot
+        limit = joint.limit or Limit()
+        for key, attr in MOTOR_LIMITS:
+            old = getattr(limit, attr)
+            if attr in given and old is not None and old != given[attr]:
+                effects.warning("W0504", f"the motor '{self.name}' of joint '{self.joint}' has {key} "
+                                f"{given[attr]:g}, its joint's limit {attr} is {old:g}: both are now "
+                                f"{given[attr]:g}, the motor's (Phobos reads a motor's from its joint)")
+        limit = replace(limit, **given)
+        return replace(robot, joints={**robot.joints, self.joint: replace(joint, limit=limit)})
 
     def effect(self, names: Names, effects: Effects) -> Names:
         return names.with_other("motor", [self.name])

@@ -31,8 +31,8 @@ W = Severity.WARNING
 CASSIE = ERD / "cassie_description/robots"
 
 # Models whose own inertias sdformat rejects ("A link named X has invalid inertia"): the
-# principal moments violate the triangle inequality (Ixx + Iyy ≥ Izz) or are negative. These
-# are the source files' numbers, written unchanged.
+# principal moments violate the triangle inequality (Ixx + Iyy ≥ Izz) or are negative. The
+# SDF export refuses them (E0504) unless `correct_inertials` is set.
 BAD_INERTIA: dict[str, tuple[set[str], str]] = {
     "alex_description/urdf/alex_psyonic_hands.urdf": (
         {"LeftPsyonicAbilityBaseLink", "Left_thumb_base", "RightPsyonicAbilityBaseLink", "Right_thumb_base"},
@@ -113,7 +113,12 @@ def _mass(robot: Robot) -> float:
 @needs_ign
 @pytest.mark.parametrize("model", GOOD)
 def test_every_model_is_valid_sdf_and_reads_back(model: str, tmp_path: Path, diags: Diags) -> None:
+    """Every model is written as SDF that `ign sdf -k` accepts. A model whose inertias
+    SDFormat refuses is not written (E0504 names exactly the links `ign sdf -k` names in its
+    text written anyway), and is written valid with `correct_inertials`."""
     robot = _read_urdf(ERD / model)
+    if model in BAD_INERTIA:
+        robot = _refused_then_corrected(model, robot, tmp_path, diags)
     sdf.emit(robot, _export(), tmp_path, diags)
     _take_expected_warnings(robot, diags)
     path = tmp_path / "sdf" / f"{robot.name}.sdf"
@@ -133,20 +138,35 @@ def test_every_model_is_valid_sdf_and_reads_back(model: str, tmp_path: Path, dia
         assert (path.parent / mesh.text).is_file()
     config = etree.parse(str(tmp_path / "sdf" / "model.config")).getroot()
     assert config.findtext("sdf") == path.name and config.findtext("name") == robot.name
+    assert _complaints(check) == ["Valid."]
 
+
+def _refused_then_corrected(model: str, robot: Robot, tmp_path: Path, diags: Diags) -> Robot:
+    """The export refuses `robot` (E0504, one per link SDFormat refuses, as `ign sdf -k`
+    names them in the text written without the check); the robot `correct_inertials` makes."""
+    from mpc.ir.physical import correct_inertials
+
+    unchecked = tmp_path / "unchecked.sdf"
+    unchecked.write_text(sdf.to_string(robot, _uri))
+    check = _check(unchecked)
+    sdf.emit(robot, _export(), tmp_path / "refused", diags)
+    _take_expected_warnings(robot, diags)
+    refused = set()
+    while any(d.code == "E0504" for d in diags.diagnostics):
+        error = diags.take("E0504")
+        assert error.hint == ("set `correct_inertials: true` on the export to make it physical, "
+                              "or fix its inertial")
+        refused.add(error.message.split("'")[1])
+    assert refused == BAD_INERTIA[model][0]
+    assert not (tmp_path / "refused" / "sdf").exists()
     complaints = _complaints(check)
-    if model not in BAD_INERTIA:
-        assert complaints == ["Valid."]
-        return
     named = {m.group(1) for ln in complaints
              if (m := re.search(r"A link named (\S+) has invalid inertia", ln))}
-    assert named == BAD_INERTIA[model][0], complaints
+    assert named == refused, complaints
     assert all("Error Code 18" in ln for ln in complaints), complaints
-    for name in named:  # the source's numbers: not positive, or not a triangle
-        i = robot.links[name].inertial.inertia  # type: ignore[union-attr]
-        low, mid, high = np.linalg.eigvalsh([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz],
-                                             [i.ixz, i.iyz, i.izz]])
-        assert low < 0 or low + mid < high, name
+    corrected, changed = correct_inertials(robot, exact=True)
+    assert refused <= set(changed)
+    return corrected
 
 
 def test_writing_twice_gives_identical_bytes(tmp_path: Path, diags: Diags) -> None:
