@@ -26,6 +26,10 @@ class OutsideOutput(ValueError):
     """A name that would put a file outside the output folder."""
 
 
+class NotAFileName(OutsideOutput):
+    """A name from the model (a link's, a pose's) that cannot be one file name in the output."""
+
+
 def name_problem(name: str, *, folders: bool = False) -> str | None:
     """Why `name` cannot be a file name inside the output folder, or None.
 
@@ -51,6 +55,17 @@ def name_problem(name: str, *, folders: bool = False) -> str | None:
             return f"a name of {len(part.encode('utf-8', 'surrogatepass'))} bytes; file systems take " \
                    f"at most {NAME_BYTES}"
     return None
+
+
+def file_name(name: str, what: str) -> str:
+    """`name`, a name taken from the model (`what`: 'link', 'pose'), as one file name inside
+    the output; raises NotAFileName when it is not one (a '/', '..', an absolute path…).
+
+    Every output path a backend builds from data passes its data through this and the whole
+    path through `confined` (tests/backends/test_output_paths.py lists the places)."""
+    if why := name_problem(name):
+        raise NotAFileName(f"the {what} name '{name}' cannot be a file name: {why}")
+    return name
 
 
 def confined(root: Path, *names: str) -> Path:
