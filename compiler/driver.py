@@ -274,6 +274,13 @@ def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Progra
         program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
         if program is None:
             return None, None
+        if not options.post_processing:  # --no-post-processing
+            from dataclasses import replace
+
+            from mpc.ir.program import CommandExport
+
+            program = replace(program, exports=tuple(e for e in program.exports
+                                                     if not isinstance(e, CommandExport)))
         with stage("apply ops"):
             return program, apply(program, sink, loader)                  # read inputs, apply ops
     except OSError as e:  # what the readers do not report themselves (a name too long, say)

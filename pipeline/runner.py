@@ -67,6 +67,7 @@ class RunOptions:
     werror: bool = False
     verify: bool = False
     allow_na: bool = False
+    post_processing: bool = True  # --no-post-processing: False
 
 
 class Reporter(Protocol):
@@ -109,7 +110,8 @@ class Runner:
         self.running: dict[str, _Running] = {}
         self.status_error: str | None = None  # why status.json could not be written
         self.start = time.perf_counter()  # when the run started
-        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force)
+        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force,
+                                   opts.post_processing)
 
     # -- the loop ----------------------------------------------------------------------------
 
@@ -222,7 +224,7 @@ class Runner:
         from mpc.core.packages import PackageResolver
 
         return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
-                       defaults=self.plan.defaults)
+                       defaults=self.plan.defaults, post_processing=self.opts.post_processing)
 
     def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:
         from mpc.backends.meshes import share_cores
