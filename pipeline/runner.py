@@ -184,10 +184,14 @@ class Runner:
         model = self.plan.models[name]
         record = self._record(model)
         unusable = self.store.unusable_state(name)
-        if unusable is not None:
+        if unusable is not None:  # said at the damaged file, set aside: the build rewrites the state
+            aside = self.store.set_aside(name)
+            line, col = self.store.unusable_at(name)
+            where = Span(str(aside), line, col) if aside else Span.of_file(str(self.store.state_file(name)))
+            kept = f"; it is kept as {aside.name}" if aside else ""
             record.warnings.append(Diagnostic(
                 Severity.WARNING, "W0640", f"the state of model '{name}' from an earlier run is unusable "
-                f"({unusable}); the model is built again", Span.of_file(str(self.store.state_file(name)))))
+                f"({unusable}); the model is built again{kept}", where))
         if model.failed:
             errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
             self._finish_all(name, "failed", first_error(errors), diagnostics=errors)
