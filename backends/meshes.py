@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -163,7 +162,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
     from mpc.core.cache import load_entry, notes_file, remove_entry, touch_entry
-    from mpc.core.files import confined, describe
+    from mpc.core.files import confined, copy_file, describe
 
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
@@ -229,7 +228,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         if source in entries:
             dest.write_bytes(entries[source])
         else:
-            shutil.copyfile(source, dest)  # a regular file, checked when the model was read
+            copy_file(source, dest)  # a regular file, checked when the model was read
     return ok
 
 

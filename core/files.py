@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import errno
 import os
+import shutil
 import stat
 import tempfile
 from collections.abc import Iterable
@@ -187,6 +188,22 @@ def describe(error: OSError, operation: str | None = None) -> str:
     if operation:
         return f"cannot {operation}{where}: {reason}"
     return f"{reason}{':' if where else ''}{where}"
+
+
+# Errors of writing, not of reading: a copy that fails with one of these failed at its target.
+_WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+
+
+def copy_file(source: Path, target: Path) -> None:
+    """shutil.copyfile, whose errors name the file that failed: shutil names the source for
+    every error of its fast copy (sendfile), a full disk included, and the user would look
+    for the problem at the mesh they gave rather than at the output."""
+    try:
+        shutil.copyfile(source, target)
+    except OSError as e:
+        if e.errno in _WRITE_ERRORS:
+            raise OSError(e.errno, e.strerror, str(target)) from e
+        raise
 
 
 def write_atomic(path: Path, data: str | bytes, *, private: bool = False) -> None:

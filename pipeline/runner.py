@@ -347,7 +347,10 @@ class Runner:
             # Without its state, a model is built again: so a state that could not be saved
             # never describes an output it did not make.
             self.store.forget_state(name)
-            replace_folder(self.store.staging(name) / "out", self.store.output(name))
+            left = replace_folder(self.store.staging(name) / "out", self.store.output(name))
+            if left is not None:
+                record.warnings.append(Diagnostic(Severity.WARNING, "W0625", left,
+                                                  Span.of_file(str(self.plan.models[name].definition))))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
                      "mpc": source_version(), "stages": {}}
