@@ -1,4 +1,6 @@
 """check_names: run every op on the input models' *names* and report what is missing.
+With an export that makes file names of poses or links, it also reports those names that cannot
+be file names, where they were made (check_file_names.py, E0540).
 
 No geometry is read: each part starts from the names of its input model (or nothing
 when they cannot be known, e.g. a repo not cloned yet), each op's `reads` are looked
