@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Severity, Sink
-from mpc.core.files import OutsideOutput, confined, describe
+from mpc.core.files import NotAFileName, OutsideOutput, confined, describe
 from mpc.core.profile import stage
 from mpc.core.span import Span
 
@@ -170,7 +170,10 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
                 continue
         folder.mkdir(parents=True, exist_ok=True)
         with stage(export.type):
-            BACKENDS[export.type]().emit(model, export, folder, sink)
+            try:
+                BACKENDS[export.type]().emit(model, export, folder, sink)
+            except NotAFileName as e:  # a name check_file_names could not see (a submodel's)
+                sink.error(export.span, "E0540", f"{e}; nothing is written")
     return not sink.has_errors()
 
 

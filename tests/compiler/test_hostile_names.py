@@ -222,3 +222,20 @@ def test_check_locates_a_link_name_a_name_editing_prefix_makes(
     spec = write(src / "model.yml", _definition("arm.urdf", _sections("link", "../")) + KCCD)
     err = _check(spec, capsys)
     assert f"{spec}:9:5: error[E0540]: the link name '../base' cannot be a file name" in err
+
+
+def test_a_submodel_s_name_replacement_making_a_link_name_a_path_is_refused_at_its_export(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A name only a submodel has (its `name_replacements`), which `mpc check` does not see:
+    compiling refuses it at the export that would make it a file name."""
+    src = _sources(tmp_path, NAMED_URDF)
+    spec = write(src / "model.yml", _definition("arm.urdf") + (
+        "  export_config:\n    - type: submodel\n      name: part\n      name_replacements:\n"
+        "        upper: ../../../../../../../x\n      export_config:\n        - type: kccd\n"))
+    out = tmp_path / "deep" / "er" / "out"
+    before = _tree(tmp_path, out)
+    assert main(["compile", str(spec), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert (f"{spec}:15:11: error[E0540]: the link name '../../../../../../../x' cannot be a file "
+            "name: it holds a '/' or '\\' (a file name, not a path); nothing is written") in err
+    assert _tree(tmp_path, out) == before and not out.exists()
