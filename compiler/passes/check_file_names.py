@@ -6,7 +6,7 @@ writes each body's hull as `meshes/iv/collision_<link>.stl`. A name that cannot 
 name (a '/', '..', an absolute path: core/files.py `name_problem`) is E0540, reported where the
 name comes from: the line of the definition that made it (a `poses` entry, a `name_editing`
 prefix) or the input model's line that holds it. The backends refuse such a name too
-(core/files.py `file_name`, E0653): this pass says so before anything is built, and where.
+(core/files.py `file_name`; E0540 at the export): this pass says so before anything is built, and where.
 """
 
 from __future__ import annotations
