@@ -1,6 +1,7 @@
 """Run a `post_processing` command in the output folder being written.
 
-The command sees the folder it may change (MPC_EXPORTDIR, the staging folder), where that
+The command runs with PATH, HOME and the variables its entry lists (`env: [NAME]`) of mpc's
+environment, nothing else. It sees the folder it may change (MPC_EXPORTDIR, the staging folder), where that
 folder will be once the build succeeds (MPC_TARGETDIR), and the definition's folder
 (MPC_DEFINITIONDIR), also under Phobos's names (PHOBOS_CI_*) so that existing scripts keep
 working. A command that fails, or cannot start, fails the build with its output; the
@@ -9,6 +10,7 @@ previous output stays as it was, since nothing is swapped into place.
 
 from __future__ import annotations
 
+import os
 import shlex
 import subprocess
 from pathlib import Path
@@ -20,9 +22,20 @@ from mpc.ir.program import CommandExport
 _OUTPUT_LINES = 20  # the end of a failing command's output shown in the diagnostic
 
 
-def environment(staging: Path, out: Path, definition_dir: Path) -> dict[str, str]:
+# What every command gets of mpc's environment besides what its entry lists (`env:`): where
+# programs are, and the home folder some programs need to start at all.
+BASE_VARIABLES = ("PATH", "HOME")
+
+
+def environment(staging: Path, out: Path, definition_dir: Path,
+                listed: tuple[str, ...] = ()) -> dict[str, str]:
+    """The command's environment: PATH, HOME and the variables its entry lists, from mpc's
+    environment as the user gave it (unset ones stay unset), and the MPC_*/PHOBOS_CI_* folders.
+    Nothing else: a token in the CI job's environment reaches no command that does not ask."""
     places = {"EXPORTDIR": staging, "TARGETDIR": out, "DEFINITIONDIR": definition_dir}
-    env = blas.user_environment()
+    user = blas.user_environment()
+    env = {name: user[name] for name in (*BASE_VARIABLES, *listed) if name in user}
+    env.setdefault("PATH", os.defpath)
     for name, path in places.items():
         env[f"MPC_{name}"] = env[f"PHOBOS_CI_{name}"] = str(path.resolve())
     return env
@@ -40,7 +53,7 @@ def run(export: CommandExport, staging: Path, out: Path, sink: Sink) -> bool:
     try:
         done = subprocess.run(export.command[0] if export.shell else list(export.command),
                               shell=export.shell, executable=export.executable or None, cwd=cwd,
-                              env=environment(staging, out, definition_dir), capture_output=True,
+                              env=environment(staging, out, definition_dir, export.env), capture_output=True,
                               text=True, errors="replace", check=False)
     except OSError as error:
         sink.error(export.span, "E0508", f"post_processing command `{shown}` could not start: "

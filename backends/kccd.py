@@ -29,6 +29,7 @@ import numpy as np
 from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.files import confined, file_name
 from mpc.ir.geometry import Mesh, MeshSource
 from mpc.ir.kinematics import links_in_root, pose_matrix
 from mpc.ir.program import KccdExport
@@ -51,7 +52,7 @@ class Body:
     @property
     def mesh(self) -> str:
         """The hull's path in the output folder."""
-        return f"{MESH_DIR}/collision_{self.link}.stl"
+        return f"{MESH_DIR}/collision_{file_name(self.link, 'link')}.stl"
 
 
 def emit(robot: Robot, export: KccdExport, out: Path, sink: Sink) -> None:
@@ -72,7 +73,7 @@ def emit(robot: Robot, export: KccdExport, out: Path, sink: Sink) -> None:
             continue
         hulls[body.link] = hull
         data = hull.export(file_type="stl")
-        path = out / body.mesh
+        path = confined(out, body.mesh)
         if path.exists() and path.read_bytes() != data:
             sink.error(export.span, "E0525", f"two kccd exports write different hulls to {body.mesh}")
             return
@@ -81,13 +82,15 @@ def emit(robot: Robot, export: KccdExport, out: Path, sink: Sink) -> None:
     if sink.has_errors():
         return
     kept = [b for b in bodies if b.link in hulls]
-    folder = out / export.dirname
-    urdf = folder / f"{model.name}.urdf"
+    folder = confined(out, export.dirname)
+    robot_name = file_name(model.name, "robot")
+    urdf = confined(folder, f"{robot_name}.urdf")
     up = "../" * len(Path(export.dirname).parts)  # from the KCCD folder to the output's
     write_path(urdf, to_string(kccd_urdf(model, kept), lambda m: up + m.source.uri))
     settings = settings_of(model, bodies, hulls, export)
-    write_path(folder / f"{model.name}_kccd.yml", json.dumps(settings, indent=2, sort_keys=True) + "\n")
-    run_tools(folder, model.name, settings, export, [out / b.mesh for b in kept], sink)
+    write_path(confined(folder, f"{robot_name}_kccd.yml"),
+               json.dumps(settings, indent=2, sort_keys=True) + "\n")
+    run_tools(folder, robot_name, settings, export, [confined(out, b.mesh) for b in kept], sink)
 
 
 def prepared(robot: Robot, export: KccdExport, sink: Sink) -> Robot | None:

@@ -19,6 +19,7 @@ from typing import Any
 
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
 from mpc.ir.program import KccdExport
 
 
@@ -35,7 +36,7 @@ def run_tools(folder: Path, robot: str, settings: dict[str, Any], export: KccdEx
         return
     if not _run(export, [urdf2kccd, "-b", f"{robot}.urdf"], folder, sink):
         return
-    cfg = folder / f"{robot}.cfg"
+    cfg = confined(folder, f"{robot}.cfg")
     if not cfg.is_file():
         sink.error(export.span, "E0520", f"urdf2kccd did not write {export.dirname}/{robot}.cfg")
         return
@@ -47,7 +48,7 @@ def run_tools(folder: Path, robot: str, settings: dict[str, Any], export: KccdEx
         for stl in stls:
             stl.unlink(missing_ok=True)
     if not export.keep_urdf:
-        (folder / f"{robot}.urdf").unlink(missing_ok=True)
+        confined(folder, f"{robot}.urdf").unlink(missing_ok=True)
 
 
 def _run(export: KccdExport, command: list[str], folder: Path, sink: Sink) -> str | None:

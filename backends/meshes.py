@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -194,7 +193,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
     from mpc.core.cache import load_entry, notes_file, remove_entry, touch_entry
-    from mpc.core.files import describe
+    from mpc.core.files import confined, copy_file, describe
 
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
@@ -208,7 +207,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 f" of a {use.element} of link '{use.link}'" if use else "")
 
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
-        dest = out / rel
+        dest = confined(out, rel)
         if dest.exists():
             continue
         if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
@@ -260,7 +259,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         if source in entries:
             dest.write_bytes(entries[source])
         else:
-            shutil.copyfile(source, dest)  # a regular file, checked when the model was read
+            copy_file(source, dest)  # a regular file, checked when the model was read
     return ok
 
 

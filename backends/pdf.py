@@ -18,6 +18,7 @@ from pathlib import Path
 
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
+from mpc.core.files import confined
 from mpc.ir.program import PdfExport
 from mpc.ir.robot import Joint, Robot
 from mpc.ir.tree import depth_first
@@ -100,7 +101,7 @@ def render_pdf(gv: str) -> bytes | str:
 def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
     """Write `<name>.pdf.gv` and, with `dot`, `<name>.pdf` in the export's root folder."""
     name = export.filename or robot.name
-    gv = out / f"{name}.pdf.gv"
+    gv = confined(out, f"{name}.pdf.gv")
     text = to_gv(robot)
     write_path(gv, text)
     dot = shutil.which("dot")
@@ -112,7 +113,7 @@ def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
     if isinstance(pdf, str):
         sink.error(export.span, "E0506", f"Graphviz could not render {gv.name}: {pdf}")
         return
-    (out / f"{name}.pdf").write_bytes(pdf)
+    confined(out, f"{name}.pdf").write_bytes(pdf)
 
 
 def _stable(data: bytes) -> bytes:

@@ -16,6 +16,7 @@ from pathlib import Path
 from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.ir.kinematics import zero_within_limits
+from mpc.core.files import confined
 from mpc.ir.program import RenderExport
 from mpc.ir.robot import Robot
 
@@ -104,7 +105,7 @@ def emit(robot: Robot, export: RenderExport, out: Path, sink: Sink) -> None:
     pictures = draw_all(robot, export, sink)
     if pictures is None:
         return
-    folder = out / "render"
+    folder = confined(out, "render")
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in sorted(pictures.items()):
-        (folder / name).write_bytes(data)
+        confined(folder, name).write_bytes(data)

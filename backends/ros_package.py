@@ -19,6 +19,7 @@ import yaml
 from mpc.backends import xml_escape
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
+from mpc.core.files import confined, file_name
 from mpc.ir.program import RosPackageExport
 from mpc.ir.robot import Robot
 
@@ -63,13 +64,12 @@ def init_positions(positions: dict[str, float]) -> str:
 
 def emit(robot: Robot, export: RosPackageExport, out: Path, sink: Sink) -> None:
     """Write the package files into the export's root folder."""
-    files = {f"config/init_positions_{pose}.yml": init_positions(dict(positions))
-             for pose, positions in sorted(robot.poses.items())}
-    for name, text in files.items():
-        _write_new(out / name, text)
+    for pose, positions in sorted(robot.poses.items()):
+        name = f"init_positions_{file_name(pose, 'pose')}.yml"
+        _write_new(confined(out, "config", name), init_positions(dict(positions)))
     folders = sorted(p.name for p in out.iterdir() if p.is_dir() and not p.name.startswith("."))
-    _write_new(out / "package.xml", package_xml(export, robot))
-    _write_new(out / "CMakeLists.txt", cmakelists(export.package, folders))
+    _write_new(confined(out, "package.xml"), package_xml(export, robot))
+    _write_new(confined(out, "CMakeLists.txt"), cmakelists(export.package, folders))
 
 
 def _write_new(path: Path, text: str) -> None:

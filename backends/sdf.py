@@ -408,4 +408,4 @@ def emit(robot: Robot, export: SdfExport, out: Path, sink: Sink) -> None:
         text = to_string(robot, meshes.namer(files, prefix), export.version,
                          cut_joints=export.include_cut_joints, formats=formats)
         write_path(confined(out, "sdf", f"{export.filename or robot.name}{suffix}.sdf"), text)
-    write_path(out / "sdf" / "model.config", model_config(robot, export.version))
+    write_path(confined(out, "sdf", "model.config"), model_config(robot, export.version))

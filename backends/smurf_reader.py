@@ -36,6 +36,7 @@ from mpc.backends.smurf_forms import (
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
+from mpc.core.span import Span
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
 from mpc.ir.robot import Material, Pose, Robot
 
@@ -394,3 +395,20 @@ class _State:
 
 
 __all__ = ["MODEL_SUFFIXES", "read"]
+
+
+def entry_span(path: Path, category: str, name: str) -> Span | None:
+    """Where the SMURF at `path` (read before, without errors) names the entry `name` of a list
+    `category` (`poses`, `motors`, …) in one of its annotation files; None when none does."""
+    quiet = Sink()
+    smurf = source.load(path, quiet)
+    files = smurf.data.get("files") if smurf is not None and isinstance(smurf.data, dict) else None
+    for listed in files if isinstance(files, list) else ():
+        if not isinstance(listed, str) or Path(listed).suffix.lower() in MODEL_SUFFIXES:
+            continue
+        doc = source.load(path.parent / listed, quiet)
+        content = doc.data.get(category) if doc is not None and isinstance(doc.data, dict) else None
+        for i, entry in enumerate(content if isinstance(content, list) else ()):
+            if isinstance(entry, dict) and entry.get("name") == name:
+                return doc.value_span((category, i, "name"))
+    return None

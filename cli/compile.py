@@ -13,7 +13,8 @@ def run(args: argparse.Namespace) -> int:
     from mpc.compiler.driver import Options, compile_model
 
     sink = sink_of(args)
-    options = Options(out=args.out, resolver=resolver_of(args), force=args.force)
+    options = Options(out=args.out, resolver=resolver_of(args), force=args.force,
+                      post_processing=not args.no_post_processing)
     if args.emit in ("ir", "ir-lowered"):
         from mpc.compiler.front_end import load_program
         from mpc.ir.text import dump

@@ -69,6 +69,8 @@ def _parser() -> argparse.ArgumentParser:
     comp.add_argument("--force", action="store_true",
                       help="build anew even when nothing the last build read has changed (its kept "
                            "outputs are not used; the mesh cache is)")
+    comp.add_argument("--no-post-processing", action="store_true",
+                      help="do not run the definition's post_processing commands")
     check = sub.add_parser("check", parents=inputs,
                            help="check definitions (or pipeline files) without building")
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
@@ -97,6 +99,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
                      help="models built at once (default: the number of cores)")
     run.add_argument("--force", action="store_true", help="rebuild even what is unchanged")
+    run.add_argument("--no-post-processing", action="store_true",
+                     help="do not run the definitions' post_processing commands")
     run.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
     run.add_argument("--verify", action="store_true",
                      help="fail unless every selected stage of every selected model is ok or cached")
@@ -106,8 +110,10 @@ def _parser() -> argparse.ArgumentParser:
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
     ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
     systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary")
+    gens = []
     for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
         gen = systems.add_parser(system, help=f"write {what}")
+        gens.append(gen)
         gen.add_argument("pipeline", type=Path, help="the pipeline file")
         gen.add_argument("-o", "--output", type=Path, help="where to write the YAML (default: stdout)")
         gen.add_argument("--stages", default="compile", metavar="STAGE,…",
@@ -139,6 +145,10 @@ def _parser() -> argparse.ArgumentParser:
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
+    for p in (run, *gens, job, summary):
+        p.add_argument("--allow-root-outside", action="store_true",
+                       help="accept a pipeline `root` outside the pipeline file's folder and its parent "
+                            "(the build folder is <root>/build)")
     return parser
 
 

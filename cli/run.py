@@ -61,7 +61,7 @@ def select(plan: Plan, only: list[str]) -> tuple[str, ...]:
 
 
 def _load(args: argparse.Namespace, sink: Sink) -> Plan | None:
-    plan = load_plan(args.pipeline, sink)
+    plan = load_plan(args.pipeline, sink, None if args.allow_root_outside else Severity.ERROR)
     render.print_diagnostics(sink.diagnostics, getattr(args, "format", "human"))
     return plan
 
@@ -89,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     opts = RunOptions(stages=stages, only=only, jobs=jobs, force=args.force,
                       build=args.out.resolve() if args.out else None,
                       package_map={name: folder for name, folder in args.package}, werror=args.werror,
-                      verify=args.verify, allow_na=args.allow_na)
+                      verify=args.verify, allow_na=args.allow_na,
+                      post_processing=not args.no_post_processing)
     report = progress.reporter(args.log_format)
     runner = Runner(plan, opts, report)
     previous = signal.signal(signal.SIGTERM, _interrupt)  # a stopped run stops its workers first
@@ -185,7 +186,8 @@ def ci(args: argparse.Namespace) -> int:
             print("mpc ci: error: no CI file was written", file=sys.stderr)
             return 1
     command = " ".join(["mpc", "ci", args.system, pipeline])
-    setup = generate.Setup(pipeline, build, stages, args.image, install, command, mpc_version(), here)
+    setup = generate.Setup(pipeline, build, stages, args.image, install, command, mpc_version(), here,
+                           args.allow_root_outside)
     text = (generate.gitlab if args.system == "gitlab" else generate.github)(plan, setup)
     if args.output is None:
         sys.stdout.write(text)

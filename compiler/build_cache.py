@@ -122,6 +122,7 @@ class KeptBuild:
             sorted((k, str(v)) for k, v in resolver.package_map.items()),
             [str(p) for p in resolver.search_path or ()], [str(p) for p in resolver.roots],
             sorted((k, v) for k, v in user_environment().items() if k not in _SESSION),
+            *([] if options.post_processing else ["no post_processing"]),
         ])
         name = hashlib.sha256(json.dumps(where).encode()).hexdigest()
         kept = cls(cache.cache_dir("builds") / name[:2] / name, hashlib.sha256(key.encode()).hexdigest(),

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Severity, Sink
-from mpc.core.files import OutsideOutput, confined, describe
+from mpc.core.files import NotAFileName, OutsideOutput, confined, describe
 from mpc.core.profile import stage
 from mpc.core.span import Span
 
@@ -67,12 +67,15 @@ def emit(program: Program, robot: Robot, out: Path, sink: Sink, target: Path | N
     output folder is E0653. Either way the previous output stays as it was.
     """
     return into_place(out, sink, program.span,
-                      lambda staging: _emit_exports(program, robot, staging, out, sink, target))
+                      lambda staging: _emit_exports(program, robot, staging, out, sink, target), target)
 
 
-def into_place(out: Path, sink: Sink, span: Span, fill: Callable[[Path], bool]) -> bool:
+def into_place(out: Path, sink: Sink, span: Span, fill: Callable[[Path], bool],
+               target: Path | None = None) -> bool:
     """Fill a staging folder next to `out` (`fill` says whether it succeeded), then swap it into
-    place; OSError and OutsideOutput raised while filling become E0660 and E0653 at `span`."""
+    place; OSError and OutsideOutput raised while filling become E0660 and E0653 at `span`.
+    A file of the staging folder is named where it was to be: in `target` (where `mpc run`
+    moves the output), else in `out`."""
     step = "make the output's folder"
     staging: Path | None = None
     try:
@@ -84,9 +87,13 @@ def into_place(out: Path, sink: Sink, span: Span, fill: Callable[[Path], bool]) 
         if not fill(staging):
             return False
         step = "move the build into place"
-        replace_folder(staging, out)
+        left = replace_folder(staging, out)
+        if left is not None:
+            sink.warning(span, "W0625", left)
         return True
     except OSError as e:
+        if staging is not None and isinstance(e.filename, str) and e.filename.startswith(f"{staging}/"):
+            e.filename = str(target or out) + e.filename[len(str(staging)):]
         sink.error(span, "E0660", f"{describe(e, step)}; the previous output is unchanged")
         return False
     except OutsideOutput as e:
@@ -164,7 +171,10 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
                 continue
         folder.mkdir(parents=True, exist_ok=True)
         with stage(export.type):
-            BACKENDS[export.type]().emit(model, export, folder, sink)
+            try:
+                BACKENDS[export.type]().emit(model, export, folder, sink)
+            except NotAFileName as e:  # a name check_file_names could not see (a submodel's)
+                sink.error(export.span, "E0540", f"{e}; nothing is written")
     return not sink.has_errors()
 
 
@@ -192,11 +202,15 @@ def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
     return robot
 
 
-def replace_folder(new: Path, out: Path) -> None:
-    """Put `new` where `out` is; the old `out` disappears only after `new` is in place."""
+def replace_folder(new: Path, out: Path) -> str | None:
+    """Put `new` where `out` is; the old `out` disappears only after `new` is in place.
+
+    The new output is in place either way; what cannot be removed of the old one (a folder
+    made immutable, `chattr +i`, or read-only by another user) stays as `.<out>.mpc-old-<pid>`
+    beside it, and the return value says so, naming it and why (W0625): None when all went."""
     if not out.exists():
         os.replace(new, out)
-        return
+        return None
     old = out.with_name(f".{out.name[:100]}.mpc-old-{os.getpid()}")
     os.replace(out, old)
     try:
@@ -204,7 +218,15 @@ def replace_folder(new: Path, out: Path) -> None:
     except OSError:
         os.replace(old, out)
         raise
-    shutil.rmtree(old, ignore_errors=True)
+    failed: list[tuple[str, BaseException]] = []  # (the path rmtree could not remove, why)
+    shutil.rmtree(old, onerror=lambda _f, path, info: failed.append((path, info[1])))
+    if not old.exists():
+        return None
+    path, error = failed[0] if failed else (str(old), None)
+    reason = getattr(error, "strerror", None) or "it is still there"
+    why = f"cannot remove '{path}': {reason}"
+    return (f"the previous output, moved aside to '{old}', could not be removed ({why}); the new "
+            "output is in place: remove the old one by hand (lsattr shows an immutable 'i' flag)")
 
 
 def compile_model(path: Path, sink: Sink, options: Options) -> Result:
@@ -291,6 +313,13 @@ def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Progra
         program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
         if program is None:
             return None, None
+        if not options.post_processing:  # --no-post-processing
+            from dataclasses import replace
+
+            from mpc.ir.program import CommandExport
+
+            program = replace(program, exports=tuple(e for e in program.exports
+                                                     if not isinstance(e, CommandExport)))
         with stage("apply ops"):
             return program, apply(program, sink, loader)                  # read inputs, apply ops
     except OSError as e:  # what the readers do not report themselves (a name too long, say)

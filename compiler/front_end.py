@@ -53,7 +53,7 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     if program is None or not passes:
         return None if sink.has_errors() else program
     loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
-    program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
+    program = run_passes(program, PassContext(sink, loader.names, later, loader.name_span))  # run passes
     loader.report_missing_meshes()                                        # check: mesh files
     return None if sink.has_errors() else program
 
@@ -108,7 +108,7 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
     if not passes:
         return program
     loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
-    program = run_passes(program, PassContext(sink, loader.names, later))  # run passes
+    program = run_passes(program, PassContext(sink, loader.names, later, loader.name_span))  # run passes
     return None if sink.has_errors() else program
 
 

@@ -133,6 +133,20 @@ class InputLoader:
             self._names[key] = self._load_names(inp)
         return self._names[key]
 
+    def name_span(self, inp: Input, kind: str, name: str) -> Span | None:
+        """Where the input model holds `name` (a link, a pose), when it was read and can tell:
+        a link's element; a pose's entry in the annotation files of a SMURF."""
+        robot = self._robots.get(self._key(inp))
+        if robot is None:
+            return None
+        if kind == "link" and name in robot.links:
+            return robot.links[name].span
+        if kind == "pose" and inp.path is not None and inp.path.suffix.lower() == ".smurf":
+            from mpc.backends.smurf_reader import entry_span
+
+            return entry_span(inp.path, "poses", name)
+        return None
+
     def _load_names(self, inp: Input) -> Names | None:
         if inp.kind == "derived_base" and self.symbolic:
             assert inp.path is not None

@@ -267,8 +267,17 @@ class _Exports:
                 self.ctx.sink.error(entry.value_span("cwd"), "E0203", "'cwd' is relative to the definition's "
                                     "folder; an absolute path would tie the definition to one machine")
                 continue
+            bad = [(i, n) for i, n in enumerate(entry.env) if not _VARIABLE.fullmatch(n)]
+            for i, name in bad:
+                listed = isinstance(entry.data_at("env"), list)
+                where = entry.value_span("env", i) if listed else entry.value_span("env")
+                self.ctx.sink.error(where, "E0541", f"'{name}' is not the name of an environment "
+                                    "variable (letters, digits and '_', not a digit first)")
+            if bad:
+                continue
             out.append(CommandExport(span=entry.value_span("cmd"), command=command, shell=entry.shell,
-                                     cwd=entry.cwd or "", executable=entry.executable or ""))
+                                     cwd=entry.cwd or "", executable=entry.executable or "",
+                                     env=tuple(entry.env)))
         return out
 
     def ros_package(self, package: str) -> RosPackageExport:
@@ -327,6 +336,7 @@ def ros_name(modelname: str) -> str:
     return name if name[0].isalpha() else f"pkg_{name}"
 # What a shell would read differently from a plain split into arguments: redirections, pipes,
 # `;`, `&&`, `&`, `$` expansions, back quotes, subshells, globs, quotes, escapes, and `~`.
+_VARIABLE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _SHELL_SYNTAX = re.compile(r"&&|\|\||[|;&<>$`()*?'\"\\]|\[.*\]|(?:^|\s)~")
 _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.

@@ -34,6 +34,8 @@ class Options:
     # Build anew: the kept build of the definition (compiler/build_cache.py) is not used, and
     # this build is kept in its place.
     force: bool = False
+    # Run the definition's post_processing commands (`--no-post-processing`: False).
+    post_processing: bool = True
 
 
 @dataclass

@@ -27,6 +27,10 @@ class OutsideOutput(ValueError):
     """A name that would put a file outside the output folder."""
 
 
+class NotAFileName(OutsideOutput):
+    """A name from the model (a link's, a pose's) that cannot be one file name in the output."""
+
+
 def name_problem(name: str, *, folders: bool = False) -> str | None:
     """Why `name` cannot be a file name inside the output folder, or None.
 
@@ -52,6 +56,17 @@ def name_problem(name: str, *, folders: bool = False) -> str | None:
             return f"a name of {len(part.encode('utf-8', 'surrogatepass'))} bytes; file systems take " \
                    f"at most {NAME_BYTES}"
     return None
+
+
+def file_name(name: str, what: str) -> str:
+    """`name`, a name taken from the model (`what`: 'link', 'pose'), as one file name inside
+    the output; raises NotAFileName when it is not one (a '/', '..', an absolute path…).
+
+    Every output path a backend builds from data passes its data through this and the whole
+    path through `confined` (tests/backends/test_output_paths.py lists the places)."""
+    if why := name_problem(name):
+        raise NotAFileName(f"the {what} name '{name}' cannot be a file name: {why}")
+    return name
 
 
 def confined(root: Path, *names: str) -> Path:
@@ -173,6 +188,22 @@ def describe(error: OSError, operation: str | None = None) -> str:
     if operation:
         return f"cannot {operation}{where}: {reason}"
     return f"{reason}{':' if where else ''}{where}"
+
+
+# Errors of writing, not of reading: a copy that fails with one of these failed at its target.
+_WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+
+
+def copy_file(source: Path, target: Path) -> None:
+    """shutil.copyfile, whose errors name the file that failed: shutil names the source for
+    every error of its fast copy (sendfile), a full disk included, and the user would look
+    for the problem at the mesh they gave rather than at the output."""
+    try:
+        shutil.copyfile(source, target)
+    except OSError as e:
+        if e.errno in _WRITE_ERRORS:
+            raise OSError(e.errno, e.strerror, str(target)) from e
+        raise
 
 
 def write_atomic(path: Path, data: str | bytes, *, private: bool = False) -> None:

@@ -46,6 +46,7 @@ class Names:
             visuals={n: frozenset(v.name for v in link.visuals if v.name)
                      for n, link in robot.links.items()},
             materials=frozenset(robot.materials),
+            others={"pose": frozenset(robot.poses)} if robot.poses else {},
         )
 
     def all(self, kind: Kind) -> frozenset[str]:

@@ -260,6 +260,8 @@ class CommandExport(ExportEntry):
     command: the program and its arguments; with `shell`, one string for the shell.
     cwd: where it runs, relative to the definition's folder ("" : the output folder).
     executable: the program to start instead of command[0] (with `shell`: the shell).
+    env: the names of the variables of mpc's environment the command gets, besides PATH, HOME
+        and the MPC_* folders (backends/commands.py).
     """
 
     span: Span
@@ -267,6 +269,7 @@ class CommandExport(ExportEntry):
     shell: bool = False
     cwd: str = ""
     executable: str = ""
+    env: tuple[str, ...] = ()
     type: Literal["command"] = "command"
 
 

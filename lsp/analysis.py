@@ -187,7 +187,8 @@ def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, opti
         return
     analysis.program, analysis.loader = lowered, loader
     errors = sink.error_count
-    program = run_passes(lowered, PassContext(sink, loader.names, Severity.WARNING))
+    program = run_passes(lowered, PassContext(sink, loader.names, Severity.WARNING,
+                                                      loader.name_span))
     analysis.passed = program
     if sink.error_count == errors:
         analysis.ran = program  # a missing mesh file (below) does not keep hover from the robot

@@ -49,6 +49,7 @@ class Setup:
     command: str
     version: str
     project: Path
+    allow_root_outside: bool = False  # the jobs' `mpc ci` commands carry --allow-root-outside
 
 
 def job_ids(plan: Plan, prefix: str, pattern: str = r"[^A-Za-z0-9_-]") -> dict[str, str]:
@@ -69,7 +70,12 @@ def _job_stages(stages: tuple[str, ...]) -> list[tuple[str, tuple[str, ...]]]:
 
 
 def _command(s: Setup, model: str, stages: tuple[str, ...]) -> str:
-    return shlex.join(["mpc", "ci", "job", s.pipeline, model, "-o", s.build, "--stages", ",".join(stages)])
+    return shlex.join(["mpc", "ci", "job", s.pipeline, model, "-o", s.build, "--stages", ",".join(stages),
+                       *_flags(s)])
+
+
+def _flags(s: Setup) -> list[str]:
+    return ["--allow-root-outside"] if s.allow_root_outside else []
 
 
 def _artifacts(s: Setup, model: str) -> list[str]:
@@ -198,7 +204,7 @@ def gitlab(plan: Plan, s: Setup) -> str:
             doc[ids[stage][name]] = job
     doc["summary"] = {
         "stage": "summary", "when": "always",
-        "script": [shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build])],
+        "script": [shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build, *_flags(s)])],
         "cache": [{**uv, "policy": "pull-push", "when": "always"},
                   {"key": key, "paths": [f"{CACHE}/mpc/"], "policy": "push", "when": "always"},
                   {"key": f"mpc-meshes-{s.version}", "paths": [f"{CACHE}/mpc/"], "policy": "push",
@@ -270,7 +276,7 @@ def github(plan: Plan, s: Setup) -> str:
             job["steps"] = steps
             jobs[job_id] = job
     everything = [j for stage in s.stages for j in ids[stage].values()]
-    summary = shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build])
+    summary = shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build, *_flags(s)])
     jobs["summary"] = {
         "name": "summary", "runs-on": "ubuntu-latest", **({"container": s.image} if s.image else {}),
         "needs": everything, "if": "${{ !cancelled() }}",

@@ -131,7 +131,7 @@ def job(args: argparse.Namespace, plan: Plan, model: str, stages: tuple[str, ...
     code = run(argparse.Namespace(
         pipeline=args.pipeline, only=[model], stages=",".join(stages), jobs=None, force=False, out=build,
         package=args.package, werror=args.werror, verify=False, allow_na=False, log_format="text",
-        format=args.format))
+        format=args.format, allow_root_outside=args.allow_root_outside, no_post_processing=False))
     after = inventory()
     used = sorted(p for p, t in after.items() if before.get(p) != t)
     made = sum(p not in before for p in used)

@@ -25,11 +25,13 @@ class Freshness:
     `force` ignores the cache."""
 
     def __init__(self, plan: Plan, store: Store, stages: tuple[str, ...], package_map: Mapping[str, Path],
-                 werror: bool, force: bool) -> None:
+                 werror: bool, force: bool, post_processing: bool = True) -> None:
         self.plan, self.store, self.stages, self.force = plan, store, stages, force
         # Package folders inside the root are named relative to it, as the files a build read.
         packages = repr(sorted((k, dep_name(v, plan.root)) for k, v in package_map.items()))
-        self.options = digest(source_version(), packages, str(werror))
+        # a build without its post_processing is another build (nothing said: the same as before)
+        skipped = () if post_processing else ("no post_processing",)
+        self.options = digest(source_version(), packages, str(werror), *skipped)
         self.resolver = PackageResolver(package_map=dict(package_map))  # where packages are now
 
     def before_build(self, model: PlannedModel, this_run: Mapping[str, str | None]) -> str:

@@ -83,9 +83,13 @@ class Plan:
         return {name: m.parents for name, m in self.models.items()}
 
 
-def load_plan(path: Path, sink: Sink) -> Plan | None:
+def load_plan(path: Path, sink: Sink, root_outside: Severity | None = Severity.ERROR) -> Plan | None:
     """The plan of the pipeline file at `path`; None (errors in `sink`) when the file itself
-    is unusable. Problems of single models stay with those models."""
+    is unusable. Problems of single models stay with those models.
+
+    root_outside: what a `root` outside the pipeline file's folder (and not its parent, the
+    default `..`) is: an error (E0621: `mpc run` would write `<root>/build` there), a warning
+    (W0624, `mpc check`), or allowed (None: `--allow-root-outside`)."""
     doc = source.load(path, sink)
     if doc is None or not verdicts.valid_pipeline(doc, sink):
         return None
@@ -102,6 +106,14 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
                    f"the workspace root '{root}' {problem}",
                    hint=hint)
         return None
+    if root_outside is not None and not _root_allowed(root, path.resolve().parent):
+        say = sink.error if root_outside is Severity.ERROR else sink.warning
+        say(doc.value_span(("pipeline", "root")), "E0621" if root_outside is Severity.ERROR else "W0624",
+            f"the workspace root '{root}' is outside the pipeline file's folder "
+            f"'{path.resolve().parent}' and its parent; `mpc run` would write '{root / 'build'}'",
+            hint="give --allow-root-outside when this root is meant")
+        if root_outside is Severity.ERROR:
+            return None
     defaults = PipelineDefaults(doc)
     by_file: dict[Path, PlannedModel] = {}
     derived: dict[Path, list[tuple[Path, Span]]] = {}
@@ -124,6 +136,12 @@ def load_plan(path: Path, sink: Sink) -> Plan | None:
     return Plan(path, doc, settings, root, models)
 
 
+def _root_allowed(root: Path, folder: Path) -> bool:
+    """Whether `root` (resolved) is the pipeline file's folder, inside it, or its parent (the
+    default `..`: a pipeline kept in a folder of the project, as Phobos CI keeps it)."""
+    return root == folder.parent or root == folder or folder in root.parents
+
+
 # What `mpc check pipeline.yml` reports of planning; checking each definition reports the
 # rest (its own errors, cycles as E0308).
 _WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "W0610")
@@ -135,7 +153,7 @@ def check_pipeline(path: Path, sink: Sink,
     modelnames, names that cannot be folders, definitions that are missing, listed twice or
     outside the root, derived_base parents outside the pipeline), and each definition that
     can be read, through `check_definition` with the pipeline's defaults."""
-    plan = load_plan(path, sink)
+    plan = load_plan(path, sink, Severity.WARNING)
     for model in plan.models.values() if plan else ():
         for d in model.diagnostics:
             if d.code in _WHOLE_PIPELINE:

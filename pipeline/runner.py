@@ -67,6 +67,7 @@ class RunOptions:
     werror: bool = False
     verify: bool = False
     allow_na: bool = False
+    post_processing: bool = True  # --no-post-processing: False
 
 
 class Reporter(Protocol):
@@ -109,7 +110,8 @@ class Runner:
         self.running: dict[str, _Running] = {}
         self.status_error: str | None = None  # why status.json could not be written
         self.start = time.perf_counter()  # when the run started
-        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force)
+        self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force,
+                                   opts.post_processing)
 
     # -- the loop ----------------------------------------------------------------------------
 
@@ -182,10 +184,14 @@ class Runner:
         model = self.plan.models[name]
         record = self._record(model)
         unusable = self.store.unusable_state(name)
-        if unusable is not None:
+        if unusable is not None:  # said at the damaged file, set aside: the build rewrites the state
+            aside = self.store.set_aside(name)
+            line, col = self.store.unusable_at(name)
+            where = Span(str(aside), line, col) if aside else Span.of_file(str(self.store.state_file(name)))
+            kept = f"; it is kept as {aside.name}" if aside else ""
             record.warnings.append(Diagnostic(
                 Severity.WARNING, "W0640", f"the state of model '{name}' from an earlier run is unusable "
-                f"({unusable}); the model is built again", Span.of_file(str(self.store.state_file(name)))))
+                f"({unusable}); the model is built again{kept}", where))
         if model.failed:
             errors = [d for d in model.diagnostics if d.severity is Severity.ERROR]
             self._finish_all(name, "failed", first_error(errors), diagnostics=errors)
@@ -222,7 +228,7 @@ class Runner:
         from mpc.core.packages import PackageResolver
 
         return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
-                       defaults=self.plan.defaults)
+                       defaults=self.plan.defaults, post_processing=self.opts.post_processing)
 
     def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:
         from mpc.backends.meshes import share_cores
@@ -341,7 +347,10 @@ class Runner:
             # Without its state, a model is built again: so a state that could not be saved
             # never describes an output it did not make.
             self.store.forget_state(name)
-            replace_folder(self.store.staging(name) / "out", self.store.output(name))
+            left = replace_folder(self.store.staging(name) / "out", self.store.output(name))
+            if left is not None:
+                record.warnings.append(Diagnostic(Severity.WARNING, "W0625", left,
+                                                  Span.of_file(str(self.plan.models[name].definition))))
             state = {"model": name, "definition": str(self.plan.models[name].definition), "pre": r.pre,
                      "fingerprint": with_deps(r.pre, message["deps"] or []), "deps": message["deps"] or [],
                      "mpc": source_version(), "stages": {}}

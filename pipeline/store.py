@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import fcntl
 import json
+import os
 import shutil
 from pathlib import Path
 from typing import IO, Any
@@ -39,6 +40,7 @@ class Store:
         self.meta = build / ".mpc"
         self._lock: IO[str] | None = None
         self._states: dict[str, tuple[dict[str, Any], str | None]] = {}  # read once a run
+        self._where: dict[str, tuple[int, int]] = {}  # where an unusable state's problem is
 
     def output(self, model: str) -> Path:
         return self.build / model
@@ -84,6 +86,24 @@ class Store:
         when it is fine or absent."""
         return self._read_state(model)[1]
 
+    def unusable_at(self, model: str) -> tuple[int, int]:
+        """The line and column of what makes the state unusable (1, 1: the whole file)."""
+        return self._where.get(model, (1, 1))
+
+    def set_aside(self, model: str) -> Path | None:
+        """Move the model's unusable state file to `<model>.json.unusable` beside it, where the
+        next run's state does not overwrite it: the warning (W0640) quotes it and the user can
+        look at it. None when it is no regular file (a link is not kept, nor quoted)."""
+        path = self.state_file(model)
+        aside = path.with_name(f"{path.name}.unusable")
+        try:
+            if not path.is_symlink() and path.is_file():
+                os.replace(path, aside)
+                return aside
+        except OSError:
+            pass
+        return None
+
     def _read_state(self, model: str) -> tuple[dict[str, Any], str | None]:
         if model not in self._states:
             self._states[model] = self._load_state(model)
@@ -108,6 +128,7 @@ class Store:
         doc = source.load(path, sink)
         if doc is None:
             first = sink.diagnostics[0]
+            self._where[model] = (first.span.line, first.span.col)
             return {}, f"{first.message} (line {first.span.line})"
         return (doc.data, None) if well_formed(doc.data) else ({}, "not a state mpc writes")
 

@@ -40,6 +40,13 @@ TOKENS = (
 )
 
 
+# The exports of the seeds, with the routes from a name to a file name (issue 35.3): a ROS
+# package writes each pose as config/init_positions_<pose>.yml, kccd each link's hull as
+# meshes/iv/collision_<link>.stl; the poses give a mutation a pose name to hit.
+ROUTES = ("      ros_pathes: true\n    - type: sdf\n      mesh_format: stl\n    - type: kccd\n"
+          "  ros_pkg_name: robot_model\n  poses:\n    init:\n      shoulder: 0.1\n")
+
+
 @dataclass(frozen=True)
 class Edit:
     """One change of a seed: `op` (value, insert, replace, delete, repeat, cut) at `where` (a
@@ -102,14 +109,14 @@ class Seeds:
 
         folder = work / "seed"
         arm(folder)
-        text = definition("arm.urdf") + "    - type: sdf\n      mesh_format: stl\n"
+        text = definition("arm.urdf") + ROUTES
         (folder / "model.yml").write_text(text)
         with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
             assert main(["compile", str(folder / "model.yml"), "-o", str(folder / "built")]) == 0
         files = {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
         files["pipeline.yml"] = b"pipeline:\n  root: .\n  model_definitions: [model.yml]\n"
         for kind, basefile in (("sdf", "built/sdf/robot.sdf"), ("smurf", "built/smurf/robot.smurf")):
-            files[f"{kind}.yml"] = definition(basefile).encode()
+            files[f"{kind}.yml"] = (definition(basefile) + ROUTES).encode()
         shutil.rmtree(folder)
         return cls(files)
 

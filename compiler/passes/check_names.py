@@ -1,4 +1,6 @@
 """check_names: run every op on the input models' *names* and report what is missing.
+With an export that makes file names of poses or links, it also reports those names that cannot
+be file names, where they were made (check_file_names.py, E0540).
 
 No geometry is read: each part starts from the names of its input model (or nothing
 when they cannot be known, e.g. a repo not cloned yet), each op's `reads` are looked
@@ -92,7 +94,13 @@ def _nearest_first(name: str, pool: frozenset[str], shown: int = 8) -> str | Non
 
 
 def check_names(program: Program, ctx: PassContext) -> Program:
-    names = symbolic(program, ctx)
+    from mpc.compiler.passes.check_file_names import Origins, check_file_names, file_routes
+
+    origins = Origins(file_routes(program))
+    names = symbolic(program, ctx, origins.trace if origins.kinds else None)
+    if names is not None and origins.kinds:
+        check_file_names(program, names, origins, ctx.input_names, ctx.name_span,
+                         lambda span, message: ctx.sink.error(span, "E0540", message))
     # the exports' names, once the rest is right: on names every op could edit, and not after
     # lowering reported an export's problem (it would be said twice)
     if names is not None and not ctx.sink.has_errors() and ctx.later is Severity.WARNING:

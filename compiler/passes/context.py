@@ -6,11 +6,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mpc.core.diagnostics import Severity, Sink
+from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.program import Input
 
 
 def _unknown(_: Input) -> Names | None:
+    return None
+
+
+def _nowhere(_: Input, kind: str, name: str) -> Span | None:
     return None
 
 
@@ -22,3 +27,5 @@ class PassContext:
     sink: Sink
     input_names: Callable[[Input], Names | None] = field(default=_unknown)
     later: Severity = Severity.ERROR
+    # where an input model holds one of its names (kind, name), when it can tell
+    name_span: Callable[[Input, str, str], Span | None] = field(default=_nowhere)

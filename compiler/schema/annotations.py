@@ -124,3 +124,4 @@ class PostProcessing(Node):
     cwd: str | None = None
     shell: bool = False
     executable: str | None = None
+    env: OneOrMore = []  # names of mpc's environment variables the command gets (commands.py)

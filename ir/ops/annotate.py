@@ -379,6 +379,9 @@ class AddPose(Op):
     positions: Mapping[JointRef, float] = field(default_factory=dict)
     default: float | None = None
 
+    def effect(self, names: Names, effects: Effects) -> Names:
+        return names.with_other("pose", [self.name])
+
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         """Values are clamped to the joint's limits (a warning says so); fixed joints are
         not configurations (a warning too)."""

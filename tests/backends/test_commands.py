@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -107,3 +108,54 @@ def test_shell_syntax_without_shell_is_an_error_and_with_shell_writes_its_file(t
     done = mpc("compile", spec, "-o", tmp_path / "out")
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out/log.txt").read_text() == "42\n"
+
+
+# -- what a command gets of the environment, and when it runs (issue 35.7) -----------------------
+
+TOKEN = "ghp_FAKE0123456789abcdefTOKEN"
+DUMP_ENV = "    - cmd: [sh, -c, 'env | sort > \"$MPC_EXPORTDIR/env.txt\"']\n"
+
+
+def _environment(out: Path) -> dict[str, str]:
+    return dict(line.split("=", 1) for line in (out / "env.txt").read_text().splitlines() if "=" in line)
+
+
+def test_a_command_gets_path_home_the_listed_variables_and_no_token(tmp_path: Path) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + "  export_config: [{type: urdf, mesh_format: stl}]\n"
+                 "  post_processing:\n" + DUMP_ENV + "      env: [MPC_TEST_WANTED, MPC_TEST_UNSET]\n")
+    done = mpc("compile", spec, "-o", tmp_path / "out", env={
+        **os.environ, "GITHUB_TOKEN": TOKEN, "CI_JOB_TOKEN": TOKEN, "MPC_TEST_WANTED": "yes"})
+    assert done.returncode == 0, done.stderr
+    env = _environment(tmp_path / "out")
+    assert env["MPC_TEST_WANTED"] == "yes" and "MPC_TEST_UNSET" not in env
+    assert {"PATH", "HOME", "MPC_EXPORTDIR", "PHOBOS_CI_TARGETDIR"} <= set(env)
+    assert TOKEN not in (tmp_path / "out" / "env.txt").read_text()
+    # what sh sets itself (PWD, SHLVL, _) and nothing else of mpc's environment
+    assert set(env) - {"PWD", "SHLVL", "_", "OLDPWD"} == {
+        "PATH", "HOME", "MPC_TEST_WANTED", *(f"{p}_{n}" for p in ("MPC", "PHOBOS_CI")
+                                             for n in ("EXPORTDIR", "TARGETDIR", "DEFINITIONDIR"))}
+
+
+def test_a_listed_name_that_is_no_variable_is_an_error_at_its_line(tmp_path: Path) -> None:
+    spec = write(tmp_path / "m.yml", HEAD + "  post_processing:\n" + DUMP_ENV + "      env: [OK, 'A=B']\n")
+    done = mpc("check", spec)
+    assert done.returncode == 1
+    assert (f"{spec}:8:17: error[E0541]: 'A=B' is not the name of an environment variable "
+            "(letters, digits and '_', not a digit first)") in done.stderr
+
+
+def test_check_and_no_post_processing_run_nothing(tmp_path: Path) -> None:
+    canary = tmp_path / "canary"
+    spec = write(tmp_path / "m.yml", HEAD + "  export_config: [{type: urdf, mesh_format: stl}]\n"
+                 f"  post_processing:\n    - cmd: [touch, '{canary}']\n")
+    assert mpc("check", spec).returncode == 0
+    assert not canary.exists()
+    done = mpc("compile", spec, "-o", tmp_path / "out", "--no-post-processing")
+    assert done.returncode == 0, done.stderr
+    assert not canary.exists() and (tmp_path / "out/urdf/arm.urdf").is_file()
+    done = mpc("compile", spec, "-o", tmp_path / "out")  # not the build above, kept: it runs
+    assert done.returncode == 0, done.stderr
+    assert canary.exists()
+    canary.unlink()
+    done = mpc("compile", spec, "-o", tmp_path / "out", "--no-post-processing")
+    assert done.returncode == 0 and not canary.exists()

@@ -61,6 +61,7 @@ NOT_NAMES: dict[tuple[str, str], str] = {
     ("AutoBitmask", "never"): "pairs of links or collisions; effect reports them",
     ("AutoBitmask", "always"): "pairs of links or collisions; effect reports them",
     ("CutJoint", "name"): "a loop joint's name; joint name editing leaves it (as before)",
+    ("CommandExport", "env"): "names of environment variables a command gets",
     # The program and its exports (ir/program.py): files, folders, repositories, formats, text.
     **{(cls, field): "a file or folder of the output, or its name" for cls, field in (
         ("UrdfExport", "filename"), ("SdfExport", "filename"), ("MjcfExport", "filename"),

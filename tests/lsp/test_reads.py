@@ -64,3 +64,22 @@ def test_keystrokes_reread_no_urdf_and_a_changed_urdf_is_read_again(tmp_path: Pa
         assert reads() > first
     finally:
         assert server.close() == 0
+
+
+def test_the_server_runs_no_post_processing_command(tmp_path: Path) -> None:
+    """Opening a definition (as an editor does on a checkout of a merge request) runs none of
+    its commands (issue 35.7)."""
+    for name in ("arm.urdf", "meshes"):
+        (shutil.copytree if name == "meshes" else shutil.copy)(EXAMPLES / name, tmp_path / name)
+    canary = tmp_path / "canary"
+    server = Client(env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}, cwd=tmp_path)
+    try:
+        server.initialize(tmp_path)
+        path = tmp_path / "arm_model.yml"
+        path.write_text(HEAD + EXPORT + f"  post_processing:\n    - cmd: [touch, '{canary}']\n"
+                        f"    - cmd: 'touch {canary}'\n      shell: true\n", encoding="utf-8")
+        uri = server.open(path)
+        assert server.diagnostics(uri, 1) == []
+    finally:
+        assert server.close() == 0
+    assert not canary.exists()

@@ -233,12 +233,18 @@ def test_a_corrupt_state_file_rebuilds_the_model_with_a_warning(built: Path, tmp
                                                                 case: str) -> None:
     folder = _copy(built, tmp_path / "p")
     state = folder / "build/.mpc/state/p.json"
-    state.write_text(CORRUPT[case](_state(folder)))
+    damaged = CORRUPT[case](_state(folder))
+    state.write_text(damaged)
     run = run_json(folder / "pipeline.yml", cache=folder / "cache")
     assert run.returncode == 0, run.stderr
     assert run.state("p") == "ok"
-    warning = f"{state}:1:1: warning[W0640]: the state of model 'p' from an earlier run is unusable ("
-    assert warning in run.stderr
+    # said at the damaged file, kept beside the new state, and quoted from it (issue 35.8)
+    warning = f"{state}.unusable:1:"
+    assert f"{warning}" in run.stderr and "warning[W0640]: the state of model 'p' from an earlier " \
+        "run is unusable (" in run.stderr
+    assert "the model is built again; it is kept as p.json.unusable" in run.stderr
+    assert f" 1 | {damaged[:30]}" in run.stderr
+    assert (folder / "build/.mpc/state/p.json.unusable").read_text() == damaged
     assert _urdf(folder) == _urdf(built)
     again = run_json(folder / "pipeline.yml", cache=folder / "cache")
     assert (again.state("p"), again.stderr) == ("cached", "")
