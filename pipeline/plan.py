@@ -151,7 +151,7 @@ def check_pipeline_file(path: Path, sink: Sink, options: Options) -> None:
 
     def check(model: Path, defaults: PipelineDefaults, root: Path) -> None:
         # The workspace root is the project of every definition (as `mpc run` reads them).
-        options.resolver.add_root(root)
+        options.resolver.add_project(root)
         front_end.check_file(model, sink, replace(options, defaults=defaults))
 
     check_pipeline(path, sink, check)

@@ -223,7 +223,7 @@ class Runner:
 
         # The workspace root is the project of every definition: their inputs may lie in it.
         return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map),
-                                                roots=[self.plan.root]),
+                                                projects=[self.plan.root]),
                        defaults=self.plan.defaults)
 
     def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:
