@@ -45,10 +45,12 @@ HOSTILE = {
         "E0670"),
     # xacro's `${…}` holds no braces: `%c` makes them
     "format-walks-attributes": (
-        '<link name="${(\'%c0.__globals__[os].environ[DEPLOY_TOKEN]%c\' % (123, 125)).format(xacro.load_yaml)}"/>',
+        '<link name="${(\'%c0.__globals__[os].environ[DEPLOY_TOKEN]%c\' % (123, 125))'
+        '.format(xacro.load_yaml)}"/>',
         "E0670"),
     "vars-and-mro": (
-        '<link name="${[c for c in python.vars(python.type)[\'__subclasses__\'](python.type.mro(python.type)[1]) '
+        '<link name="${[c for c in python.vars(python.type)[\'__subclasses__\']'
+        '(python.type.mro(python.type)[1]) '
         'if \'Popen\' in python.repr(c)][0]([\'touch\', \'{pwned}\'])}"/>', "E0670"),
     "generator-frame": ('<link name="${(x for x in [1]).gi_frame.f_globals}"/>', "E0670"),
     "env": ('<link name="$(env DEPLOY_TOKEN)"/>', "E0671"),
@@ -131,7 +133,8 @@ def test_the_language_server_expands_under_the_same_rules(tmp_path: Path) -> Non
 
 @pytest.mark.parametrize(("expression", "why"), [
     ("().__class__", "it reads the attribute '__class__', which leads to Python's internals"),
-    ("[x for x in [1] if x.__class__]", "it reads the attribute '__class__', which leads to Python's internals"),
+    ("[x for x in [1] if x.__class__]",
+     "it reads the attribute '__class__', which leads to Python's internals"),
     ("[__import__ for _ in [1]]", "it uses the name '__import__'"),
     ("'{0}'.format(1)", "it reads the attribute 'format', which leads to Python's internals"),
     ("python.str.mro()", "it reads the attribute 'mro', which leads to Python's internals"),
@@ -167,7 +170,7 @@ def test_an_allowed_variable_is_read_and_another_is_named(tmp_path: Path) -> Non
     assert done.returncode == 0, done.stderr
     urdf = (tmp_path / "out/urdf/r.urdf").read_text()
     assert '<link name="left_base"' in urdf and '<link name="gripper"' in urdf
-    spec.write_text(spec.read_text().replace("xacro_env: [ROBOT_SIDE, ROBOT_TOOL]", "xacro_env: [ROBOT_TOOL]"))
+    spec.write_text(spec.read_text().replace("[ROBOT_SIDE, ROBOT_TOOL]", "[ROBOT_TOOL]"))
     done = mpc("check", spec, env=env)
     assert done.returncode == 1
     assert done.stderr.splitlines()[0] == (

@@ -83,7 +83,8 @@ def _project(tmp_path: Path, key: str, attack: str) -> tuple[Path, list[list[str
     if key != "mesh":
         arm(project)  # arm.urdf, for the keys that start from it
     if key == "pipeline-entry":
-        pipeline = write(project / "pipeline.yml", f"pipeline:\n  root: .\n  model_definitions: [{written}]\n")
+        pipeline = write(project / "pipeline.yml",
+                         f"pipeline:\n  root: .\n  model_definitions: [{written}]\n")
         return project, [["check", str(pipeline)]]
     return project, [["check", str(spec)], ["compile", str(spec), "-o", str(out)]]
 
@@ -99,7 +100,8 @@ def _everything_written(*folders: Path) -> str:
 
 @pytest.mark.parametrize("attack", ATTACKS)
 @pytest.mark.parametrize("key", KEYS)
-def test_a_file_outside_the_project_is_refused_without_quoting_it(tmp_path: Path, key: str, attack: str) -> None:
+def test_a_file_outside_the_project_is_refused_without_quoting_it(tmp_path: Path, key: str,
+                                                                  attack: str) -> None:
     project, commands = _project(tmp_path, key, attack)
     cache = tmp_path / "cache"
     env = {**os.environ, "MPC_CACHE_DIR": str(cache), "DEPLOY_TOKEN": ENV_CANARY}
