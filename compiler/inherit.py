@@ -66,7 +66,7 @@ def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
     """The defaults files named from `doc`, nearest first; None after an error that ends the walk."""
     seen: list[tuple[Path, str, Span | None]] = [(path.resolve(), "", None)]  # file, name, named at
     chain: list[Document] = []
-    roots = (project_root(path),)
+    roots = (project_root(path.parent),)
     current, current_path = doc, path
     while isinstance(current.data, dict) and "defaults" in current.data:
         written = current.data["defaults"]

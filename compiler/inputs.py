@@ -48,7 +48,7 @@ class InputLoader:
 
     def __post_init__(self) -> None:
         for definition in self.stack:  # inputs are read inside their definitions' projects
-            self.options.resolver.add_project(project_root(definition))
+            self.options.resolver.add_project(project_root(definition.parent))
 
     def _key(self, inp: Input) -> tuple[str, str]:
         return (inp.kind, str(inp.path) if inp.path else repr(inp.repo))

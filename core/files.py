@@ -139,11 +139,11 @@ def _input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] 
     return None
 
 
-def project_root(path: Path) -> Path:
-    """The project of the definition (or pipeline) file `path`: the git work tree holding it
-    (the nearest folder above with a `.git`, a folder or a worktree's file), else its own
-    folder; resolved. Its files are the ones a definition may read besides the packages'."""
-    folder = Path(os.path.realpath(path)).parent
+def project_root(folder: Path) -> Path:
+    """The project of a definition (or pipeline) file in `folder`: the git work tree holding
+    it (the nearest folder above with a `.git`, a folder or a worktree's file), else `folder`
+    itself; resolved. Its files are the ones a definition may read besides the packages'."""
+    folder = Path(os.path.realpath(folder))
     for candidate in (folder, *folder.parents):
         if os.path.lexists(candidate / ".git"):
             return candidate

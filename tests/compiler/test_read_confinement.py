@@ -1,7 +1,8 @@
 """One rule for every file mpc reads (issue 35, points 2 and 4; specs/files.md "What mpc reads").
 
 Every file-reading key (a definition's `defaults`, `derived_base`, the `basefile` of each
-input format, a mesh of an input URDF, a xacro include, a pipeline entry) is pointed, in a
+input format, a mesh of an input URDF, a xacro include, a pipeline entry, `submechanisms_file`,
+`test_data_file`) is pointed, in a
 project that is a real git work tree, at a secret: `/proc/self/environ` (the environment
 holds a canary), a link out of the project, an absolute path, `../` and `file://` (a file
 outside the project holding a canary). `mpc check` and `mpc compile` refuse each at its line
@@ -28,7 +29,8 @@ HEADER = re.compile(r"^(\S+):(\d+):(\d+): error\[(E\d{4})\]: ", re.M)
 # key → the suffix of the secret file it is pointed at (the reader is chosen by it)
 KEYS = {"defaults": ".yml", "derived_base": ".yml", "basefile-urdf": ".urdf", "basefile-sdf": ".sdf",
         "basefile-smurf": ".smurf", "basefile-xacro": ".urdf.xacro", "mesh": ".stl",
-        "xacro-include": ".xacro", "pipeline-entry": ".yml"}
+        "xacro-include": ".xacro", "pipeline-entry": ".yml", "submechanisms_file": ".yml",
+        "test_data_file": ".yml"}
 ATTACKS = ("proc", "link", "absolute", "dotdot", "file-uri")
 
 
@@ -68,6 +70,9 @@ def _project(tmp_path: Path, key: str, attack: str) -> tuple[Path, list[list[str
         write(spec, f"defaults: {written}\n" + _input("basefile: arm.urdf"))
     elif key == "derived_base":
         write(spec, _input(f"derived_base: {written}"))
+    elif key in ("submechanisms_file", "test_data_file"):
+        where = "  test:\n    test_data_file" if key == "test_data_file" else "  submechanisms_file"
+        write(spec, _input("basefile: arm.urdf") + f"{where}: {written}\n")
     elif key.startswith("basefile"):
         write(spec, _input(f"basefile: {written}"))
     elif key == "mesh":
@@ -124,14 +129,14 @@ def test_a_file_outside_the_project_is_refused_without_quoting_it(tmp_path: Path
 def _expected(key: str, attack: str) -> set[str]:
     """The codes a refusal may have: E0650 (the read rule); a `file://` that is no path of
     mpc's for the key (a definition's keys take paths, not URIs) names no file: E0601 (it does
-    not exist) or, in a xacro, E0620; a pipeline entry outside its root is E0641; an input
+    not exist; E0702 for a test_data_file) or, in a xacro, E0620; a pipeline entry outside its root is E0641; an input
     model that resolves to /proc/self/environ has no format mpc reads (E0202)."""
     if key == "pipeline-entry":
         return {"E0641", "E0650"} if attack != "file-uri" else {"E0601"}
     if attack == "proc" and key.startswith("basefile"):
         return {"E0202", "E0650"}
     if attack == "file-uri" and key != "mesh":
-        return {"E0620"} if key == "xacro-include" else {"E0601"}
+        return {"xacro-include": {"E0620"}, "test_data_file": {"E0702"}}.get(key, {"E0601"})
     return {"E0650"}
 
 
