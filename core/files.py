@@ -100,12 +100,24 @@ def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] |
 _refused: set[str] = set()
 
 
+def special_problem(path: str | Path) -> str | None:
+    """Why `path` (resolved here) is refused wherever it is named: it is of /proc, /sys or
+    /dev, the kernel's files, whose content is the process's secrets (its environment)."""
+    real = os.path.realpath(path)
+    return f"it is '{real}', a special file of the system" if _is_special(real) else None
+
+
+def _is_special(real: str) -> bool:
+    """Whether the resolved path `real` is of /proc, /sys or /dev."""
+    return real in _SPECIAL or real.startswith(_SPECIAL_BELOW)
+
+
 def quotable(file: str) -> bool:
     """Whether a diagnostic may show lines of `file`: a regular file, not of /proc, /sys or
     /dev, that the read rule (`input_problem`) has not refused. A diagnostic whose span lies
     in any other file shows its header line alone, so that no secret reaches a log."""
     real = os.path.realpath(file)
-    if real in _SPECIAL or real.startswith(_SPECIAL_BELOW) or real in _refused:
+    if _is_special(real) or real in _refused:
         return False
     try:
         return stat.S_ISREG(os.stat(real).st_mode)
@@ -122,7 +134,7 @@ def _input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] 
     else:
         real = _realpath(path, real_dirs)
         normal = ""
-    if real in _SPECIAL or real.startswith(_SPECIAL_BELOW):
+    if _is_special(real):
         return f"it is '{real}', a special file of the system"
     if found is None:
         try:

@@ -129,8 +129,9 @@ def test_a_file_outside_the_project_is_refused_without_quoting_it(tmp_path: Path
 def _expected(key: str, attack: str) -> set[str]:
     """The codes a refusal may have: E0650 (the read rule); a `file://` that is no path of
     mpc's for the key (a definition's keys take paths, not URIs) names no file: E0601 (it does
-    not exist; E0702 for a test_data_file) or, in a xacro, E0620; a pipeline entry outside its root is E0641; an input
-    model that resolves to /proc/self/environ has no format mpc reads (E0202)."""
+    not exist; E0702 for a test_data_file) or, in a xacro, E0620; a pipeline entry outside its
+    root is E0641; an input model that resolves to /proc/self/environ has no format mpc reads
+    (E0202)."""
     if key == "pipeline-entry":
         return {"E0641", "E0650"} if attack != "file-uri" else {"E0601"}
     if attack == "proc" and key.startswith("basefile"):
@@ -168,6 +169,18 @@ def test_inside_a_git_work_tree_the_whole_tree_is_the_project(tmp_path: Path) ->
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == \
         (tmp_path / "models/meshes/tetra.stl").read_bytes()
+
+
+@pytest.mark.parametrize("command", ["check", "compile"])
+def test_a_definition_linked_to_proc_is_not_read(tmp_path: Path, command: str) -> None:
+    link = tmp_path / "robot.yml"
+    link.symlink_to("/proc/self/environ")
+    out = ["-o", str(tmp_path / "out")] if command == "compile" else []
+    done = mpc(command, link, *out, env={**os.environ, "DEPLOY_TOKEN": ENV_CANARY})
+    assert done.returncode == 1
+    assert re.fullmatch(rf"{link}:1:1: error\[E0650\]: '{link}' is not read: it is '/proc/\d+/environ', a "
+                        "special file of the system", done.stderr.splitlines()[0])
+    assert ENV_CANARY not in done.stdout + done.stderr and not (tmp_path / "out").exists()
 
 
 def test_a_diagnostic_never_quotes_a_line_of_proc(tmp_path: Path) -> None:
