@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from mpc.compiler import inherit
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
-from mpc.core.files import input_problem
+from mpc.core.files import input_problem, project_root
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document
 from mpc.pipeline import dag, verdicts
@@ -131,30 +131,29 @@ _WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "E0650", "W0610")
 
 
 def check_pipeline(path: Path, sink: Sink,
-                   check_definition: Callable[[Path, PipelineDefaults, Path], None]) -> None:
+                   check_definition: Callable[[Path, PipelineDefaults], None]) -> None:
     """`mpc check pipeline.yml`: the file itself, what only the whole pipeline shows (clashing
     modelnames, names that cannot be folders, definitions that are missing, listed twice or
     outside the root, derived_base parents outside the pipeline), and each definition that
-    can be read, through `check_definition` with the pipeline's defaults and workspace root."""
+    can be read, through `check_definition` with the pipeline's defaults."""
     plan = load_plan(path, sink)
     for model in plan.models.values() if plan else ():
         for d in model.diagnostics:
             if d.code in _WHOLE_PIPELINE:
                 sink.report(d)
         if not any(d.code in ("E0601", "E0641", "E0650") for d in model.diagnostics):
-            check_definition(model.definition, plan.defaults, plan.root)  # type: ignore[union-attr]
+            check_definition(model.definition, plan.defaults)  # type: ignore[union-attr]
 
 
 def check_pipeline_file(path: Path, sink: Sink, options: Options) -> None:
     """`mpc check pipeline.yml` with the driver: each definition under the pipeline's defaults."""
     from mpc.compiler import front_end
 
-    def check(model: Path, defaults: PipelineDefaults, root: Path) -> None:
-        # The workspace root is the project of every definition (as `mpc run` reads them).
-        options.resolver.add_project(root)
-        front_end.check_file(model, sink, replace(options, defaults=defaults))
-
-    check_pipeline(path, sink, check)
+    # The pipeline's project (its git work tree, else its folder) is every definition's too,
+    # as `mpc run` reads them.
+    options.resolver.add_project(project_root(path.parent))
+    check_pipeline(path, sink, lambda model, defaults: front_end.check_file(
+        model, sink, replace(options, defaults=defaults)))
 
 
 def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span: Span,
