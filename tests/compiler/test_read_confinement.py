@@ -196,3 +196,19 @@ def test_a_diagnostic_never_quotes_a_line_of_proc(tmp_path: Path) -> None:
     finally:
         del os.environ["MPC_TEST_SECRET"]
     assert text == "/proc/self/environ:1:1: error[E0203]: m"
+
+
+def test_a_pipeline_s_folder_is_the_project_of_its_definitions(tmp_path: Path) -> None:
+    """Without git, `mpc check pipeline.yml` reads a definition's input beside its folder, in
+    the pipeline's folder; alone, the definition may not."""
+    arm(tmp_path / "models")
+    spec = write(tmp_path / "definitions/arm.yml", _input("basefile: ../models/arm.urdf"))
+    pipeline = write(tmp_path / "pipeline.yml", "pipeline:\n  root: .\n  model_definitions: "
+                     "[definitions/arm.yml]\n")
+    done = mpc("check", pipeline)
+    assert done.returncode == 0, done.stderr
+    done = mpc("check", spec)
+    assert done.returncode == 1
+    assert done.stderr.splitlines()[0] == (
+        f"{spec}:6:17: error[E0650]: input model '{tmp_path / 'models/arm.urdf'}' is not read: it is "
+        f"'{tmp_path / 'models/arm.urdf'}', outside the project and the model's package roots")
