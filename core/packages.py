@@ -60,8 +60,8 @@ class PackageResolver:
 
     package_map: dict[str, Path] = field(default_factory=dict)
     search_path: list[Path] | None = None
-    # Folders, besides the packages, whose files inputs may link to: the definitions' own
-    # folders and the checkouts of `repo` inputs (compiler/inputs.py adds them).
+    # Folders, besides the packages, whose files inputs may be: the checkouts of `repo` inputs
+    # (compiler/inputs.py adds them) and the workspaces of sourced ROS 2 prefixes.
     roots: list[Path] = field(default_factory=list)
     # The projects of the definitions being compiled (core/files.py: project_root), whose files
     # inputs may be; none when a model file is read on its own (a build's output, a model
