@@ -199,3 +199,21 @@ def test_a_real_xacro_expands_as_the_xacro_command_expands_it(tmp_path: Path) ->
     assert [d.code for d in sink.diagnostics] == ["W0623"]  # "redefining global symbol: pi", as xacro says
     assert ours is not None and "<mass value=\"1.477\"/>" in ours
     assert ours.splitlines() == [line for line in command.splitlines() if line not in banner]
+
+
+@pytest.mark.parametrize("name", ["env", "comprehension-globals", "include-outside"])
+def test_mpc_run_keeps_no_secret_in_its_state_or_log(tmp_path: Path, name: str) -> None:
+    """`mpc run` of a pipeline whose model is hostile: the model fails with the refusal, the
+    payload does not run, and no secret is in its log, its state files or the build."""
+    spec, _, pwned = _hostile(tmp_path, name)
+    pipeline = write(spec.parent / "pipeline.yml", "pipeline:\n  root: .\n  model_definitions: [robot.yml]\n")
+    cache = tmp_path / "cache"
+    done = mpc("run", pipeline, cwd=spec.parent,
+               env={**os.environ, "DEPLOY_TOKEN": ENV_CANARY, "MPC_CACHE_DIR": str(cache)})
+    said = done.stdout + done.stderr
+    assert done.returncode == 1, said
+    assert f"error[{HOSTILE[name][1]}]" in said
+    assert not pwned.exists()
+    for canary in (ENV_CANARY, FILE_CANARY):
+        assert canary not in said
+        assert canary not in _written(spec.parent, cache)
