@@ -102,6 +102,10 @@ class _Reader:
             self.sink.error(self.smurf.value_span(where), "E0601", f"'{name}', listed in the SMURF, "
                             "does not exist")
             return None
+        if why := self.resolver.refusal(self.path.parent / name, self.path.parent):
+            self.sink.error(self.smurf.value_span(where), "E0650", f"'{name}', listed in the SMURF, "
+                            f"is not read: {why}")
+            return None
         return path
 
     def model(self, name: str, where: tuple[str | int, ...]) -> Robot | None:

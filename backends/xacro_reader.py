@@ -33,30 +33,36 @@ _LOCK = threading.Lock()
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
-         args: tuple[tuple[str, str], ...] = (), origin: Span | None = None) -> Robot | None:
-    """Expand the xacro at `path` with `args` and read the URDF; None after reporting why."""
+         args: tuple[tuple[str, str], ...] = (), origin: Span | None = None,
+         environment: tuple[str, ...] = ()) -> Robot | None:
+    """Expand the xacro at `path` with `args` and read the URDF; None after reporting why.
+    environment: the variables `$(env)` and `$(optenv)` may read (the input's `xacro_env`)."""
     from mpc.backends.urdf_reader import read_text
 
     resolver = resolver or PackageResolver()
-    text = expand(path, sink, resolver, args, origin)
+    text = expand(path, sink, resolver, args, origin, environment)
     if text is None:
         return None
     return read_text(text.encode(), f"{path} (expanded by xacro)", path.parent.resolve(), sink, resolver)
 
 
 def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[str, str], ...] = (),
-           origin: Span | None = None) -> str | None:
-    """The URDF text the xacro command would print for `path` and `args`; None after an error."""
+           origin: Span | None = None, environment: tuple[str, ...] = ()) -> str | None:
+    """The URDF text the xacro command would print for `path` and `args`; None after an error.
+    It expands under backends/xacro_guard.py's rules: a refused expression, variable or file
+    is an error at its line in the xacro file."""
     import xml.parsers.expat
 
     import xacro
+
+    from mpc.backends.xacro_guard import guarded, refusal_of
 
     if not path.is_file():
         sink.error(origin or Span.of_file(str(path)), "E0601", f"xacro file '{path}' does not exist")
         return None
     said = io.StringIO()
-    with _LOCK, _resolving(resolver, path.parent), contextlib.redirect_stderr(said), \
-            contextlib.redirect_stdout(said):
+    with _LOCK, _resolving(resolver, path.parent), guarded(resolver, path.parent.resolve(), environment), \
+            contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
         try:
             doc = xacro.process_file(str(path.resolve()), mappings=dict(args))
             _drop_banner(doc)
@@ -68,6 +74,10 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
             return None
         except Exception as e:
             where = _current_file(path)
+            if (refused := refusal_of(e)) is not None:
+                sink.error(_locate(where, refused.needle) or origin or Span.of_file(where), refused.code,
+                           f"xacro, expanding '{where}': {refused.message}")
+                return None
             macros = [f"'{m.body.getAttribute('name')}' of {Path(m.history[-1][-1]).name}"
                       for m in (getattr(xacro, "macrostack", None) or []) if m.history and m.history[-1]]
             inside = f" (in macro {', '.join(macros)})" if macros else ""
@@ -90,6 +100,21 @@ def _drop_banner(doc: Any) -> None:
         if first is None or first.nodeType != first.COMMENT_NODE:
             return
         doc.removeChild(first)
+
+
+def _locate(file: str, needle: str) -> Span | None:
+    """Where `needle` is first written in the xacro `file` (which the read rule allowed:
+    xacro was expanding it), or None."""
+    try:
+        text = Path(file).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    at = text.find(needle)
+    if at < 0 or not needle:
+        return None
+    line = text.count("\n", 0, at) + 1
+    col = at - (text.rfind("\n", 0, at) + 1) + 1
+    return Span(file, line, col, line, col + len(needle.split("\n")[0]))
 
 
 def _current_file(path: Path) -> str:

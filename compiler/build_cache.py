@@ -121,6 +121,7 @@ class KeptBuild:
             where, source_version(), sys.version, sys.prefix, _distributions(),
             sorted((k, str(v)) for k, v in resolver.package_map.items()),
             [str(p) for p in resolver.search_path or ()], [str(p) for p in resolver.roots],
+            [str(p) for p in resolver.projects],
             sorted((k, v) for k, v in user_environment().items() if k not in _SESSION),
             *([] if options.post_processing else ["no post_processing"]),
         ])

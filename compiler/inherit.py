@@ -33,6 +33,7 @@ from typing import Any
 
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.files import input_problem, project_root
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document, Path_
 
@@ -65,6 +66,7 @@ def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
     """The defaults files named from `doc`, nearest first; None after an error that ends the walk."""
     seen: list[tuple[Path, str, Span | None]] = [(path.resolve(), "", None)]  # file, name, named at
     chain: list[Document] = []
+    roots = (project_root(path.parent),)
     current, current_path = doc, path
     while isinstance(current.data, dict) and "defaults" in current.data:
         written = current.data["defaults"]
@@ -83,6 +85,11 @@ def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
         if not target.exists():
             sink.error(at, "E0601", f"defaults file '{written}' does not exist",
                        hint=f"the path is relative to the folder of '{current.file}'")
+            return None
+        if why := input_problem(target, roots):
+            sink.error(at, "E0650", f"defaults file '{written}' is not read: {why}",
+                       hint="a defaults file lies inside the definition's project (its git work "
+                       "tree, else its folder)")
             return None
         display = os.path.normpath(os.path.join(os.path.dirname(current.file), written))
         loaded = source.load(target, sink, display=display, origin=at)

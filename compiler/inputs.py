@@ -13,6 +13,7 @@ from pathlib import Path
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.files import project_root
 from mpc.core.span import Span
 from mpc.ir.geometry import Mesh
 from mpc.ir.names import Names
@@ -46,8 +47,8 @@ class InputLoader:
     missing_meshes: list[Diagnostic] = field(default_factory=list)  # symbolic: E0602, reported last
 
     def __post_init__(self) -> None:
-        for definition in self.stack:  # inputs may link to files beside their definitions
-            self.options.resolver.add_root(definition.parent)
+        for definition in self.stack:  # inputs are read inside their definitions' projects
+            self.options.resolver.add_project(project_root(definition.parent))
 
     def _key(self, inp: Input) -> tuple[str, str]:
         return (inp.kind, str(inp.path) if inp.path else repr(inp.repo))
@@ -77,7 +78,7 @@ class InputLoader:
             return self._read(inp.path, inp)
         if inp.kind == "derived_base":
             assert inp.path is not None
-            if self._cycle(inp):
+            if self._cycle(inp) or self._refused(inp.path, inp):
                 return None
             assert self.build is not None, "derived_base inputs need driver.input_loader's loader"
             return self.build(inp.path, self.sink, self.options, (*self.stack, inp.path))
@@ -86,13 +87,22 @@ class InputLoader:
 
     def _read(self, path: Path, inp: Input) -> Robot | None:
         """A model file, by its extension: URDF, SDF, SMURF, or a xacro (expanded with its args)."""
-        if why := self.options.resolver.refusal(path):
-            self.sink.error(inp.span, "E0650", f"input model '{path}' is not read: {why}")
+        if self._refused(path, inp):
             return None
         if self.options.models is not None:
-            return self.options.models.read(path, inp.xacro_args, self.sink,
+            expanded_with = (*inp.xacro_args, *(("$(env)", name) for name in inp.xacro_env))
+            return self.options.models.read(path, expanded_with, self.sink,
                                             lambda sink: self._parse(path, inp, sink))
         return self._parse(path, inp, self.sink)
+
+    def _refused(self, path: Path, inp: Input) -> bool:
+        """Whether the input's file lies outside the project and the package roots, or is a
+        special file (core/files.py: input_problem), after reporting it at the key naming it."""
+        if why := self.options.resolver.refusal(path):
+            key = "derived_base" if inp.kind == "derived_base" else "input model"
+            self.sink.error(inp.span, "E0650", f"{key} '{path}' is not read: {why}")
+            return True
+        return False
 
     def _parse(self, path: Path, inp: Input, sink: Sink) -> Robot | None:
         from mpc.backends import BACKENDS
@@ -101,7 +111,8 @@ class InputLoader:
         if suffix == ".xacro":
             from mpc.backends import xacro_reader
 
-            return xacro_reader.read(path, sink, self.options.resolver, inp.xacro_args, inp.span)
+            return xacro_reader.read(path, sink, self.options.resolver, inp.xacro_args, inp.span,
+                                     inp.xacro_env)
         reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
         return reader.read(path, sink, self.options.resolver)
 
@@ -150,7 +161,7 @@ class InputLoader:
     def _load_names(self, inp: Input) -> Names | None:
         if inp.kind == "derived_base" and self.symbolic:
             assert inp.path is not None
-            if self._cycle(inp):
+            if self._cycle(inp) or self._refused(inp.path, inp):
                 return None
             assert self.names_of is not None, "derived_base inputs need driver.input_loader's loader"
             return self.names_of(inp.path, self.sink, self.options, (*self.stack, inp.path))

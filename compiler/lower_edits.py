@@ -20,6 +20,7 @@ from mpc.compiler.lower_context import LowerContext, items_span, pair_span
 from mpc.compiler.schema.annotations import MULTI_LINK_SENSORS, SINGLE_LINK_SENSORS, sensor_entries
 from mpc.compiler.schema.base import Node
 from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
+from mpc.core.files import input_problem, project_root
 from mpc.ir import ops
 from mpc.ir.ops import Op
 
@@ -399,10 +400,15 @@ def submechanisms(ctx: LowerContext) -> list[Op]:
             ctx.sink.error(m.key_span("submechanisms_file"), "E0315", "give either "
                            "'submechanisms_file' or 'submechanisms'/'exoskeletons', not both")
             return []
-        path = (ctx.folder_of(m, "submechanisms_file") / m.submechanisms_file).resolve()
+        folder = ctx.folder_of(m, "submechanisms_file")
+        path = (folder / m.submechanisms_file).resolve()
         if not path.is_file():
             ctx.sink.error(m.value_span("submechanisms_file"), "E0601",
                            f"submechanisms_file '{path}' does not exist")
+        elif why := input_problem(folder / m.submechanisms_file, (project_root(folder),)):
+            ctx.sink.error(m.value_span("submechanisms_file"), "E0650",
+                           f"submechanisms_file '{m.submechanisms_file}' is not read: {why}")
+            return []
         out.append(ops.SubmechanismsFile(span=m.value_span("submechanisms_file"), path=str(path)))
     for exo, items in ((False, m.submechanisms or []), (True, m.exoskeletons or [])):
         for s in items:

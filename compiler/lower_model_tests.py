@@ -104,7 +104,11 @@ class _TestLowering:
             return None
         span = self.span("test_data_file") if written else self.section.span
         from mpc.core import yaml_source as source
+        from mpc.core.files import input_problem, project_root
 
+        if path.is_file() and (why := input_problem(path, (project_root(self.base_dir),))):
+            self.sink.error(span, "E0650", f"test_data_file '{written or path.name}' is not read: {why}")
+            return None
         doc = source.load(path, self.sink) if path.is_file() else None
         if doc is None:
             if not path.is_file():

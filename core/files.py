@@ -1,9 +1,9 @@
 """Paths and bytes on disk → confined output paths, checked inputs, atomic writes.
 
 The one place that decides where mpc may write (`confined`: under the output root, never
-through a link out of it), what it may read (`input_problem`: regular files, links only
-within the package roots, nothing of /proc, /sys or /dev), how it writes a file
-(`write_atomic`: all or nothing) and how an OSError reads to a user (`describe`). It
+through a link out of it), what it may read (`input_problem`: regular files inside the
+project and the package roots, however named, nothing of /proc, /sys or /dev), how it writes
+a file (`write_atomic`: all or nothing) and how an OSError reads to a user (`describe`). It
 imports nothing of mpc (the ground floor); it reports nothing itself.
 """
 
@@ -92,22 +92,65 @@ def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
 
 def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] | None = None,
                   found: tuple[str, int] | None = None) -> str | None:
-    """Why the input file `path` must not be read, or None.
+    """Why the input file `path` must not be read, or None: the one rule of every file mpc
+    reads (a definition's `defaults`, a `derived_base`, a pipeline entry, an input model, a
+    mesh, a texture, a xacro include; specs/files.md).
 
-    A link (or a linked folder on the way) must resolve inside one of `roots`: a mesh that
-    links to /proc/self/environ or ~/.ssh would otherwise be copied into the build and
-    deployed. Whatever the path, devices, FIFOs, sockets and the kernel's /proc, /sys and
-    /dev are refused. real_dirs: folders resolved before, kept by the caller for the files
-    of one build (the meshes of a model share a few folders). found: what `plain_stat` found
-    for `path`, which saves looking again.
+    The file, once links are followed, must lie inside one of `roots` (the project and the
+    package roots: `project_root`, core/packages.py), however it is named (a link, an
+    absolute path, `../`, `file://`): a mesh at /proc/self/environ or ~/.ssh would otherwise
+    be copied into the build and deployed, a `defaults:` file quoted in the log. Whatever the
+    roots, devices, FIFOs, sockets and the kernel's /proc, /sys and /dev are refused.
+
+    real_dirs: folders resolved before, kept by the caller for the files of one build (the
+    meshes of a model share a few folders). found: what `plain_stat` found for `path`, which
+    saves looking again.
     """
+    why = _input_problem(path, roots, real_dirs, found)
+    if why is not None:
+        _refused.add(os.path.realpath(path))
+    return why
+
+
+# The files `input_problem` refused, resolved: no diagnostic quotes a line of them (`quotable`).
+_refused: set[str] = set()
+
+
+def special_problem(path: str | Path) -> str | None:
+    """Why `path` (resolved here) is refused wherever it is named: it is of /proc, /sys or
+    /dev, the kernel's files, whose content is the process's secrets (its environment)."""
+    real = os.path.realpath(path)
+    return f"it is '{real}', a special file of the system" if _is_special(real) else None
+
+
+def _is_special(real: str) -> bool:
+    """Whether the resolved path `real` is of /proc, /sys or /dev."""
+    return real in _SPECIAL or real.startswith(_SPECIAL_BELOW)
+
+
+def quotable(file: str) -> bool:
+    """Whether a diagnostic may show lines of `file`: a regular file, not of /proc, /sys or
+    /dev, that the read rule (`input_problem`) has not refused. A diagnostic whose span lies
+    in any other file shows its header line alone, so that no secret reaches a log."""
+    real = os.path.realpath(file)
+    if _is_special(real) or real in _refused:
+        return False
+    try:
+        return stat.S_ISREG(os.stat(real).st_mode)
+    except OSError:
+        return False
+
+
+def _input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] | None = None,
+                   found: tuple[str, int] | None = None) -> str | None:
+    """The rule of `input_problem` (which notes what this refuses, for `quotable`)."""
     if found is not None:
         real, mode = found
         normal = str(path)  # plain: already absolute and normal
     else:
         real = _realpath(path, real_dirs)
         normal = ""
-    if real in _SPECIAL or real.startswith(_SPECIAL_BELOW):
+    if _is_special(real):
         return f"it is '{real}', a special file of the system"
     if found is None:
         try:
@@ -117,10 +160,22 @@ def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] |
         normal = os.path.normpath(os.path.abspath(path))
     if not stat.S_ISREG(mode):
         return "it is not a regular file (a device, FIFO, socket or folder)"
-    link = real != normal  # a link on the way
-    if link and not any(_within(real, str(r)) for r in roots):
-        return f"it is a link to '{real}', outside the model's package roots"
+    if not any(_within(real, str(r)) for r in roots):
+        if real != normal:  # a link on the way
+            return f"it is a link to '{real}', outside the model's package roots"
+        return f"it is '{real}', outside the project and the model's package roots"
     return None
+
+
+def project_root(folder: Path) -> Path:
+    """The project of a definition (or pipeline) file in `folder`: the git work tree holding
+    it (the nearest folder above with a `.git`, a folder or a worktree's file), else `folder`
+    itself; resolved. Its files are the ones a definition may read besides the packages'."""
+    folder = Path(os.path.realpath(folder))
+    for candidate in (folder, *folder.parents):
+        if os.path.lexists(candidate / ".git"):
+            return candidate
+    return folder
 
 
 def plain_stat(path: Path, real_dirs: dict[str, str]) -> tuple[str, int] | bool:

@@ -159,15 +159,24 @@ def _path_list(variable: str) -> list[str]:
     return [p for p in os.environ.get(variable, "").split(os.pathsep) if p]
 
 
+# The folders of a model's files in the layout mpc and Phobos write (`urdf/robot.urdf`,
+# `meshes/stl/…`): a file in one may name the files of the folder above (PackageResolver.refusal).
+MODEL_FOLDERS = frozenset({"urdf", "sdf", "smurf"})
+
+
 @dataclass
 class PackageResolver:
     """Finds the folder of a ROS package by name (see the module docstring)."""
 
     package_map: dict[str, Path] = field(default_factory=dict)
     search_path: list[Path] | None = None
-    # Folders, besides the packages, whose files inputs may link to: the definitions' own
-    # folders and the checkouts of `repo` inputs (compiler/inputs.py adds them).
+    # Folders, besides the packages, whose files inputs may be: the checkouts of `repo` inputs
+    # (compiler/inputs.py adds them) and the workspaces of sourced ROS 2 prefixes.
     roots: list[Path] = field(default_factory=list)
+    # The projects of the definitions being compiled (core/files.py: project_root), whose files
+    # inputs may be; none when a model file is read on its own (a build's output, a model
+    # named on the command line).
+    projects: list[Path] = field(default_factory=list)
     _cache: dict[str, Path | None] = field(default_factory=dict)
     _real_roots: dict[tuple[Path, ...], tuple[Path, ...]] = field(default_factory=dict)
     _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
@@ -237,11 +246,20 @@ class PackageResolver:
         if folder not in self.roots:
             self.roots.append(folder)
 
+    def add_project(self, folder: Path) -> None:
+        if folder not in self.projects:
+            self.projects.append(folder)
+
     def refusal(self, path: Path, base_dir: Path | None = None) -> str | None:
-        """Why the input file `path` (a mesh, a model) must not be read, or None: a link out
-        of the package roots (and `base_dir`, the folder of the file naming it), a special
-        file (core/files.py: input_problem). A missing file is no refusal: whoever reads
-        it reports that."""
+        """Why the input file `path` (a mesh, a model) must not be read, or None: a file
+        outside the projects, the package roots and `base_dir` (the folder of the file naming
+        it), a special file (core/files.py: input_problem). A missing file is no refusal:
+        whoever reads it reports that.
+
+        A model file read on its own (no project: a build's output, a model named on the
+        command line) may also name the files of its model folder: the folder above
+        `base_dir` when that is one of the format folders mpc and Phobos write side by side
+        (`urdf/`, `sdf/`, `smurf/` beside `meshes/`)."""
         from mpc.core.files import input_problem, plain_stat
 
         found = plain_stat(path, self._real_dirs)
@@ -260,8 +278,9 @@ class PackageResolver:
         # environment named it, as `--package` names one. (Not one found above the model: a
         # model may name any folder above it.)
         found = (f for f in self._cache.values() if f is not None)
-        folders = (*self.package_map.values(), *self.search_path, *found, *self.roots,
-                   *([base_dir] if base_dir else []))
+        own = (base_dir, base_dir.parent) if base_dir and not self.projects and base_dir.name in \
+            MODEL_FOLDERS else (base_dir,) if base_dir else ()
+        folders = (*self.package_map.values(), *self.search_path, *found, *self.roots, *self.projects, *own)
         if folders not in self._real_roots:
             self._real_roots[folders] = package_roots(folders)
         yield from self._real_roots[folders]

@@ -13,6 +13,7 @@ from operator import attrgetter
 from pathlib import Path
 from typing import Any
 
+from mpc.core.files import quotable
 from mpc.core.record import record
 
 
@@ -119,6 +120,8 @@ def source_line(file: str, line: int) -> str | None:
 
     Files are read once per (modification time, size), so an edited file is read again.
     """
+    if not quotable(file):  # the read rule's (core/files.py): no line of /proc/self/environ
+        return None
     try:
         stat = os.stat(file)
         lines = _source_lines(file, (stat.st_mtime_ns, stat.st_size))

@@ -25,6 +25,7 @@ import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mpc.core.diagnostics import Sink
+from mpc.core.files import special_problem
 from mpc.core.span import Span
 
 Path_ = tuple[str | int, ...]
@@ -279,6 +280,9 @@ def load(path: Path, sink: Sink, display: str | None = None, origin: Span | None
             loaded.add(absolute)
         if absolute in _overlay:
             return loads(_overlay[absolute], file, sink)
+    if why := special_problem(path):  # a definition named on the command line, too
+        sink.error(origin or Span.of_file(file), "E0650", f"'{file}' is not read: {why}")
+        return None
     try:
         text = _read(path, LIMITS)
     except _NotAFile:

@@ -41,6 +41,7 @@ class Input:
     smurf_data: whether the input keeps its SMURF data (motors, sensors, poses, annotations…);
         False for a derived_base under `inherit_smurf_properties: false` (ir/smurf_data.py).
     xacro_args: (name, value) of each argument a xacro model file is expanded with.
+    xacro_env: the environment variables its xacro may read with `$(env)` and `$(optenv)`.
     span: the YAML value that names the source.
     """
 
@@ -52,6 +53,7 @@ class Input:
     is_human: bool = False
     smurf_data: bool = True
     xacro_args: tuple[tuple[str, str], ...] = ()
+    xacro_env: tuple[str, ...] = ()
 
 
 class ExportEntry:

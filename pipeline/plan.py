@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from mpc.compiler import inherit
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.files import input_problem, project_root
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document
 from mpc.pipeline import dag, verdicts
@@ -144,7 +145,7 @@ def _root_allowed(root: Path, folder: Path) -> bool:
 
 # What `mpc check pipeline.yml` reports of planning; checking each definition reports the
 # rest (its own errors, cycles as E0308).
-_WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "W0610")
+_WHOLE_PIPELINE = ("E0601", "E0610", "E0612", "E0641", "E0650", "W0610")
 
 
 def check_pipeline(path: Path, sink: Sink,
@@ -158,7 +159,7 @@ def check_pipeline(path: Path, sink: Sink,
         for d in model.diagnostics:
             if d.code in _WHOLE_PIPELINE:
                 sink.report(d)
-        if not any(d.code in ("E0601", "E0641") for d in model.diagnostics):
+        if not any(d.code in ("E0601", "E0641", "E0650") for d in model.diagnostics):
             check_definition(model.definition, plan.defaults)  # type: ignore[union-attr]
 
 
@@ -166,6 +167,9 @@ def check_pipeline_file(path: Path, sink: Sink, options: Options) -> None:
     """`mpc check pipeline.yml` with the driver: each definition under the pipeline's defaults."""
     from mpc.compiler import front_end
 
+    # The pipeline's project (its git work tree, else its folder) is every definition's too,
+    # as `mpc run` reads them.
+    options.resolver.add_project(project_root(path.parent))
     check_pipeline(path, sink, lambda model, defaults: front_end.check_file(
         model, sink, replace(options, defaults=defaults)))
 
@@ -186,6 +190,8 @@ def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span
                 sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
             elif not definition.is_file():
                 sink.error(span, "E0601", f"model definition '{written}' does not exist")
+            elif why := input_problem(definition, (root,)):
+                sink.error(span, "E0650", f"model definition '{written}' is not read: {why}")
         except OSError as e:  # a name too long, a loop of links
             sink.error(span, "E0601", f"model definition '{written}' cannot be read: {e.strerror}")
     if sink.diagnostics:

@@ -225,9 +225,12 @@ class Runner:
         """Compile options of every worker (made when the first one starts: a run where all
         is cached never imports the compiler)."""
         from mpc.compiler.driver import Options
+        from mpc.core.files import project_root
         from mpc.core.packages import PackageResolver
 
-        return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map)),
+        # The pipeline's project (its git work tree, else its folder) is every definition's too.
+        return Options(resolver=PackageResolver(package_map=dict(self.opts.package_map),
+                                                projects=[project_root(self.plan.file.parent)]),
                        defaults=self.plan.defaults, post_processing=self.opts.post_processing)
 
     def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:

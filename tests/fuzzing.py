@@ -3,10 +3,11 @@ outside `-o` (and mpc's cache). Shared by the bounded Hypothesis suite (tests/te
 and the long run (bench/fuzz.py); neither decides how many cases to try, this module does
 not either.
 
-A case is a seed input (a definition, a pipeline file, a URDF, an SDF or a SMURF file that
-mpc reads well) and a list of edits; each edit puts a hostile token (`../`, an absolute
-path, a NUL, an alias loop, a 300-character name, an entity, a link to /proc…) at a place
-in the text, deletes, repeats or cuts it.
+A case is a seed input (a definition, a pipeline file, a URDF, an SDF, a SMURF or a xacro
+file that mpc reads well) and a list of edits; each edit puts a hostile token (`../`, an
+absolute path, a NUL, an alias loop, a 300-character name, an entity, a link to /proc, a
+xacro expression that reaches for Python or the environment…) at a place in the text,
+deletes, repeats or cuts it. A secret in the environment must reach no message and no output.
 """
 
 from __future__ import annotations
@@ -22,9 +23,10 @@ from pathlib import Path
 from tests.conftest import definition
 from tests.fixtures import arm
 
-KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf")
+KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf", "xacro")
 ESCAPE = "MPCFUZZESCAPE"  # any file with this name outside the case folder is an escape
 ABSOLUTE = f"/tmp/{ESCAPE}"
+SECRET = "MPCFUZZ_SECRET_4e1b"  # the value of MPC_FUZZ_SECRET while a case runs
 
 # Tokens an edit may write; chosen to hit each class of issue 17 and the parsers' limits.
 TOKENS = (
@@ -37,6 +39,13 @@ TOKENS = (
     '<!DOCTYPE r [<!ENTITY e "x">]>', "&e;", '<!ENTITY % p SYSTEM "http://127.0.0.1:9/x">',
     "<![CDATA[", "]]>", "<", ">", "&", "</robot>", "<gazebo>", 'name=""', 'xmlns:x="u"',
     "-1", "0", "1e308", "nan", "-0", "3.4.5",
+    # issue 35: a xacro that runs code, reads the environment or a system file
+    "${().__class__.__base__.__subclasses__()}",
+    "${[c for c in ().__class__.__base__.__subclasses__() if c.__name__ == 'Popen'][0]"
+    f"(['touch', '{ABSOLUTE}'])}}",
+    f"${{[f.__globals__['os'].system('touch {ABSOLUTE}') for f in [xacro.load_yaml]]}}",
+    "$(env MPC_FUZZ_SECRET)", "$(optenv MPC_FUZZ_SECRET)", "${xacro.load_yaml('/proc/self/environ')}",
+    '<xacro:include filename="/etc/passwd"/>', '<xacro:include filename="/proc/self/environ"/>',
 )
 
 
@@ -115,6 +124,13 @@ class Seeds:
             assert main(["compile", str(folder / "model.yml"), "-o", str(folder / "built")]) == 0
         files = {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
         files["pipeline.yml"] = b"pipeline:\n  root: .\n  model_definitions: [model.yml]\n"
+        files["arm.urdf.xacro"] = files["arm.urdf"].replace(
+            b'<robot name="arm">', b'<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+            b'  <xacro:property name="m" value="2"/>\n  <xacro:include filename="parts.xacro"/>', 1
+        ).replace(b'<mass value="2"/>', b'<mass value="${m}"/>', 1)
+        files["parts.xacro"] = (b'<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+                                b'  <xacro:property name="half" value="${0.5}"/>\n</robot>\n')
+        files["xacro.yml"] = definition("arm.urdf.xacro").encode()
         for kind, basefile in (("sdf", "built/sdf/robot.sdf"), ("smurf", "built/smurf/robot.smurf")):
             files[f"{kind}.yml"] = (definition(basefile) + ROUTES).encode()
         shutil.rmtree(folder)
@@ -124,7 +140,8 @@ class Seeds:
         """The file a case of `kind` mutates, and the definition or pipeline file mpc runs."""
         return {"definition": ("model.yml", "model.yml"), "pipeline": ("pipeline.yml", "pipeline.yml"),
                 "urdf": ("arm.urdf", "model.yml"), "sdf": ("built/sdf/robot.sdf", "sdf.yml"),
-                "smurf": ("built/smurf/robot.smurf", "smurf.yml")}[kind]
+                "smurf": ("built/smurf/robot.smurf", "smurf.yml"),
+                "xacro": ("arm.urdf.xacro", "xacro.yml")}[kind]
 
 
 _COUNTER = itertools.count()
@@ -152,9 +169,14 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
         args = args[:2]
     err = io.StringIO()
     os.environ["MPC_CACHE_DIR"] = str(case / "cache")
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        status = main(args)
+    os.environ["MPC_FUZZ_SECRET"] = SECRET
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            status = main(args)
+    finally:
+        del os.environ["MPC_FUZZ_SECRET"]
     text = err.getvalue()
+    assert SECRET not in text and "root:x:0:0" not in text, f"a secret in the messages: {kind} {edits}"
     assert status in (0, 1), f"exit {status} for {kind} {edits}:\n{text[-3000:]}"
     assert "Traceback" not in text and "internal error" not in text, text[-3000:]
     new = {p for p in case.rglob("*")} - before
@@ -168,7 +190,8 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
         for p in (case / "out").rglob("*"):
             assert not p.is_symlink(), f"a link in the output: {p}"
             if p.is_file():
-                assert b"ghp_" not in p.read_bytes() and b"PATH=" not in p.read_bytes(), p
+                data = p.read_bytes()
+                assert b"ghp_" not in data and b"PATH=" not in data and SECRET.encode() not in data, p
     shutil.rmtree(case, ignore_errors=True)
     return status
 

@@ -36,3 +36,23 @@ def test_mutated_inputs_exit_0_or_1_and_write_only_into_the_output(
         run_case(seeds, base, kind, edits, command)
 
     one()
+
+
+XACRO_PAYLOADS = [i for i, token in enumerate(TOKENS) if token.startswith(("${", "$(", "<xacro:"))]
+
+
+@pytest.mark.parametrize("token", XACRO_PAYLOADS, ids=lambda i: TOKENS[i][:40])
+def test_each_xacro_payload_is_refused_wherever_it_is_written(
+        seeds: Seeds, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, token: int) -> None:
+    """Issue 35: each xacro payload of TOKENS, as a link's name, as an include's filename and
+    as an element of its own, fails the check and the build (exit 1) with the invariants of
+    run_case: no code ran (no escape file), no secret in a message or an output."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    base = tmp_path / "a/b/cases"
+    base.mkdir(parents=True)
+    text = seeds.files["arm.urdf.xacro"].decode()
+    places = (('<link name="base"', "value"), ("<xacro:include", "value"), ("  <xacro:include", "insert"))
+    for anchor, op in places:
+        edit = Edit(op, text.index(anchor) / len(text), token)
+        for command in ("check", "compile"):
+            assert run_case(seeds, base, "xacro", [edit], command) == 1, (anchor, op, command)

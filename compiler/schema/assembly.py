@@ -41,6 +41,7 @@ class InputModel(Node):
     repo: Repo | None = None
     is_human: bool = False
     xacro_args: dict[str, Any] | None = None  # scalars each, checked when lowered (E0240)
+    xacro_env: list[str] | None = None  # the environment variables its xacro may read
 
     def problem(self) -> str | None:
         given = [k for k in ("basefile", "derived_base", "repo") if getattr(self, k) is not None]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import git
+
 from mpc.compiler.inherit import resolve
 from mpc.core import yaml_source as source
 from mpc.core.span import Span
@@ -227,6 +229,7 @@ def test_self_cycle(tmp_path: Path, diags: Diags):
 
 
 def test_paths_are_relative_to_the_naming_file(tmp_path: Path, diags: Diags):
+    git.Repo.init(tmp_path)  # the project: defaults files lie in the definition's git work tree
     write(tmp_path / "base.yml", "default_model:\n  mass: 1\n  links: [base]\n")
     write(tmp_path / "defs" / "arm.yml", "defaults: ../base.yml\ndefault_model:\n  links: [arm]\n")
     path = write(tmp_path / "robots" / "robot.yml", "defaults: ../defs/arm.yml\nmodel:\n  links: [hand]\n")
