@@ -15,8 +15,8 @@ from pathlib import Path
 
 from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
 from mpc.core.diagnostics import Sink, did_you_mean
-from mpc.ir.kinematics import zero_within_limits
 from mpc.core.files import confined
+from mpc.ir.kinematics import zero_within_limits
 from mpc.ir.program import RenderExport
 from mpc.ir.robot import Robot
 
