@@ -12,7 +12,6 @@ import dataclasses
 import functools
 import json
 import types
-import typing
 from collections import abc
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -23,6 +22,7 @@ from mpc.core.diagnostics import did_you_mean
 from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.ops import OPS, import_all
+from mpc.ir.refs import type_hints
 
 import_all()  # the IR text names every op: import the op modules `mpc check` does not need
 
@@ -142,14 +142,9 @@ def _collect(hint: Any, found: dict[str, type]) -> None:
 
 @functools.cache
 def field_hints(cls: type) -> dict[str, Any]:
-    """A dataclass's init fields → their resolved type hints (ClassVars are not fields)."""
-    try:
-        hints = typing.get_type_hints(cls)
-    except NameError:  # a name imported under TYPE_CHECKING: try the IR's own namespaces
-        import mpc.ir
-        import mpc.ir.program
-
-        hints = typing.get_type_hints(cls, localns={**vars(mpc.ir), **vars(mpc.ir.program)})
+    """A dataclass's init fields → their resolved type hints, without `Annotated` (ClassVars are
+    not fields)."""
+    hints = type_hints(cls, extras=False)
     return {f.name: hints[f.name] for f in dataclasses.fields(cls) if f.init}
 
 
