@@ -89,15 +89,10 @@ _BUSY: set[type] = set()  # classes whose shapes are being worked out (a record 
 def type_hints(cls: type, extras: bool = True) -> dict[str, Any]:
     """The resolved types of a dataclass's fields (ClassVars are not fields), once per class.
 
-    extras: keep `Annotated[…]` (the references); without, the bare types."""
-    try:
-        hints = typing.get_type_hints(cls, include_extras=extras)
-    except NameError:  # a name imported under TYPE_CHECKING: try the IR's own namespaces
-        import mpc.ir
-        import mpc.ir.program
-
-        hints = typing.get_type_hints(cls, localns={**vars(mpc.ir), **vars(mpc.ir.program)},
-                                      include_extras=extras)
+    extras: keep `Annotated[…]` (the references); without, the bare types. A field type must
+    resolve at run time (no name imported only under TYPE_CHECKING): tests/ir/test_refs.py
+    resolves every IR record, and the IR text (text_types) reads the same hints."""
+    hints = typing.get_type_hints(cls, include_extras=extras)
     return {f.name: hints[f.name] for f in dataclasses.fields(cls)}
 
 
