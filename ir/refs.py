@@ -86,13 +86,12 @@ _BUSY: set[type] = set()  # classes whose shapes are being worked out (a record 
 
 
 @functools.cache
-def type_hints(cls: type, extras: bool = True) -> dict[str, Any]:
-    """The resolved types of a dataclass's fields (ClassVars are not fields), once per class.
-
-    extras: keep `Annotated[…]` (the references); without, the bare types. A field type must
-    resolve at run time (no name imported only under TYPE_CHECKING): tests/ir/test_refs.py
-    resolves every IR record, and the IR text (text_types) reads the same hints."""
-    hints = typing.get_type_hints(cls, include_extras=extras)
+def type_hints(cls: type) -> dict[str, Any]:
+    """The resolved types of a dataclass's fields (ClassVars are not fields), with their
+    `Annotated[…]` (the references), once per class; the IR text (text_types) reads them too.
+    A field's type must resolve at run time (no name imported only under TYPE_CHECKING):
+    tests/ir/test_refs.py resolves every IR record."""
+    hints = typing.get_type_hints(cls, include_extras=True)
     return {f.name: hints[f.name] for f in dataclasses.fields(cls)}
 
 
