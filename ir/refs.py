@@ -82,7 +82,6 @@ _SEQUENCES = (tuple, list, frozenset, set, abc.Sequence, abc.MutableSequence, ab
               abc.Collection, abc.Iterable)
 _MAPPINGS = (dict, abc.Mapping, abc.MutableMapping, types.MappingProxyType)
 _SHAPES: dict[type, tuple[tuple[str, Shape], ...]] = {}
-_BUSY: set[type] = set()  # classes whose shapes are being worked out (a record that holds itself)
 
 
 @functools.cache
@@ -119,22 +118,48 @@ def shape_of(hint: Any) -> Shape:
         return ("map", key, value) if key is not None or value is not None else None
     if hasattr(hint, "__supertype__"):  # NewType
         return shape_of(hint.__supertype__)
-    if isinstance(hint, type) and dataclasses.is_dataclass(hint) and (hint in _BUSY or shapes(hint)):
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint) and _holds_refs(hint):
         return ("record",)
     return None
+
+
+@functools.cache
+def _holds_refs(cls: type) -> bool:
+    """Whether a record of this class may hold a reference: it declares one, or a record it
+    may hold does (records may hold each other in a circle: a mesh's ops hold shapes)."""
+    seen: set[type] = set()
+    todo = [cls]
+    while todo:
+        record = todo.pop()
+        if record in seen:
+            continue
+        seen.add(record)
+        for name, hint in type_hints(record).items():
+            if (record.__name__, name) in FREE_DATA or _declares(hint, todo):
+                return True
+    return False
+
+
+def _declares(hint: Any, records: list[type]) -> bool:
+    """Whether a type declares a reference itself (or is Any); adds the records in it to
+    `records`."""
+    if get_origin(hint) is Annotated and any(isinstance(m, Ref) for m in hint.__metadata__):
+        return True
+    if hint is Any:
+        return True
+    if hasattr(hint, "__supertype__"):
+        return _declares(hint.__supertype__, records)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        records.append(hint)
+    return any(_declares(arg, records) for arg in get_args(hint) if arg is not Ellipsis)
 
 
 def shapes(cls: type) -> tuple[tuple[str, Shape], ...]:
     """The fields of a record class that hold references or records, with their shapes."""
     found = _SHAPES.get(cls)
     if found is None:
-        _BUSY.add(cls)
-        try:
-            hints = type_hints(cls)
-            found = tuple((name, shape) for name, hint in hints.items()
-                          if (shape := _free((cls.__name__, name)) or shape_of(hint)) is not None)
-        finally:
-            _BUSY.discard(cls)
+        found = tuple((name, shape) for name, hint in type_hints(cls).items()
+                      if (shape := _free((cls.__name__, name)) or shape_of(hint)) is not None)
         _SHAPES[cls] = found
     return found
 

@@ -321,3 +321,35 @@ def test_a_pair_of_references_is_read_and_renamed_item_by_item() -> None:
         (("link",), "upper", "ends/0"), (("joint",), "elbow", "ends/1")]
     out = refs.renamed(pair, lambda kinds, name: f"{kinds[0]}_{name}")
     assert out.ends == ("link_upper", "joint_elbow")
+
+
+@dataclasses.dataclass(frozen=True)
+class _Shape:  # records in a circle that hold no reference (as a mesh's ops hold shapes)
+    inner: tuple[_Shape, ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class _Middle:  # holds a reference through a record that holds it back
+    outer: _Outer | None = None
+
+
+@dataclasses.dataclass(frozen=True)
+class _Outer:
+    middle: _Middle | None = None
+    link: refs.LinkRef = ""
+
+
+def test_records_in_a_circle_are_walked_only_when_one_of_them_holds_a_reference() -> None:
+    assert refs.shapes(_Shape) == ()
+    assert refs.shapes(_Middle) == (("outer", ("record",)),)
+    value = _Middle(outer=_Outer(middle=_Middle(outer=_Outer(link="hand")), link="arm"))
+    assert [(name, path) for _, name, path in refs.refs(value)] == [
+        ("hand", "outer/middle/outer/link"), ("arm", "outer/link")]
+
+
+def test_the_program_declares_the_links_its_exports_name() -> None:
+    at = Span("d.yml", 1, 1, 1, 2)
+    kccd = program.KccdExport(simplify_swept_from=("upper",), span=at)
+    prog = program.Program(robotname="r", modelname="r", inputs={}, ops=(), exports=(kccd,), span=at)
+    assert [(r.kinds, name, path) for r, name, path in refs.refs(prog)] == [
+        (("link",), "upper", "exports/0/simplify_swept_from/0")]
