@@ -187,8 +187,13 @@ def test_the_guard_finds_a_new_string_field_that_names_a_link() -> None:
     class NewExport:
         link: str = ""
         start: refs.LinkRef = ""
+        frame: Optional[str] = None  # noqa: UP045
+        extra: Mapping[str, object] = dataclasses.field(default_factory=dict)
+        count: int = 0
+        mode: Literal["a", "b"] = "a"
+        ends: tuple[MovedLink, ...] = ()
 
-    assert _undeclared([NewExport]) == ["NewExport.link"]
+    assert _undeclared([NewExport]) == ["NewExport.link", "NewExport.frame", "NewExport.extra"]
 
 
 def test_names_in_free_data_are_declared_renamed_and_pruned() -> None:
