@@ -1,6 +1,8 @@
 """Hand-written IR (issue 30.7): a line may leave out its `@ file:line:col-…` span, as
 grammar/ir.lark allows, and then the line's own place in the IR file stands in for it; what
-`mpc check` and `mpc compile` report about such a line points at the line.
+`mpc check` and `mpc compile` report about such a line points at the line. A program written
+in another order than the language's gets W0330 only when it is reordered, not when it is
+refused (E0330).
 """
 
 from __future__ import annotations
@@ -55,3 +57,36 @@ def test_a_span_field_and_no_at_is_the_field(tmp_path: Path) -> None:
     text = _arm_ir(tmp_path, 'op take_leaf link="upper" span=span("a.yml", 9, 1, 9, 4)')
     program = parse(text, "hand.ir", Sink())
     assert program is not None and program.ops[1].span == Span("a.yml", 9, 1, 9, 4)
+
+
+LINE = ('<robot name="arm"><link name="base"/><link name="upper"/><link name="lower"/><link name="hand"/>'
+        '<joint name="j1" type="fixed"><parent link="base"/><child link="upper"/></joint>'
+        '<joint name="j2" type="fixed"><parent link="upper"/><child link="lower"/></joint>'
+        '<joint name="j3" type="fixed"><parent link="lower"/><child link="hand"/></joint></robot>\n')
+MOVED = ['op take_leaf link="upper"', 'op remove_beyond links=["lower"]']  # reordered, with W0330
+CLASH = ['op add_pose name="home" positions={}',
+         'op transform_link link="upper" xyz=[0.1, 0.0, 0.0]']  # refused, E0330
+
+
+def _line_ir(folder: Path, *ops: str) -> Path:
+    write(folder / "line.urdf", LINE)
+    return write(folder / "line.ir", "\n".join([
+        "# mpc ir 1", 'program robotname="line" modelname="line"',
+        f'input line kind="basefile" path=path("{folder / "line.urdf"}")', 'op load_model input="line"',
+        *ops, 'export urdf mesh_format="input_type"']) + "\n")
+
+
+def test_a_reordered_program_is_checked_with_w0330(tmp_path: Path) -> None:
+    _line_ir(tmp_path, *MOVED)
+    done = mpc("check", "line.ir", "--format", "gcc", cwd=tmp_path)
+    assert (done.returncode, done.stderr.splitlines()) == (0, [
+        "line.ir:6:1: warning: remove_beyond (line 6) runs before take_leaf (line 5), "
+        "in the language's order [W0330]"])
+
+
+def test_a_refused_program_gets_no_w0330(tmp_path: Path) -> None:
+    _line_ir(tmp_path, *MOVED, *CLASH)
+    done = mpc("check", "line.ir", "--format", "gcc", cwd=tmp_path)
+    assert (done.returncode, done.stderr.splitlines()) == (1, [
+        "line.ir:8:1: error: transform_link (line 8) is written after add_pose (line 7), but the "
+        "language runs it first, and the two do not give the same robot in either order [E0330]"])
