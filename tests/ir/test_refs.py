@@ -1,10 +1,13 @@
 """Declared references (ir/refs.py): every string field of the IR's records that names an element
 is typed as such, so that reads, renaming and name checks find it without being told.
 
-A new string field of an op, of a robot element or of the model data beyond URDF fails
-`test_every_string_field_is_declared_or_said_not_to_name_an_element` until it is either typed
-(`LinkRef`, `JointName`, …) or listed in NOT_NAMES with the reason it names no element, or
-names one in a way a type cannot say.
+A new field that may hold a string (`str`, `Any`, `object`, in any container or union), of an
+op, of a robot element, of the model data beyond URDF, of the program or of any IR record these
+hold, fails `test_every_string_field_is_declared_or_said_not_to_name_an_element` until it is
+either typed (`LinkRef`, `JointName`, …) or listed in NOT_NAMES with the reason it names no
+element, or names one in a way a type cannot say. Types are read resolved, as ir/refs.py reads
+them: an alias or `Optional[…]` of a reference declares it (the tests at the end prove it
+through check_names, the pass `mpc check` runs).
 """
 
 from __future__ import annotations
