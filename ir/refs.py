@@ -3,10 +3,16 @@ material, motor, sensor or pose, and one walk over them.
 
 A field declares what it names by its type: `link: LinkRef` names a link that must exist,
 `name: LinkName` is the name of a link the record defines (an op that adds one, or the link
-itself), `targets: tuple[Ref.to("joint", "link"), ...]` a joint, else a link of that name.
-The declarations are read from the annotation text (the IR modules use
-`from __future__ import annotations`), without typing.get_type_hints: `mpc check` imports
-the IR on every editor save, and resolving hints is slow.
+itself), `targets: tuple[LinkOrJointRef, ...]` a joint, else a link of that name. Each of these
+is `Annotated[str, Ref(kinds)]`; a new kind of name is one more such alias here.
+
+The declarations are read from the fields' resolved types (`typing.get_type_hints` with
+`include_extras`), not from their text: an alias (`MovedLink = LinkRef`), `Optional[LinkRef]`,
+`LinkRef | None`, a tuple, list, set or mapping of references, a NewType over a record, all
+declare what they resolve to. A class's types are resolved once, when a record of it is first
+walked (`mpc check` resolves only the classes of the ops a definition uses). A union whose
+members declare different things cannot be walked (a string is a string) and is refused with
+TypeError; tests/ir/test_refs.py resolves every record class of the IR, so that shows in tests.
 
 Free data (annotations, submechanism definitions as written) has no types: FREE_DATA declares
 the keys in it that the SMURF is known to hold names under, by a path pattern per record field.
@@ -21,11 +27,13 @@ does not do: decide what a name means (that is the op's).
 from __future__ import annotations
 
 import dataclasses
-import re
-import sys
+import functools
+import types
+import typing
+from collections import abc
 from collections.abc import Callable, Iterator, Mapping
 from fnmatch import fnmatchcase
-from typing import Annotated, Any
+from typing import Annotated, Any, Union, get_args, get_origin
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -35,11 +43,6 @@ class Ref:
 
     kinds: tuple[str, ...]
     defines: bool = False
-
-    @classmethod
-    def to(cls, *kinds: str) -> Any:
-        """A string naming an element of one of `kinds`."""
-        return Annotated[str, cls(kinds)]
 
 
 LinkRef = Annotated[str, Ref(("link",))]
@@ -68,77 +71,95 @@ FREE_DATA: dict[tuple[str, str], tuple[tuple[str, Ref], ...]] = {
     ("Robot", "annotations"): (("self_collision/may_collide/*/*", Ref(("link",))),),
 }
 
-ALIASES: dict[str, Ref] = {name: value.__metadata__[0] for name, value in dict(globals()).items()
-                           if name.endswith(("Ref", "Name")) and hasattr(value, "__metadata__")}
-
-# A field's shape, parsed from its annotation: ("ref", Ref) | ("record",) | ("seq", shape) |
-# ("map", key shape, value shape) | ("opt", shape) | ("free", ((pattern parts, Ref), …)) for
-# free data (FREE_DATA); None: nothing declared in it.
+# A field's shape, from its resolved type: ("ref", Ref) | ("record",) (a record, or Any: look at
+# the value) | ("seq", shape) | ("items", (shape, …)) for a tuple of fixed length | ("map", key
+# shape, value shape) | ("free", ((pattern parts, Ref), …)) for free data (FREE_DATA); None:
+# nothing declared in it.
 Shape = tuple[Any, ...] | None
 Rename = Callable[[tuple[str, ...], str], str]  # (the kinds it may be, name) → new name
 
-_TOKEN = re.compile(r"\s*([\w.]+|\[|\]|,|\||\.\.\.)")
-_CONTAINERS = {"tuple": "seq", "list": "seq", "Sequence": "seq", "frozenset": "seq",
-               "Mapping": "map", "dict": "map"}
+_SEQUENCES = (tuple, list, frozenset, set, abc.Sequence, abc.MutableSequence, abc.Set, abc.MutableSet,
+              abc.Collection, abc.Iterable)
+_MAPPINGS = (dict, abc.Mapping, abc.MutableMapping, types.MappingProxyType)
 _SHAPES: dict[type, tuple[tuple[str, Shape], ...]] = {}
 
 
-def _parse(text: str, module: dict[str, Any]) -> Shape:
-    """The shape of one annotation: which parts of the value are references or records."""
-    tokens = _TOKEN.findall(text)
-    pos = 0
+@functools.cache
+def type_hints(cls: type) -> dict[str, Any]:
+    """The resolved types of a dataclass's fields (ClassVars are not fields), with their
+    `Annotated[…]` (the references), once per class; the IR text (text_types) reads them too.
+    A field's type must resolve at run time (no name imported only under TYPE_CHECKING):
+    tests/ir/test_refs.py resolves every IR record."""
+    hints = typing.get_type_hints(cls, include_extras=True)
+    return {f.name: hints[f.name] for f in dataclasses.fields(cls)}
 
-    def union() -> Shape:
-        nonlocal pos
-        options = [single()]
-        while pos < len(tokens) and tokens[pos] == "|":
-            pos += 1
-            options.append(single())
-        found = [o for o in options if o is not None]
-        if not found:
-            return None
-        return ("opt", found[0]) if len(options) > 1 else found[0]
 
-    def single() -> Shape:
-        nonlocal pos
-        name = tokens[pos]
-        pos += 1
-        args: list[Shape] = []
-        if pos < len(tokens) and tokens[pos] == "[":
-            pos += 1
-            while tokens[pos] != "]":
-                if tokens[pos] in (",", "..."):
-                    pos += 1
-                    continue
-                args.append(union())
-            pos += 1
-        if name in ALIASES:
-            return ("ref", ALIASES[name])
-        kind = _CONTAINERS.get(name.rsplit(".", 1)[-1])
-        if kind == "seq":
-            inner = [a for a in args if a is not None]
-            return ("seq", inner[0]) if inner else None
-        if kind == "map" and len(args) == 2 and (args[0] is not None or args[1] is not None):
-            return ("map", args[0], args[1])
-        target = module.get(name)
-        if isinstance(target, type) and dataclasses.is_dataclass(target) and shapes(target):
-            return ("record",)
-        if name == "Any":  # a value the module does not import at run time: look at it
-            return ("record",)
-        return None
+def shape_of(hint: Any) -> Shape:
+    """The shape of one resolved type: which parts of a value of it are references or records."""
+    origin, args = get_origin(hint), get_args(hint)
+    if origin is Annotated:
+        ref = next((m for m in hint.__metadata__ if isinstance(m, Ref)), None)
+        return ("ref", ref) if ref is not None else shape_of(args[0])
+    if hint is Any:  # a value whose type the record does not say: look at it
+        return ("record",)
+    if origin in (Union, types.UnionType):
+        found = {shape for arg in args if (shape := shape_of(arg)) is not None}
+        if len(found) > 1:
+            raise TypeError(f"{hint} declares different things in one union: {sorted(map(str, found))}")
+        return found.pop() if found else None
+    if origin is tuple and args and args[-1] is not Ellipsis:
+        items = tuple(shape_of(arg) for arg in args)
+        return ("items", items) if any(s is not None for s in items) else None
+    if origin in _SEQUENCES:
+        inner = shape_of(args[0]) if args else None
+        return ("seq", inner) if inner is not None else None
+    if origin in _MAPPINGS and len(args) == 2:
+        key, value = shape_of(args[0]), shape_of(args[1])
+        return ("map", key, value) if key is not None or value is not None else None
+    if hasattr(hint, "__supertype__"):  # NewType
+        return shape_of(hint.__supertype__)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint) and _holds_refs(hint):
+        return ("record",)
+    return None
 
-    return union()
+
+@functools.cache
+def _holds_refs(cls: type) -> bool:
+    """Whether a record of this class may hold a reference: it declares one, or a record it
+    may hold does (records may hold each other in a circle: a mesh's ops hold shapes)."""
+    seen: set[type] = set()
+    todo = [cls]
+    while todo:
+        record = todo.pop()
+        if record in seen:
+            continue
+        seen.add(record)
+        for name, hint in type_hints(record).items():
+            if (record.__name__, name) in FREE_DATA or _declares(hint, todo):
+                return True
+    return False
+
+
+def _declares(hint: Any, records: list[type]) -> bool:
+    """Whether a type declares a reference itself (or is Any); adds the records in it to
+    `records`."""
+    if get_origin(hint) is Annotated and any(isinstance(m, Ref) for m in hint.__metadata__):
+        return True
+    if hint is Any:
+        return True
+    if hasattr(hint, "__supertype__"):
+        return _declares(hint.__supertype__, records)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        records.append(hint)
+    return any(_declares(arg, records) for arg in get_args(hint) if arg is not Ellipsis)
 
 
 def shapes(cls: type) -> tuple[tuple[str, Shape], ...]:
     """The fields of a record class that hold references or records, with their shapes."""
     found = _SHAPES.get(cls)
     if found is None:
-        module = vars(sys.modules[cls.__module__])
-        found = tuple((f.name, shape) for f in dataclasses.fields(cls)
-                      if (shape := _free((cls.__name__, f.name))
-                          or _parse(f.type if isinstance(f.type, str) else f.type.__name__, module))
-                      is not None)
+        found = tuple((name, shape) for name, hint in type_hints(cls).items()
+                      if (shape := _free((cls.__name__, name)) or shape_of(hint)) is not None)
         _SHAPES[cls] = found
     return found
 
@@ -176,8 +197,9 @@ def _refs(value: Any, shape: Shape, path: str) -> Iterator[tuple[Ref, str, str]]
     elif tag == "free":
         for parts, ref in shape[1]:
             yield from _free_refs(value, parts, ref, path)
-    elif tag == "opt":
-        yield from _refs(value, shape[1], path)
+    elif tag == "items":
+        for i, (item, inner) in enumerate(zip(value, shape[1], strict=False)):
+            yield from _refs(item, inner, f"{path}/{i}")
     elif tag == "seq":
         for i, item in enumerate(value):
             yield from _refs(item, shape[1], f"{path}/{i}")
@@ -232,8 +254,10 @@ def _renamed(value: Any, shape: Shape, rename: Rename) -> Any:
         for parts, ref in shape[1]:
             value = _free_map(value, parts, lambda name, ref=ref: rename(ref.kinds, name))
         return value
-    if tag == "opt":
-        return _renamed(value, shape[1], rename)
+    if tag == "items":
+        items = [_renamed(item, inner, rename) for item, inner in zip(value, shape[1], strict=False)]
+        items += value[len(items):]
+        return value if all(a is b for a, b in zip(items, value, strict=True)) else type(value)(items)
     if tag == "seq":
         items = [_renamed(item, shape[1], rename) for item in value]
         return value if all(a is b for a, b in zip(items, value, strict=True)) else type(value)(items)

@@ -1,7 +1,8 @@
 """ir.Program ↔ the textual IR (`mpc compile --emit ir`): `dump` prints, `parse` reads back.
 
 One record a line: `program …`, then `input NAME …`, `op KIND …` and `export TYPE …`,
-each `field=value …` and `@ file:line:col-end_line:end_col` (its span). The format is
+each `field=value …` and `@ file:line:col-end_line:end_col` (its span; a hand-written line
+may leave it out, and then the record's own place in the IR file is its span). The format is
 generic over the dataclasses' fields (text_types walks their type hints), so a new op
 or field needs no change here. It does not check what ops mean: passes do that.
 
@@ -396,5 +397,7 @@ class _Builder:
                 why = "has no span" if "span" not in hints else "has both '@ …' and a field 'span'"
                 return conv.error(rec.span, "E0231" if "span" not in hints else "E0234", f"{owner} {why}")
             given["span"] = rec.at
+        elif "span" in hints and not any(f.name == "span" for f in rec.fields):
+            given["span"] = rec.span  # hand-written: the line stands in for what it came from
         kwargs = conv.fields(cls, rec.fields, owner, rec.span, given)
         return BAD if kwargs is None else conv.build(cls, kwargs, owner, rec.span)

@@ -12,17 +12,17 @@ import dataclasses
 import functools
 import json
 import types
-import typing
 from collections import abc
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import Any, Literal, Union, get_args, get_origin
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 from mpc.core.diagnostics import did_you_mean
 from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.ops import OPS, import_all
+from mpc.ir.refs import type_hints
 
 import_all()  # the IR text names every op: import the op modules `mpc check` does not need
 
@@ -142,22 +142,22 @@ def _collect(hint: Any, found: dict[str, type]) -> None:
 
 @functools.cache
 def field_hints(cls: type) -> dict[str, Any]:
-    """A dataclass's init fields → their resolved type hints (ClassVars are not fields)."""
-    try:
-        hints = typing.get_type_hints(cls)
-    except NameError:  # a name imported under TYPE_CHECKING: try the IR's own namespaces
-        import mpc.ir
-        import mpc.ir.program
-
-        hints = typing.get_type_hints(cls, localns={**vars(mpc.ir), **vars(mpc.ir.program)})
+    """A dataclass's init fields → their resolved type hints (ClassVars are not fields); the
+    declared references' `Annotated[…]` stay (`unwrap` sees through them), so that the IR text
+    and ir/refs.py resolve each class once."""
+    hints = type_hints(cls)
     return {f.name: hints[f.name] for f in dataclasses.fields(cls) if f.init}
 
 
 def unwrap(hint: Any) -> Any:
-    """NewType → its base type; Any stays Any."""
-    while hasattr(hint, "__supertype__"):
-        hint = hint.__supertype__
-    return hint
+    """NewType → its base type, `Annotated[T, …]` → T; Any stays Any."""
+    while True:
+        if hasattr(hint, "__supertype__"):
+            hint = hint.__supertype__
+        elif get_origin(hint) is Annotated:
+            hint = get_args(hint)[0]
+        else:
+            return hint
 
 
 def union_arms(hint: Any) -> tuple[Any, ...]:

@@ -10,7 +10,7 @@ with a warning (W0330) when every op that moves passes only ops it is independen
 other parts of the assembly, or a pair the language declares independent (`remove_beyond` and
 `take_leaf` keep the same links in either order; every other op keeps the robot's name).
 Otherwise moving could change what the program means, and the file is refused (E0330),
-naming both lines.
+naming both lines; a refused program is not reordered, and gets no W0330.
 
     op take_leaf link="forearm" @ arm.ir:4
     op remove_beyond links=["wrist"] @ arm.ir:5
@@ -79,6 +79,7 @@ def order_ops(program: Program, ctx: PassContext) -> Program:
         return program
     position = {id(op): i for i, op in enumerate(ordered)}
     refused = False
+    moved: list[tuple[Op, Op]] = []  # (op, the first op of its part it now precedes)
     for i, later in enumerate(program.ops):  # `later`: written after the ops it now precedes
         passed = [op for op in program.ops[:i] if position[id(op)] > position[id(later)]]
         if not passed:
@@ -94,9 +95,12 @@ def order_ops(program: Program, ctx: PassContext) -> Program:
         # Moving past other parts' ops, or past the robot's name, changes nothing one could see.
         swapped = [op for op in passed if set(op.parts()) & set(later.parts())
                    and not {op.phase(), later.phase()} & INDEPENDENT_OF_ALL]
-        if swapped and not refused:
-            first = min(swapped, key=lambda op: position[id(op)])
-            ctx.sink.warning(later.span, "W0330", f"{later.kind} (line {later.span.line}) runs "
-                             f"before {first.kind} (line {first.span.line}), in the language's order",
-                             hint="the program is reordered; write it in that order to silence this")
-    return program if refused else replace(program, ops=ordered)
+        if swapped:
+            moved.append((later, min(swapped, key=lambda op: position[id(op)])))
+    if refused:  # nothing is reordered: saying what moved would be wrong
+        return program
+    for later, first in moved:
+        ctx.sink.warning(later.span, "W0330", f"{later.kind} (line {later.span.line}) runs "
+                         f"before {first.kind} (line {first.span.line}), in the language's order",
+                         hint="the program is reordered; write it in that order to silence this")
+    return replace(program, ops=ordered)

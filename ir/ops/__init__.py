@@ -15,11 +15,15 @@ from typing import TYPE_CHECKING, Any
 from mpc.ir.names import Names
 from mpc.ir.ops.base import OPS, ROOT, Effects, Op, Phase, Ref
 
-# The op classes live in the modules below and register in OPS when their module is imported.
-# A module is imported when one of its names is first asked for (`from mpc.ir.ops import AddFrame`,
-# `ops.AddFrame`), so that `mpc check` imports only the ops a definition uses; `import_all` imports
-# every one (the IR text printer and parser know every op).
-_MODULES = {
+# The op catalogue: each op module and the op classes it defines, the one list of the ops.
+# An op class registers in OPS when its module is imported; a module is imported when one of
+# its names is first asked for (`from mpc.ir.ops import AddFrame`, `ops.AddFrame`), so that
+# `mpc check` imports only the ops a definition uses; `import_all` imports every one (the IR
+# text printer and parser know every op). The lazy names, `import_all` and `__all__` derive
+# from it; the imports under TYPE_CHECKING below repeat it for static tools (editors, type
+# checkers), which cannot read a table, and tests/ir/test_op_catalogue.py holds the two equal
+# and every op class defined in an op module listed.
+CATALOGUE: dict[str, tuple[str, ...]] = {
     "annotate": ("AddAnnotations", "AddPose", "AddSensor", "AddSubmechanism", "AutoBitmask",
                  "CompleteSubmechanisms", "EditCollisions", "EditMaterial", "EditVisuals",
                  "SubmechanismsFile"),
@@ -31,50 +35,43 @@ _MODULES = {
     "meshes": ("ApplyScale", "ReduceMeshes"),
     "robot": ("SetRobotName",),
 }
-_MODULE_OF = {name: module for module, names in _MODULES.items() for name in names}
+_MODULE_OF = {name: module for module, names in CATALOGUE.items() for name in names}
 
-if TYPE_CHECKING:
-    from mpc.ir.ops.annotate import (
-        AddAnnotations,
-        AddPose,
-        AddSensor,
-        AddSubmechanism,
-        AutoBitmask,
-        CompleteSubmechanisms,
-        EditCollisions,
-        EditMaterial,
-        EditVisuals,
-        SubmechanismsFile,
-    )
-    from mpc.ir.ops.assembly import (
-        Attach,
-        EditNames,
-        LoadModel,
-        Mirror,
-        RemoveBeyond,
-        TakeLeaf,
-    )
-    from mpc.ir.ops.frames import (
-        AddFrame,
-        AnnotateLinks,
-        EstimateMissingComs,
-        EstimateMissingInertia,
-        MakeRoot,
-        ReparentLink,
-        TransformFrame,
-        TransformLink,
-    )
-    from mpc.ir.ops.joints import (
-        AddCutJoint,
-        EditJoint,
-        JointDefaults,
-        MoveJointAxisToIntersection,
-        RemoveJoint,
-        ReplaceJointTypes,
-        SetMotor,
-    )
-    from mpc.ir.ops.meshes import ApplyScale, ReduceMeshes
-    from mpc.ir.ops.robot import SetRobotName
+if TYPE_CHECKING:  # the catalogue again, for static tools (`X as X`: a name this package exports)
+    from mpc.ir.ops.annotate import AddAnnotations as AddAnnotations
+    from mpc.ir.ops.annotate import AddPose as AddPose
+    from mpc.ir.ops.annotate import AddSensor as AddSensor
+    from mpc.ir.ops.annotate import AddSubmechanism as AddSubmechanism
+    from mpc.ir.ops.annotate import AutoBitmask as AutoBitmask
+    from mpc.ir.ops.annotate import CompleteSubmechanisms as CompleteSubmechanisms
+    from mpc.ir.ops.annotate import EditCollisions as EditCollisions
+    from mpc.ir.ops.annotate import EditMaterial as EditMaterial
+    from mpc.ir.ops.annotate import EditVisuals as EditVisuals
+    from mpc.ir.ops.annotate import SubmechanismsFile as SubmechanismsFile
+    from mpc.ir.ops.assembly import Attach as Attach
+    from mpc.ir.ops.assembly import EditNames as EditNames
+    from mpc.ir.ops.assembly import LoadModel as LoadModel
+    from mpc.ir.ops.assembly import Mirror as Mirror
+    from mpc.ir.ops.assembly import RemoveBeyond as RemoveBeyond
+    from mpc.ir.ops.assembly import TakeLeaf as TakeLeaf
+    from mpc.ir.ops.frames import AddFrame as AddFrame
+    from mpc.ir.ops.frames import AnnotateLinks as AnnotateLinks
+    from mpc.ir.ops.frames import EstimateMissingComs as EstimateMissingComs
+    from mpc.ir.ops.frames import EstimateMissingInertia as EstimateMissingInertia
+    from mpc.ir.ops.frames import MakeRoot as MakeRoot
+    from mpc.ir.ops.frames import ReparentLink as ReparentLink
+    from mpc.ir.ops.frames import TransformFrame as TransformFrame
+    from mpc.ir.ops.frames import TransformLink as TransformLink
+    from mpc.ir.ops.joints import AddCutJoint as AddCutJoint
+    from mpc.ir.ops.joints import EditJoint as EditJoint
+    from mpc.ir.ops.joints import JointDefaults as JointDefaults
+    from mpc.ir.ops.joints import MoveJointAxisToIntersection as MoveJointAxisToIntersection
+    from mpc.ir.ops.joints import RemoveJoint as RemoveJoint
+    from mpc.ir.ops.joints import ReplaceJointTypes as ReplaceJointTypes
+    from mpc.ir.ops.joints import SetMotor as SetMotor
+    from mpc.ir.ops.meshes import ApplyScale as ApplyScale
+    from mpc.ir.ops.meshes import ReduceMeshes as ReduceMeshes
+    from mpc.ir.ops.robot import SetRobotName as SetRobotName
 
 
 def __getattr__(name: str) -> Any:
@@ -87,52 +84,9 @@ def __getattr__(name: str) -> Any:
 
 def import_all() -> dict[str, type[Op]]:
     """OPS with every op in it."""
-    for module in _MODULES:
+    for module in CATALOGUE:
         __import__(f"{__name__}.{module}")
     return OPS
 
 
-__all__ = [
-    "OPS",
-    "ROOT",
-    "AddAnnotations",
-    "AddCutJoint",
-    "AddFrame",
-    "AddPose",
-    "AddSensor",
-    "AddSubmechanism",
-    "AnnotateLinks",
-    "ApplyScale",
-    "Attach",
-    "AutoBitmask",
-    "CompleteSubmechanisms",
-    "EditCollisions",
-    "EditJoint",
-    "EditMaterial",
-    "EditNames",
-    "EditVisuals",
-    "Effects",
-    "EstimateMissingComs",
-    "EstimateMissingInertia",
-    "JointDefaults",
-    "LoadModel",
-    "MakeRoot",
-    "Mirror",
-    "MoveJointAxisToIntersection",
-    "Names",
-    "Op",
-    "Phase",
-    "ReduceMeshes",
-    "Ref",
-    "RemoveBeyond",
-    "RemoveJoint",
-    "ReparentLink",
-    "ReplaceJointTypes",
-    "SetMotor",
-    "SetRobotName",
-    "SubmechanismsFile",
-    "TakeLeaf",
-    "TransformFrame",
-    "TransformLink",
-    "import_all",
-]
+__all__ = ["CATALOGUE", "OPS", "ROOT", "Effects", "Names", "Op", "Phase", "Ref", "import_all", *_MODULE_OF]
