@@ -181,6 +181,7 @@ class PackageResolver:
     _real_roots: dict[tuple[Path, ...], tuple[Path, ...]] = field(default_factory=dict)
     _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
     _near: dict[tuple[str, Path], Path | None] = field(default_factory=dict)  # (package, near) → folder
+    _named_above: set[Path] = field(default_factory=set)  # packages above a model, by package.xml
     # The search path's folders that are crawled as rospack does (ROS_PACKAGE_PATH's); the
     # others are share/ folders, with their packages right below them.
     _crawled: frozenset[Path] = frozenset()
@@ -214,10 +215,22 @@ class PackageResolver:
         if found is None and near is not None:
             key = (package, near)
             if key not in self._near:  # every mesh of a model asks: Path.parents is slow
-                self._near[key] = next((p for p in (near, *near.parents)
-                                        if p.name == package or package_name(p) == package), None)
+                self._near[key] = self._above(package, near)
             return self._near[key]
         return found
+
+    def _above(self, package: str, near: Path) -> Path | None:
+        """The folder above `near` that is `package`: named so by its package.xml, or by its
+        folder's name. One its package.xml names is a package root (the package the model
+        lives in, as a `-master` archive unpacks it); one only its folder's name matches is not
+        (`package://home/…` from a model under /home must not open the home folders)."""
+        for folder in (near, *near.parents):
+            if package_name(folder) == package:
+                self._named_above.add(folder)
+                return folder
+            if folder.name == package:
+                return folder
+        return None
 
     def _search(self, package: str) -> Path | None:
         """The first folder of the search path that holds `package`: named so by its
@@ -275,9 +288,9 @@ class PackageResolver:
 
         assert self.search_path is not None
         # A package found on the search path is a root wherever its folder links to: the
-        # environment named it, as `--package` names one. (Not one found above the model: a
-        # model may name any folder above it.)
-        found = (f for f in self._cache.values() if f is not None)
+        # environment named it, as `--package` names one. One found above the model is a root
+        # when its package.xml names it (`_above`).
+        found = (*(f for f in self._cache.values() if f is not None), *sorted(self._named_above))
         own = (base_dir, base_dir.parent) if base_dir and not self.projects and base_dir.name in \
             MODEL_FOLDERS else (base_dir,) if base_dir else ()
         folders = (*self.package_map.values(), *self.search_path, *found, *self.roots, *self.projects, *own)

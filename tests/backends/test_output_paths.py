@@ -77,6 +77,14 @@ SITES: dict[tuple[str, str, str], str] = {
     ("urdf.py", "emit", "confined(out, 'urdf', f'{export.filename or robot.name}{suffix}.urdf')"): CONFINED,
     ("xacro_reader.py", "expand", "Path(m.history[-1][-1])"): READ,
     ("xacro_reader.py", "_current_file", "Path(stack[-1])"): READ,
+    ("xacro_reader.py", "_locate", "Path(file)"): READ,
+    ("xacro_guard.py", "check", "Path(path)"): READ,
+    ("xacro_guard.py", "guarded", "Path(path)"): READ,
+    ("xacro_guard.py", "checked_file", "Path(path)"): READ,
+    ("xacro_origins.py", "start_element_handler", "Path(stack[-1])"): READ,
+    ("xacro_origins.py", "_recording", "Path(stack[-1])"): READ,
+    ("meshes.py", "key", "Path(mesh.source.uri.removeprefix(GENERATED))"):
+        "a made mesh's key (`<link>_joined`); its output path goes through copy's confined",
 }
 
 

@@ -32,7 +32,7 @@ model:
   collisions: {{auto_bitmask: true}}
   export_config:
     - {{type: urdf, mesh_format: stl, link_in_smurf: true}}
-    - {{type: sdf, mesh_format: stl}}
+    - {{type: sdf, mesh_format: stl, correct_inertials: true}}
     - {{type: mjcf, mesh_format: stl, correct_inertials: true}}
 """
 

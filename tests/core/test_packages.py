@@ -78,6 +78,22 @@ def test_the_folders_above_the_model_are_named_by_their_package_xml(tmp_path: Pa
     assert (tmp_path / "out/meshes/stl/tetra.stl").read_bytes() == (clone / "meshes/tetra.stl").read_bytes()
 
 
+def test_a_folder_above_the_model_named_like_a_package_opens_none_of_its_files(tmp_path: Path) -> None:
+    """`package://NAME` also finds a folder above the model by its folder's name (old layouts),
+    but only a package.xml makes it a package root: a model under `home/` cannot read
+    `package://home/…` outside its project."""
+    secrets = tmp_path / "home"
+    tetra_stl(secrets / "secret.stl")
+    write(secrets / "project/arm.urdf", ARM_URDF.replace("meshes/tetra.stl", "package://home/secret.stl"))
+    spec = write(secrets / "project/model.yml", definition("arm.urdf", "stl", "arm"))
+    env = {**os.environ, "ROS_PACKAGE_PATH": "", "AMENT_PREFIX_PATH": ""}
+    done = mpc("compile", spec, "-o", tmp_path / "out", env=env)
+    assert done.returncode == 1
+    assert f"error[E0650]: mesh 'package://home/secret.stl' in link 'base' is not read: it is " \
+           f"'{secrets / 'secret.stl'}', outside the project and the model's package roots" in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_an_ament_prefix_share_folder_holds_packages_by_their_package_xml(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     prefix = tmp_path / "install"

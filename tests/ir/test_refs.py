@@ -76,6 +76,7 @@ NOT_NAMES: dict[tuple[str, str], str] = {
     ("AutoBitmask", "always"): "pairs of links or collisions; effect reports them",
     ("CutJoint", "name"): "a loop joint's name; joint name editing leaves it (as before)",
     ("CommandExport", "env"): "names of environment variables a command gets",
+    ("Input", "xacro_env"): "names of environment variables a xacro model may read",
     # The program and its exports (ir/program.py): files, folders, repositories, formats, text.
     **{(cls, field): "a file or folder of the output, or its name" for cls, field in (
         ("UrdfExport", "filename"), ("SdfExport", "filename"), ("MjcfExport", "filename"),

@@ -95,7 +95,9 @@ def served(tmp_path_factory: pytest.TempPathFactory) -> tuple[Client, str]:
     assert client.proc.wait(timeout=30) == 0
     assert client.proc.stderr is not None
     log = client.proc.stderr.read().decode()
-    assert "Traceback" not in log and "a message is a JSON object, not null" in log
+    # One line per refusal, never a traceback. (Which refusals this server saw depends on how
+    # pytest-xdist shared the cases among its workers: each worker has its own server.)
+    assert "Traceback" not in log
 
 
 def test_there_are_twenty_kinds_of_malformed_frame() -> None:
