@@ -1,0 +1,38 @@
+"""`mpc` (the program, not the library) gives pydantic no plugins, and so starts faster.
+
+pydantic asks the installed packages for plugins (entry points) when it builds its first
+validator: `pydantic.plugin._schema_validator` imports `get_plugins` from the private module
+`pydantic.plugin._loader`, whose import brings in importlib.metadata, a tenth of a cold
+`mpc check`. The definition language takes no plugin, and another package's must not change
+how mpc validates; so the program puts a module of that name in `sys.modules` whose
+`get_plugins()` gives none, before anything imports pydantic's.
+
+A hack on a private module, fenced: only `cli/main.py` installs it (importing mpc's modules
+from another program leaves pydantic as it is), pyproject.toml keeps pydantic below 3, and
+tests/cli/test_pydantic_plugins.py fails when the installed pydantic uses the private module
+for anything but `get_plugins()`.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from collections.abc import Iterable
+
+PRIVATE = "pydantic.plugin._loader"
+
+
+def _get_plugins() -> Iterable[object]:
+    return ()
+
+
+# What the stand-in module holds: pydantic's names from the private module, each replaced.
+REPLACED = {"get_plugins": _get_plugins}
+
+
+def install() -> None:
+    """Give pydantic no plugins; nothing when pydantic's own loader is imported already."""
+    if PRIVATE not in sys.modules:
+        loader = types.ModuleType(PRIVATE, "mpc: no pydantic plugins (cli/pydantic_plugins.py)")
+        loader.__dict__.update(REPLACED)
+        sys.modules[PRIVATE] = loader
