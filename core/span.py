@@ -18,7 +18,7 @@ from mpc.core.files import quotable
 from mpc.core.record import is_record, record, record_values
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class Span:
     """A region of a source file.
 
