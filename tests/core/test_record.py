@@ -154,8 +154,8 @@ BULK = {"Pose", "Fragment", "FragmentRef", "Robot", "Link", "Inertial", "Inertia
 
 def test_every_class_made_in_bulk_gets_its_fast_init_and_maker_on_this_python() -> None:
     """What reads dataclass's internals still understands them on this Python (run this file on
-    each supported version: it needs only lxml and pytest, `--noconftest`): each class of the opt-in list gets record's __init__ and a maker,
-    not the fallback to dataclass's, and they make what dataclass's __init__ makes."""
+    each supported version: it needs only lxml and pytest, `--noconftest`): each class of the
+    opt-in list gets record's __init__ and a maker, not the fallback to dataclass's."""
     from mpc.backends import urdf_reader
 
     urdf_reader._makers()  # the reader's makers: every class it asks for must be on the list
