@@ -64,7 +64,8 @@ _MODELLED = frozenset({
 def _makers() -> SimpleNamespace:
     """A maker of each IR record a read makes (core/record.py: maker, a quarter of the class
     call's time; a URDF read makes 1,600 of them), written at the first read rather than at
-    import: `mpc check` imports this module on every save."""
+    import: `mpc check` imports this module on every save. Each class opts in to it with
+    `@record(..., bulk=True)` (the list: tests/core/test_record.py BULK)."""
     return SimpleNamespace(
         pose=maker(Pose), fragment=maker(Fragment), ref=maker(FragmentRef), robot=maker(Robot),
         link=maker(Link), inertial=maker(Inertial), inertia=maker(Inertia), box=maker(Box),

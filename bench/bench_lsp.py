@@ -5,6 +5,10 @@ The definition is TALOS (example-robot-data) with an entry for each of its joint
 a pose of all of them, renamed links and collision edits: every keystroke is checked against
 its names, as in an editor. Each edit is a full-text change; the time runs from sending it
 until its diagnostics arrive (the server's debounce included). Goal (issue 20): median ≤ 30 ms.
+
+Also the memory of 40 TALOS models held in the server's model cache (compiler/options.py
+ModelCache, read as the server reads them): what the process grows by (VmRSS) once they are
+read, the parsed files freed. Goal (issue 30): ≤ 20 MiB (76 MiB while each kept its parse).
 Run: python bench/bench_lsp.py [edits]
 """
 
@@ -63,8 +67,30 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def held_models_mib(urdf: Path, count: int = 40) -> float:
+    """What `count` TALOS models held in a ModelCache take (the growth of this process's VmRSS),
+    each read as the server reads an input model. One read first, so that imports and the
+    readers' one-time set-up are not counted."""
+    import gc
+
+    from mpc.backends import urdf_reader
+    from mpc.compiler.options import ModelCache
+    from mpc.core.diagnostics import Sink
+
+    urdf_reader.read(urdf, Sink())
+    cache = ModelCache()
+    gc.collect()
+    before = memory_kb(os.getpid())
+    for i in range(count):  # one entry each: the cache keys a model by its file and xacro args
+        cache.read(urdf, (("copy", str(i)),), Sink(), lambda sink: urdf_reader.read(urdf, sink))
+    gc.collect()
+    assert len(cache) == count, f"the cache keeps {len(cache)} of {count} models"
+    return (memory_kb(os.getpid()) - before) / 1024
+
+
 def main(edits: int = 50) -> None:
     urdf = PackageResolver().find("example-robot-data") / TALOS
+    held = held_models_mib(urdf)
     with tempfile.TemporaryDirectory(prefix="mpc-bench-lsp-") as work:
         path = Path(work) / "talos.yml"
         text = definition(urdf)
@@ -99,6 +125,7 @@ def main(edits: int = 50) -> None:
     print(f"the server's CPU time per edit: {cpu / edits * 1000:.1f} ms (what the latency is on an idle "
           f"machine, less the debounce; load average now {os.getloadavg()[0]:.1f})")
     print(f"server memory holding TALOS: {rss / 1024:.0f} MiB (VmRSS)")
+    print(f"40 TALOS models held in the model cache: {held:.1f} MiB (goal ≤ 20 MiB)")
 
 
 if __name__ == "__main__":

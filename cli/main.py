@@ -192,9 +192,11 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from mpc.cli import pydantic_plugins
     from mpc.core import blas
 
     blas.one_thread()  # before anything imports numpy
+    pydantic_plugins.install()  # before anything builds a pydantic validator
     args = _parser().parse_args(argv)
     try:
         with _without_cyclic_gc(args.command):

@@ -4,6 +4,7 @@ anything is read, and a compilation that its build cache serves reads no model."
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,11 +46,19 @@ class ModelCache:
 
     Each entry keeps the diagnostics its reading reported, replayed into the sink of every
     compilation that takes it. Only the model file itself is watched, not what a xacro includes.
+
+    What is kept is values, not parses: a model's spans are found as it enters (core/span.py:
+    settle_spans), so no parsed file stays alive behind it. The cache is bounded: the models
+    used longest ago go once more than `most_models` are kept or their files together exceed
+    `most_bytes` (the model used last always stays).
     """
 
-    _models: dict[tuple[str, tuple[tuple[str, str], ...]], tuple[tuple[int, int], Robot | None,
-                                                                 list[Diagnostic]]] = \
-        field(default_factory=dict)
+    most_models: int = 64
+    most_bytes: int = 32 * 1024 * 1024  # of model files; a model held takes about 3× its file
+    _models: OrderedDict[tuple[str, tuple[tuple[str, str], ...]],
+                         tuple[tuple[int, int], Robot | None, list[Diagnostic]]] = \
+        field(default_factory=OrderedDict)
+    _bytes: int = 0
 
     def read(self, path: Path, xacro_args: tuple[tuple[str, str], ...], sink: Sink,
              reader: Callable[[Sink], Robot | None]) -> Robot | None:
@@ -61,8 +70,30 @@ class ModelCache:
         key, stamp = (str(path.resolve()), xacro_args), (stat.st_mtime_ns, stat.st_size)
         entry = self._models.get(key)
         if entry is None or entry[0] != stamp:
+            from mpc.core.span import settle_spans
+
             own = Sink()
-            entry = self._models[key] = (stamp, reader(own), own.diagnostics)
+            entry = (stamp, reader(own), own.diagnostics)
+            settle_spans(entry)
+            self._forget(key)
+            self._models[key] = entry
+            self._bytes += stamp[1]
+            self._bound()
+        else:
+            self._models.move_to_end(key)
         for diagnostic in entry[2]:
             sink.report(diagnostic)
         return entry[1]
+
+    def __len__(self) -> int:
+        return len(self._models)
+
+    def _forget(self, key: tuple[str, tuple[tuple[str, str], ...]]) -> None:
+        old = self._models.pop(key, None)
+        if old is not None:
+            self._bytes -= old[0][1]
+
+    def _bound(self) -> None:
+        while len(self._models) > 1 and (len(self._models) > self.most_models
+                                         or self._bytes > self.most_bytes):
+            self._forget(next(iter(self._models)))

@@ -8,10 +8,16 @@ and `__delattr__`; the three methods below behave as dataclass's own would (fiel
 order, the class's qualified name, equal only to the same class, tuple hash), so
 `dataclasses.fields`, `replace` and `asdict` and every repr-based digest are unchanged.
 
-A record with slots gets, when it is first made, an `__init__` that sets each slot through
-the slot's own setter (`_fast_init`): dataclass's frozen one goes through object.__setattr__
-for every field, which takes twice as long. Code that makes thousands of records (a reader)
-asks for a `maker`, which skips the class call too: a quarter of its time. A record with
+Two things read dataclass's internals (the parameters and defaults of the `__init__` it
+generates), for the classes a reader makes by the thousand, and only for those: the classes
+that opt in with `@record(slots=True, bulk=True)` (`bulk_records()`: the URDF reader's IR
+values and Span). Such a class gets, when it is first made, an `__init__` that sets each slot
+through the slot's own setter (`_fast_init`): dataclass's frozen one goes through
+object.__setattr__ for every field, which takes twice as long. And code that makes thousands
+of them (a reader) asks for a `maker`, which skips the class call too: a quarter of its time.
+Every other record keeps dataclass's own `__init__`, and `maker` refuses it. Where the
+internals are not as expected (another Python), both fall back to dataclass's `__init__`;
+tests/core/test_record.py fails then, on each supported Python it runs on. A record with
 slots also pickles its fields as a tuple, in order, as dataclass's own `__getstate__` does,
 without looking the fields up for each object. The build cache writes records as their field
 values (`record_values`) and reads them back without running their code (`from_values`:
@@ -32,6 +38,7 @@ R = TypeVar("R")
 _NAMES: dict[type, tuple[str, ...]] = {}
 _VALUES: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
 _RECORDS: set[type] = set()  # every class made by @record
+_BULK: set[type] = set()  # those made in bulk: @record(slots=True, bulk=True)
 
 
 def _names(cls: type) -> tuple[str, ...]:
@@ -57,6 +64,11 @@ def _values(obj: Any) -> tuple[Any, ...]:
 def is_record(cls: type) -> bool:
     """Whether `cls` was made by @record (not a subclass of one that was not)."""
     return cls in _RECORDS
+
+
+def bulk_records() -> frozenset[type]:
+    """The record classes that opted in to `maker` and the fast `__init__` (bulk=True)."""
+    return frozenset(_BULK)
 
 
 def record_fields(cls: type) -> tuple[str, ...]:
@@ -206,10 +218,14 @@ def maker(cls: type[R]) -> Callable[..., R]:
     default_factory and __post_init__), in a quarter of the time, for code that makes many
     (the readers): it fills an unfrozen twin of `cls` (the same slots, so each assignment is
     the interpreter's direct slot store) and then makes it a `cls`; no class call, whose
-    keyword arguments go through a dict. `cls` itself for a record it does not cover (no
-    slots, a base class, InitVar or init=False fields, an __init__ of its own)."""
+    keyword arguments go through a dict. Only for a record made in bulk (`bulk=True`; a
+    TypeError for any other); `cls` itself for one it does not cover (a base class, InitVar
+    or init=False fields, an __init__ of its own)."""
     make = _MAKERS.get(cls)
     if make is None:
+        if cls not in _BULK:
+            raise TypeError(f"{cls.__qualname__} is not made in bulk: maker serves only "
+                            "@record(slots=True, bulk=True) classes")
         make = _MAKERS[cls] = _maker(cls)
     return make
 
@@ -240,12 +256,15 @@ def _maker(cls: Any) -> Callable[..., Any]:
 @overload
 def record(cls: T, /) -> T: ...
 @overload
-def record(*, slots: bool = False, kw_only: bool = False) -> Callable[[T], T]: ...
+def record(*, slots: bool = False, kw_only: bool = False, bulk: bool = False) -> Callable[[T], T]: ...
 
 
 @dataclass_transform(frozen_default=True)
-def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) -> Any:
-    """`@dataclass(frozen=True, …)` with repr, == and hash from this module."""
+def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bulk: bool = False) -> Any:
+    """`@dataclass(frozen=True, …)` with repr, == and hash from this module. bulk: a class a
+    reader makes by the thousand, given the fast `__init__` and a `maker` (needs slots)."""
+    if bulk and not slots:
+        raise TypeError("@record(bulk=True) needs slots=True")
 
     def wrap(c: T) -> T:
         written = "__init__" in c.__dict__
@@ -256,8 +275,9 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False) ->
         for name, method in methods:
             if name not in c.__dict__:
                 setattr(out, name, method)
-        if slots and not written:  # dataclass wrote it
+        if bulk and not written:  # dataclass wrote it
             out.__init__ = _first_init(out, out.__init__)  # type: ignore[misc]
+            _BULK.add(out)
         _RECORDS.add(out)
         return out
 

@@ -16,7 +16,7 @@ from mpc.core.span import Span
 RefKind = Literal["link", "joint"]
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class FragmentRef:
     """One place in a fragment that names a link or joint.
 
@@ -32,7 +32,7 @@ class FragmentRef:
     name: str
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Fragment:
     """An XML element kept verbatim.
 

@@ -17,7 +17,7 @@ Vec3 = tuple[float, float, float]
 Attrs = tuple[tuple[str, str], ...]
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Box:
     """A box centred at its origin. size: edge lengths along x, y, z in metres."""
 
@@ -25,7 +25,7 @@ class Box:
     extra_attrs: Attrs = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Cylinder:
     """A cylinder along z, centred at its origin. radius and length in metres."""
 
@@ -34,7 +34,7 @@ class Cylinder:
     extra_attrs: Attrs = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Sphere:
     """A sphere centred at its origin. radius in metres."""
 
@@ -146,7 +146,7 @@ class MaterialPart:
 MeshOp = ReflectMesh | ConvexHull | JoinShapes | ReduceMesh | ScaleMesh | ConvexPart | MaterialPart
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Mesh:
     """A triangle mesh.
 

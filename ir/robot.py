@@ -41,7 +41,7 @@ JOINT_TYPES: tuple[str, ...] = JointType.__args__  # type: ignore[attr-defined]
 ZERO: Vec3 = (0.0, 0.0, 0.0)
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class Pose:
     """X_PC as URDF writes it: origin of C in P (xyz, metres) and fixed-axis rpy (radians).
 
@@ -56,7 +56,7 @@ class Pose:
 IDENTITY = Pose(written=(False, False))
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Inertia:
     """The rotational inertia about the COM, in the inertial frame (kg·m²)."""
 
@@ -68,7 +68,7 @@ class Inertia:
     izz: float
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Inertial:
     """Mass properties: origin is the COM frame in the link frame; mass in kg."""
 
@@ -78,7 +78,7 @@ class Inertial:
     extras: tuple[Fragment, ...] = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Material:
     """A named material: rgba colour (0..1 each) and/or a texture filename.
 
@@ -99,7 +99,7 @@ class Material:
     span: Span | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Visual:
     """A visual shape of a link.
 
@@ -119,7 +119,7 @@ class Visual:
     span: Span | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Collision:
     """A collision shape of a link."""
 
@@ -134,7 +134,7 @@ class Collision:
     span: Span | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Link:
     """A rigid body. visuals and collisions keep their source order."""
 
@@ -150,7 +150,7 @@ class Link:
     span: Span | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Limit:
     """Joint limits: position (lower, upper; rad or m), effort (N·m or N), velocity."""
 
@@ -161,7 +161,7 @@ class Limit:
     extra_attrs: Attrs = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Dynamics:
     """Viscous damping and Coulomb friction of a joint."""
 
@@ -170,7 +170,7 @@ class Dynamics:
     extra_attrs: Attrs = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Mimic:
     """This joint follows `joint`: q = multiplier · q_joint + offset."""
 
@@ -179,7 +179,7 @@ class Mimic:
     offset: float | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Calibration:
     """Reference positions of the joint's calibration switches."""
 
@@ -188,7 +188,7 @@ class Calibration:
     reference_position: float | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class SafetyController:
     """Soft limits and gains of the joint's safety controller."""
 
@@ -198,7 +198,7 @@ class SafetyController:
     soft_upper_limit: float | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Joint:
     """A joint from `parent` to `child`; origin is X_PJ, the joint frame in the parent.
 
@@ -224,7 +224,7 @@ class Joint:
     span: Span | None = None
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Robot:
     """A robot model: a tree of links connected by joints.
 

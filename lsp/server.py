@@ -5,7 +5,8 @@ A change is checked after a short quiet time (debounce; `mpc lsp --debounce-ms`,
 so that a burst of keystrokes is checked once; a request (completion, hover…) checks a pending
 change first, so it always sees the buffer as it is. After a file is checked, the open files
 whose check read it (as their `defaults` chain, as a derived_base parent) are checked again.
-Input models stay in one ModelCache for the server's life, re-read only when their file changes.
+Input models stay in one ModelCache (bounded; their spans found as they enter, so no parse
+stays alive), re-read only when their file changes.
 """
 
 from __future__ import annotations

@@ -28,8 +28,6 @@ that takes mappings, a list to the one that takes lists, and a union of nodes by
 costs no schema building: `mpc check` starts cold on every save of an editor.
 """
 
-import sys
-import types
 import typing
 from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
@@ -52,21 +50,6 @@ from mpc.core.span import Span
 from mpc.core.yaml_source import Document, Path_
 
 KEY = "\x00key\x00"  # stands for the key in a message made before the key is known
-
-
-def _no_plugins() -> None:
-    """pydantic asks the installed packages for plugins (entry points) when it builds the
-    first validator; importing importlib.metadata for that is a tenth of a cold `mpc check`.
-    The language takes no plugin, and another package's must not change how it validates:
-    pydantic's plugin loader is given none (it is only asked `get_plugins()`)."""
-    name = "pydantic.plugin._loader"
-    if name not in sys.modules:
-        loader = types.ModuleType(name, "mpc: no pydantic plugins (compiler/schema/base.py)")
-        loader.get_plugins = lambda: ()  # type: ignore[attr-defined]
-        sys.modules[name] = loader
-
-
-_no_plugins()
 
 
 def problem(text: str, code: str = "E0203", *, at: str = "value", sub: str | None = None,

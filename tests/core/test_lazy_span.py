@@ -8,6 +8,7 @@ import copy
 import dataclasses
 import gc
 import pickle
+import types
 import weakref
 from pathlib import Path
 
@@ -15,8 +16,8 @@ import pytest
 
 from mpc.backends import sdf_reader, urdf
 from mpc.backends.xml import XmlSource
-from mpc.core.diagnostics import Sink
-from mpc.core.span import LazySpan, Span, lazy_span
+from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.span import LazySpan, Span, lazy_span, settle_spans
 
 URDF = b"""<robot name="r">
   <link name="base">
@@ -153,3 +154,16 @@ def test_the_sdf_reader_finds_no_span_until_asked_and_then_the_eager_one(tmp_pat
     spans = [robot.span, robot.links["base"].span, robot.links["arm"].span, robot.joints["j"].span]
     assert all(type(s) is LazySpan and not _set_slots(s) for s in spans)
     assert [(s.line, s.col, s.end_col) for s in spans] == [(2, 3, 9), (3, 5, 10), (4, 5, 10), (7, 5, 11)]
+
+
+def test_settle_spans_finds_every_lazy_span_however_nested_and_lets_the_finders_go() -> None:
+    finders = [Finder(Span("a.urdf", n, 2, n, 4)) for n in range(1, 6)]
+    spans = [lazy_span("a.urdf", f) for f in finders]
+    watched = [weakref.ref(f) for f in finders]
+    value = {"k": (spans[0], [spans[1]]), "view": types.MappingProxyType({"x": [(spans[2],)]}),
+             "record": Diagnostic(Severity.ERROR, "E0414", "m", spans[3], notes=((spans[4], "n"),))}
+    del finders
+    assert settle_spans(value) == 5 and settle_spans(value) == 0
+    gc.collect()
+    assert all(w() is None for w in watched)
+    assert [(s.line, s.col, s.end_col) for s in spans] == [(n, 2, 4) for n in range(1, 6)]

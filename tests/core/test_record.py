@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+from pathlib import Path
 
 import pytest
 
-from mpc.core.record import maker, record
+from mpc.core import record as record_module
+from mpc.core.record import bulk_records, maker, record
 from mpc.core.span import Span
 from mpc.ir.geometry import Box
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class Pair:
     a: int
     b: tuple[str, ...] = ()
@@ -55,7 +57,7 @@ def test_ir_values_print_as_before() -> None:
     assert repr(box) == "Box(size=(1.0, 2.0, 3.0), extra_attrs=())"
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class Mixed:
     a: int
     b: str = "b"
@@ -67,12 +69,12 @@ class Mixed:
             raise ValueError("a must not be negative")
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class Child(Mixed):
     e: float = 0.5
 
 
-@record(slots=True)
+@record(slots=True, bulk=True)
 class WithInitVar:
     a: int
     scale: dataclasses.InitVar[int] = 1
@@ -123,5 +125,106 @@ def test_makers_make_what_the_class_makes() -> None:
         make(1).a = 2  # type: ignore[misc]
     assert hash(maker(Pair)(a=1)) == hash(Pair(a=1))
     assert maker(Child) is Child and maker(WithInitVar) is WithInitVar
-    assert maker(One) is One
     assert maker(Span)("f", 3, 4, 1, 1) == Span("f", 3, 4, 1, 1) == Span("f", 3, 4, 3, 4)  # __post_init__
+
+
+@record(slots=True)
+class Plain:
+    a: int
+    b: str = "b"
+
+
+def test_only_records_made_in_bulk_read_dataclass_internals() -> None:
+    """A record that did not opt in (bulk=True) keeps dataclass's own __init__, and has no maker."""
+    assert Plain(1) == Plain(a=1, b="b") and Plain(1) != Plain(2)
+    assert Plain.__init__.__code__.co_filename == "<string>"  # dataclass's, not record's
+    for cls in (Plain, One):
+        with pytest.raises(TypeError, match="is not made in bulk"):
+            maker(cls)
+    with pytest.raises(TypeError, match="needs slots"):
+        record(bulk=True)
+
+
+# The opt-in list: what the URDF reader makes by the thousand (backends/urdf_reader.py
+# _makers) and the spans of every file read (backends/xml.py).
+BULK = {"Pose", "Fragment", "FragmentRef", "Robot", "Link", "Inertial", "Inertia", "Box", "Cylinder",
+        "Sphere", "Mesh", "Visual", "Collision", "Material", "Joint", "Limit", "Dynamics", "Mimic",
+        "Calibration", "SafetyController", "Span"}
+
+
+def test_every_class_made_in_bulk_gets_its_fast_init_and_maker_on_this_python() -> None:
+    """What reads dataclass's internals still understands them on this Python (run this file on
+    each supported version: it needs only lxml and pytest, `--noconftest`): each class of the
+    opt-in list gets record's __init__ and a maker, not the fallback to dataclass's."""
+    from mpc.backends import urdf_reader
+
+    urdf_reader._makers()  # the reader's makers: every class it asks for must be on the list
+    ours = {cls for cls in bulk_records() if cls.__module__.startswith("mpc.")}
+    assert {cls.__qualname__ for cls in ours} == BULK
+    for cls in sorted(ours, key=lambda c: c.__qualname__):
+        slow = cls.__init__.__wrapped__
+        assert record_module._fast_init(cls, slow) is not slow, cls
+        make = maker(cls)
+        assert make is not cls and make.__qualname__ == f"{cls.__qualname__}.make", cls
+        assert _parameters(make) == _parameters(slow)[1:], cls  # the same, less `self`
+
+
+def _parameters(function: object) -> list[tuple[str, object, object]]:
+    return [(p.name, p.kind, p.default) for p in inspect.signature(function).parameters.values()]  # type: ignore[arg-type]
+
+
+FULL = """<robot name="r" xmlns:x="urn:x">
+  <material name="grey"><color rgba="0.5 0.5 0.5 1"/></material>
+  <link name="base">
+    <inertial><origin xyz="0 0 0.1" rpy="0 0 0"/><mass value="2"/>
+      <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <visual><geometry><mesh filename="base.stl" scale="1 1 1"/></geometry><material name="grey"/></visual>
+    <collision><geometry><box size="1 2 3"/></geometry></collision>
+    <x:note>kept</x:note>
+  </link>
+  <link name="arm">
+    <visual><geometry><cylinder radius="0.1" length="1"/></geometry></visual>
+    <collision><geometry><sphere radius="0.2"/></geometry></collision>
+  </link>
+  <link name="twin"/>
+  <joint name="j" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="3" velocity="4"/><dynamics damping="0.1" friction="0.2"/>
+    <calibration rising="0.5"/><safety_controller k_velocity="10" soft_lower_limit="-0.9"/>
+  </joint>
+  <joint name="k" type="revolute">
+    <parent link="arm"/><child link="twin"/><limit lower="-1" upper="1" effort="3" velocity="4"/>
+    <mimic joint="j" multiplier="2"/>
+  </joint>
+  <gazebo reference="base"><plugin name="p"/></gazebo>
+</robot>
+"""
+
+
+def test_what_the_reader_makes_is_what_dataclass_s_init_makes(tmp_path: Path) -> None:
+    """Every record of a URDF read (made by the makers) equals the same record made by the
+    class call (record's __init__) and by dataclass's own __init__, for every class listed."""
+    from mpc.backends import urdf_reader
+    from mpc.core.diagnostics import Sink
+
+    path = tmp_path / "r.urdf"
+    path.write_text(FULL, encoding="utf-8")
+    robot = urdf_reader.read(path, Sink())
+    assert robot is not None
+    seen: set[str] = set()
+    stack: list[object] = [robot]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack += item.values()
+        elif isinstance(item, tuple | list):
+            stack += item
+        elif type(item) in bulk_records():
+            cls = type(item)
+            values = {f.name: getattr(item, f.name) for f in dataclasses.fields(item)}
+            by_dataclass = object.__new__(cls)
+            cls.__init__.__wrapped__(by_dataclass, **values)
+            assert item == cls(**values) == by_dataclass and repr(item) == repr(by_dataclass)
+            seen.add(cls.__qualname__)
+            stack += values.values()
+    assert seen == BULK
