@@ -392,7 +392,7 @@ class Node(BaseModel):
         plan = cls.__dict__.get("_keys")
         if plan is None:
             plan = {f.alias or n: n for n, f in cls.model_fields.items()}
-            cls._keys = plan  # type: ignore[attr-defined]
+            cls._keys = plan
         return plan
 
     @classmethod
@@ -446,9 +446,9 @@ class Node(BaseModel):
         if type(other) is not type(self):
             return NotImplemented
         return all(getattr(self, n) == getattr(other, n) for n in type(self).model_fields) \
-            and self.entries == other.entries  # type: ignore[attr-defined]
+            and self.entries == other.entries
 
-    __hash__ = None  # type: ignore[assignment]  # equal by value, and lists are not hashable
+    __hash__ = None  # equal by value, and lists are not hashable
 
     def __repr__(self) -> str:
         items = [f"{n}={getattr(self, n)!r}" for n in type(self).model_fields]
