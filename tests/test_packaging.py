@@ -18,6 +18,7 @@ import zipfile
 from pathlib import Path
 
 import jedi
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
@@ -88,6 +89,7 @@ def test_basedpyright_resolves_every_mpc_package_to_the_checkout(tmp_path: Path)
     assert revealed == ['Type of "Robot" is "type[Robot]"']
 
 
+@pytest.mark.long  # seven runs of basedpyright
 def test_the_type_check_fails_on_a_new_error_and_on_an_error_fixed_but_still_listed(tmp_path: Path) -> None:
     (tmp_path / "scripts").mkdir()
     shutil.copy(ROOT / "scripts/typecheck.sh", tmp_path / "scripts")
