@@ -42,7 +42,7 @@ def select(robot: Robot, export: JointLimitsExport, sink: Sink) -> list[str]:
             chosen = abstract_joints(robot)
         else:
             key = f"jointnames_{export.joints[0].lower()}"
-            chosen = {str(j) for sm in robot.submechanisms for j in sm.definition.get(key, ())}  # type: ignore[union-attr]
+            chosen = {str(j) for sm in robot.submechanisms for j in sm.definition.get(key, ())}
         return [j for j in movable if j in chosen]
     if export.joints == ("ACTUATED",):
         driven = {m.joint for m in robot.motors.values()}

@@ -63,7 +63,7 @@ def to_gv(robot: Robot, changed: Collection[str] | None = None) -> str:
     colour: dict[str, str] = {}
     for i, sm in enumerate(robot.submechanisms):
         for key in ("jointnames_spanningtree", "jointnames"):
-            for joint in sm.definition.get(key, ()):  # type: ignore[union-attr]
+            for joint in sm.definition.get(key, ()):
                 colour.setdefault(str(joint), PALETTE[i % len(PALETTE)])
     out = [f"digraph {_quote(robot.name)} {{", '  rankdir="TB";', '  node [fontsize=10];']
     for joint, link in depth_first(robot):

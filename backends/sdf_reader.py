@@ -374,7 +374,7 @@ class _Reader:
                 shift[j.child][:3, 3] = X_CJ[j.name][:3, 3]
         if any(X is None for X in X_M.values()):
             return None
-        X_IR = {n: X @ shift[n] if n in shift else X for n, X in X_M.items()}  # type: ignore[operator]
+        X_IR = {n: X @ shift[n] if n in shift else X for n, X in X_M.items()}
 
         def origin(j: _Joint) -> Pose:
             return matrix_pose(tf.inverse(X_IR[j.parent]) @ X_IR[j.child])
@@ -438,10 +438,10 @@ class _Reader:
             kw = {"geometry": geometry, "name": item.get("name"), "span": self.src.lazy_span(item),
                   "origin": self.local(item, name, shift, where)}
             if item.tag == "collision":
-                collisions.append(Collision(**kw, extras=self.extras(item, ("pose", "geometry"))))  # type: ignore[arg-type]
+                collisions.append(Collision(**kw, extras=self.extras(item, ("pose", "geometry"))))
                 continue
             material = self.material(item, f"{name}__{item.get('name', len(visuals))}", where)
-            visuals.append(Visual(**kw, material=material and material.name, inline_material=material,  # type: ignore[arg-type]
+            visuals.append(Visual(**kw, material=material and material.name, inline_material=material,
                                   extras=self.extras(item, ("pose", "geometry", "material", "transparency"))))
         self.keep(el, ("pose", "inertial", "visual", "collision"), name)
         return Link(name=name, inertial=inertial, visuals=tuple(visuals), collisions=tuple(collisions),

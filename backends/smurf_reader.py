@@ -216,7 +216,7 @@ class _Reader:
         s.sensors[e["name"]] = Sensor(
             name=e["name"], type=kind, link=e.get("link"), joint=e.get("joint"), frame=e.get("frame"),
             targets=tuple(targets), annotations={k: v for k, v in e.items() if k not in core},
-            **offsets)  # type: ignore[arg-type]
+            **offsets)
 
     def _poses(self, e: dict[str, Any], at: tuple[str | int, ...]) -> None:
         values = e.get("joints", {})

@@ -192,7 +192,7 @@ class _Reader:
             self.warn_unknown_attrs(el, _POSE, where)
         xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
         rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
-        pose = self.new.pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))  # type: ignore[arg-type]
+        pose = self.new.pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))
         if len(keys) == has_xyz + has_rpy and (xyz or not has_xyz) and (rpy or not has_rpy):
             self.poses[items] = pose
         return pose
@@ -386,10 +386,10 @@ class _Reader:
             self.error(el, "E0405", f"<geometry> in {where} must hold exactly one shape, found {count}")
             return None
         if shape.tag == "mesh":  # type: ignore[union-attr]
-            return self.mesh(shape, where)  # type: ignore[arg-type]
+            return self.mesh(shape, where)
         if shape.tag == "box":
             size = self.floats(shape, "size", 3, where, True)
-            return self.new.box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None  # type: ignore[arg-type]
+            return self.new.box(size=size, extra_attrs=self.extra_attrs(shape, ("size",))) if size else None
         if shape.tag == "cylinder":
             r, h = self.number(shape, "radius", where, True), self.number(shape, "length", where, True)
             if r is None or h is None:
@@ -420,7 +420,7 @@ class _Reader:
         if why:
             self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
             return None
-        return self.new.mesh(source=source, scale=scale, span=self.src.lazy_span(el, "filename"),  # type: ignore[arg-type]
+        return self.new.mesh(source=source, scale=scale, span=self.src.lazy_span(el, "filename"),
                     extra_attrs=self.extra_attrs(el, _MESH))
 
     def shape_children(self, el: etree._Element, visual: bool) -> tuple[
@@ -513,7 +513,7 @@ class _Reader:
             elif child.tag == "texture" and texture is None:
                 texture = child
         rgba = self.floats(color, "rgba", 4, f"material '{name}'", True) if color is not None else None
-        return self.new.material(name=name, rgba=rgba,  # type: ignore[arg-type]
+        return self.new.material(name=name, rgba=rgba,
                         texture=texture.get("filename", "") if texture is not None else None,
                         comments=comments, span=self.src.lazy_span(el))
 
@@ -552,8 +552,8 @@ class _Reader:
         if not ok:  # already reported; kept (as fixed) so that the tree checks do not cascade
             jtype = "fixed"
         return self.new.joint(
-            name=name, type=jtype, parent=ends["parent"], child=ends["child"],  # type: ignore[arg-type]
-            origin=self.pose(first.get("origin"), where), axis=axis, limit=limit,  # type: ignore[arg-type]
+            name=name, type=jtype, parent=ends["parent"], child=ends["child"],
+            origin=self.pose(first.get("origin"), where), axis=axis, limit=limit,
             dynamics=self.dynamics(first.get("dynamics"), where),
             mimic=self.mimic(first.get("mimic"), where),
             calibration=self.calibration(first.get("calibration"), where),

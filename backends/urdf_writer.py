@@ -52,7 +52,7 @@ class _Writer:
         if type(xs) is not tuple:  # a list: not hashable
             text = fmt_floats(xs)
         else:
-            text = self.tuple_texts.get(xs)  # type: ignore[assignment]
+            text = self.tuple_texts.get(xs)
             if text is None:
                 text = self.tuple_texts[xs] = " ".join(map(self.text, xs))
         return text if self.formats is None else self.formats(key, text)  # type: ignore[return-value]

@@ -90,7 +90,7 @@ def _recording(places: list[tuple[str, int, int]]) -> Iterator[None]:
         return Builder().parseString(text)
 
     original_parse, original_string = xml.dom.minidom.parse, xml.dom.minidom.parseString
-    xml.dom.minidom.parse, xml.dom.minidom.parseString = parse, parse_string  # type: ignore[assignment]
+    xml.dom.minidom.parse, xml.dom.minidom.parseString = parse, parse_string
     try:
         yield
     finally:

@@ -89,14 +89,14 @@ def _shape_changed(a: object, b: object, tol: Tolerances) -> bool:
         return True
     match ga:
         case Box():
-            sizes = (ga.size, gb.size)  # type: ignore[union-attr]
+            sizes = (ga.size, gb.size)
         case Cylinder():
-            sizes = ((ga.radius, ga.length), (gb.radius, gb.length))  # type: ignore[union-attr]
+            sizes = ((ga.radius, ga.length), (gb.radius, gb.length))
         case Sphere():
-            sizes = ((ga.radius,), (gb.radius,))  # type: ignore[union-attr]
+            sizes = ((ga.radius,), (gb.radius,))
         case Mesh():
-            scale = (tuple(ga.scale or (1.0, 1.0, 1.0)), tuple(gb.scale or (1.0, 1.0, 1.0)))  # type: ignore[union-attr]
-            return scale[0] != scale[1] or _mesh_digest(ga) != _mesh_digest(gb)  # type: ignore[arg-type]
+            scale = (tuple(ga.scale or (1.0, 1.0, 1.0)), tuple(gb.scale or (1.0, 1.0, 1.0)))
+            return scale[0] != scale[1] or _mesh_digest(ga) != _mesh_digest(gb)
         case _:
             return ga != gb
     return bool(np.max(np.abs(np.subtract(*sizes))) > tol.distance)

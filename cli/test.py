@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
             return 1
     else:
         result = compile_model(args.definition, sink, options)
-        program, robot, out = result.program, result.robot, result.out  # type: ignore[assignment]
+        program, robot, out = result.program, result.robot, result.out
     if program is None or robot is None or out is None:
         print_diagnostics(sink, args.format)
         print(f"error: could not compile '{args.definition}' ({summary(sink)})",

@@ -112,7 +112,7 @@ def _new_frame(ctx: LowerContext, name: str, d: FrameDef) -> Op:
     xyz = ctx.vec(src, "xyz", f"frame '{name}' xyz") or (0.0, 0.0, 0.0)
     rpy = ctx.vec(src, "rpy", f"frame '{name}' rpy") or (0.0, 0.0, 0.0)
     joint = (j.name if j is not None else d.jointname) or name
-    return ops.AddFrame(span=d.span, link=name, parent=parent or "", joint=joint,  # type: ignore[arg-type]
+    return ops.AddFrame(span=d.span, link=name, parent=parent or "", joint=joint,
                         type=(j.type if j is not None else d.type) or "fixed", xyz=xyz, rpy=rpy,
                         axis=ctx.vec(src, "axis", f"frame '{name}' axis"),
                         mass=ctx.num(d, "mass", f"frame '{name}' mass"), annotations=d.entries,

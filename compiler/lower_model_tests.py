@@ -192,7 +192,7 @@ class _TestLowering:
                 self.sink.error(span, "E0703", f"{what}: 'density' is the range of plausible densities "
                                 "[min, max] in kg/m³, 0 ≤ min < max, e.g. [100, 25000]")
                 return None
-            density = (got[0], got[1])  # type: ignore[assignment]
+            density = (got[0], got[1])
         if "inertia_factor" in settings:
             value = self.number(settings["inertia_factor"], span, f"{what} inertia_factor")
             if value is None or value < 1:
@@ -220,7 +220,7 @@ class _TestLowering:
                     self.sink.error(test.span, "E0703", f"{what}: 'plane' is the normal of the mirror "
                                     "plane, three numbers not all zero, e.g. [0, 1, 0]")
                     return None
-                plane = tuple(got)  # type: ignore[assignment]
+                plane = tuple(got)
             arg = arg.get("links")
         if not isinstance(arg, list) or len(arg) != 2 or not all(isinstance(x, str) for x in arg):
             self.sink.error(test.span, "E0703", f"{what} needs two link names [left, right], got {arg!r}")
@@ -244,7 +244,7 @@ class _TestLowering:
             angles = [self.number(v, test.span, f"{what}[{i}]") for i, v in enumerate(arg)]
             return None if None in angles else ModelTest(**base, angles=tuple(angles))  # type: ignore[arg-type]
         value = self.number(arg, test.span, what)
-        return None if value is None else ModelTest(**base, angle=value)  # type: ignore[arg-type]
+        return None if value is None else ModelTest(**base, angle=value)
 
 
 _NEEDS = {

@@ -163,7 +163,7 @@ def material_colours(path: Path) -> tuple[RGBA | None, ...]:
     try:
         data, _ = load_entry(entry)
         if data is not None:
-            return tuple(None if c is None else tuple(c) for c in json.loads(data))  # type: ignore[misc]
+            return tuple(None if c is None else tuple(c) for c in json.loads(data))
     except (OSError, ValueError, TypeError):
         pass  # unusable: computed again
     colours = tuple(colour for colour, _ in material_parts(path))

@@ -326,7 +326,7 @@ def _read(path: Path, limits: Limits) -> str:
 _CParser: Any = getattr(getattr(yaml, "cyaml", None), "CParser", None)  # None without libyaml
 
 
-class _FastComposer(*((_CParser,) if _CParser else ()), _Resolver):  # type: ignore[misc]
+class _FastComposer(*((_CParser,) if _CParser else ()), _Resolver):
     """libyaml's composer (C, about 20 times faster) with the resolver above. It counts
     nothing and composes recursively in C, so `_fast_node` lets it compose only text whose
     events (an iteration, not a recursion) stay within the limits."""

@@ -48,7 +48,7 @@ def reroot(robot: Robot, root: str) -> Robot:
     for joint in path:
         axis = joint.axis
         if joint.type not in ("fixed", "floating"):
-            axis = tuple(-x + 0.0 for x in (joint.axis or (1.0, 0.0, 0.0)))  # type: ignore[assignment]
+            axis = tuple(-x + 0.0 for x in (joint.axis or (1.0, 0.0, 0.0)))
         joints[joint.name] = replace(joint, parent=joint.child, child=joint.parent, axis=axis,
                                      origin=inverse_pose(moved[joint.child]))
     on_path = {j.name for j in path}

@@ -36,7 +36,7 @@ from mpc.ir.refs import (
 )
 
 JointType = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar"]
-JOINT_TYPES: tuple[str, ...] = JointType.__args__  # type: ignore[attr-defined]
+JOINT_TYPES: tuple[str, ...] = JointType.__args__
 
 ZERO: Vec3 = (0.0, 0.0, 0.0)
 

@@ -4,7 +4,7 @@ from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import ConfigDict
 
-from mpc.compiler.schema.base import Expr, Field, Length, Node, OneOrMore, Vec3, one_of
+from mpc.compiler.schema.base import ONE_OF, Expr, Field, Length, Node, OneOrMore, Vec3
 from mpc.compiler.schema.editing import ConstraintAxis
 
 SINGLE_LINK_SENSORS = ("Joint6DOF", "CameraSensor", "RotatingRaySensor", "IMU", "GPS")
@@ -37,7 +37,8 @@ class SensorDef(Node):
 
 
 # The section is a list of sensors or a mapping type → sensor(s); validated as the form it has.
-SensorsSection = one_of(list[SensorDef], dict[SensorType, one_of(SensorDef, list[SensorDef])])
+SensorsSection = Annotated[
+    list[SensorDef] | dict[SensorType, Annotated[SensorDef | list[SensorDef], ONE_OF]], ONE_OF]
 
 
 def sensor_entries(section: SensorsSection) -> list[tuple[str | None, SensorDef]]:
@@ -113,14 +114,14 @@ class AnnotationsSection(Node):
     SECTION: ClassVar[str] = "annotations"
     named_annotations: dict[str, dict[str, Any]] = {}
     # a mapping (the category `annotations`), or Phobos's list of [category, content] pairs
-    general_annotations: one_of(dict[str, Any], list[Annotated[list[Any], Length(2, 2)]]) = {}
+    general_annotations: Annotated[dict[str, Any] | list[Annotated[list[Any], Length(2, 2)]], ONE_OF] = {}
 
 
 class PostProcessing(Node):
     """A command run after export: an argument list, or a string run by a shell when `shell`."""
 
     SECTION: ClassVar[str] = "a post_processing command"
-    cmd: one_of(str, Annotated[list[str], Length(1)])
+    cmd: Annotated[str | Annotated[list[str], Length(1)], ONE_OF]
     cwd: str | None = None
     shell: bool = False
     executable: str | None = None

@@ -22,9 +22,9 @@ Three kinds of mapping appear in the language:
   (`ANNOTATIONS`); an annotation key close to a declared one is a warning, since it
   is most likely a typo of an operation.
 
-Unions are told apart by the shape of the data (`one_of`): a mapping goes to the member
-that takes mappings, a list to the one that takes lists, and a union of nodes by their
-`type` (`tagged`). The models build on first use (`defer_build`), so importing the schema
+Unions are told apart by the shape of the data (`Annotated[A | B, ONE_OF]`): a mapping goes
+to the member that takes mappings, a list to the one that takes lists, and a union of nodes
+by their `type` (`BY_TYPE`). The models build on first use (`defer_build`), so importing the schema
 costs no schema building: `mpc check` starts cold on every save of an editor.
 """
 
@@ -255,55 +255,69 @@ class _Shape:
         return self.exact(v)
 
 
-def one_of(*members: Any) -> Any:
-    """A union told apart by the data's shape: a list or mapping goes to the one member
-    that takes it (whose problems are then the ones shown); a scalar to the first member
-    it is exactly, else the first it converts to."""
-    shapes = [_Shape(m) for m in members]
-    wanted = " or ".join(dict.fromkeys(s.wanted for s in shapes))
+class OneOf:
+    """A union told apart by the data's shape, as `Annotated[A | B, ONE_OF]` (type checkers
+    read the union): a list or mapping goes to the one member that takes it (whose problems
+    are then the ones shown); a scalar to the first member it is exactly, else the first it
+    converts to."""
 
-    def pick(v: Any) -> str | None:
-        fitting = [i for i, s in enumerate(shapes) if s.fits(v)]
-        if len(fitting) == 1 and isinstance(v, list | dict):
-            return f"<{fitting[0]}>"
-        for test in ("exact", "takes"):
-            for i in fitting:
-                if getattr(shapes[i], test)(v):
-                    return f"<{i}>"
-        return None
+    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+        members = typing.get_args(source)
+        shapes = [_Shape(m) for m in members]
+        wanted = " or ".join(dict.fromkeys(s.wanted for s in shapes))
 
-    tagged = tuple(Annotated[m, Tag(f"<{i}>")] for i, m in enumerate(members))
-    return Annotated[typing.Union[tagged], Discriminator(  # noqa: UP007  (built at run time)
-        pick, custom_error_type="mpc_union", custom_error_message=wanted)]
+        def pick(v: Any) -> str | None:
+            fitting = [i for i, s in enumerate(shapes) if s.fits(v)]
+            if len(fitting) == 1 and isinstance(v, list | dict):
+                return f"<{fitting[0]}>"
+            for test in ("exact", "takes"):
+                for i in fitting:
+                    if getattr(shapes[i], test)(v):
+                        return f"<{i}>"
+            return None
+
+        tagged = tuple(Annotated[m, Tag(f"<{i}>")] for i, m in enumerate(members))
+        return handler.generate_schema(Annotated[typing.Union[tagged], Discriminator(  # noqa: UP007
+            pick, custom_error_type="mpc_union", custom_error_message=wanted)])
 
 
-def tagged(*members: type["Node"]) -> Any:
-    """A union of nodes told apart by their `type` literal (export entries)."""
-    tags: dict[str, type[Node]] = {}
+ONE_OF = OneOf()
 
-    def kinds() -> dict[str, type["Node"]]:  # on first use: the members may contain this union
-        if not tags:
-            tags.update((t, m) for m in members for t in typing.get_args(_type_literal(m)))
-        return tags
 
-    def check(value: Any, handler: Any) -> Any:
-        if not isinstance(value, dict):
-            raise wrong("a mapping", value)
-        kind = value.get("type")
-        known = kinds()
-        if not (isinstance(kind, str) and kind in known):
-            if kind is None:
-                raise problem("this entry has no 'type'; one of " + ", ".join(f"'{t}'" for t in known)
-                              + " is required", at="value" if "type" in value else "key",
-                              sub="type" if "type" in value else None)
-            word = members[0].TYPE_WORD
-            raise problem(f"unknown {word} '{kind}'{did_you_mean(str(kind), set(known))}", sub="type",
-                          hint=f"{word}s: " + ", ".join(known))
-        return handler(value)
+class ByType:
+    """A union of nodes told apart by their `type` literal (export entries), as
+    `Annotated[A | B, BY_TYPE]`."""
 
-    union = typing.Union[tuple(Annotated[m, Tag(m.__name__)] for m in members)]  # noqa: UP007
-    return Annotated[union, Discriminator(lambda v: kinds()[v["type"]].__name__),
-                     _Wrap(check)]
+    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+        members: tuple[type[Node], ...] = typing.get_args(source)
+        tags: dict[str, type[Node]] = {}
+
+        def kinds() -> dict[str, type[Node]]:  # on first use: the members may contain this union
+            if not tags:
+                tags.update((t, m) for m in members for t in typing.get_args(_type_literal(m)))
+            return tags
+
+        def check(value: Any, handler: Any) -> Any:
+            if not isinstance(value, dict):
+                raise wrong("a mapping", value)
+            kind = value.get("type")
+            known = kinds()
+            if not (isinstance(kind, str) and kind in known):
+                if kind is None:
+                    raise problem("this entry has no 'type'; one of " + ", ".join(f"'{t}'" for t in known)
+                                  + " is required", at="value" if "type" in value else "key",
+                                  sub="type" if "type" in value else None)
+                word = members[0].TYPE_WORD
+                raise problem(f"unknown {word} '{kind}'{did_you_mean(str(kind), set(known))}", sub="type",
+                              hint=f"{word}s: " + ", ".join(known))
+            return handler(value)
+
+        union = typing.Union[tuple(Annotated[m, Tag(m.__name__)] for m in members)]  # noqa: UP007
+        return handler.generate_schema(Annotated[union, Discriminator(
+            lambda v: kinds()[v["type"]].__name__), _Wrap(check)])
+
+
+BY_TYPE = ByType()
 
 
 class _Wrap:
@@ -361,7 +375,7 @@ class Node(BaseModel):
         plan = cls.__dict__.get("_keys")
         if plan is None:
             plan = {f.alias or n: n for n, f in cls.model_fields.items()}
-            cls._keys = plan  # type: ignore[attr-defined]
+            cls._keys = plan
         return plan
 
     @classmethod
@@ -415,9 +429,9 @@ class Node(BaseModel):
         if type(other) is not type(self):
             return NotImplemented
         return all(getattr(self, n) == getattr(other, n) for n in type(self).model_fields) \
-            and self.entries == other.entries  # type: ignore[attr-defined]
+            and self.entries == other.entries
 
-    __hash__ = None  # type: ignore[assignment]  # equal by value, and lists are not hashable
+    __hash__ = None  # equal by value, and lists are not hashable
 
     def __repr__(self) -> str:
         items = [f"{n}={getattr(self, n)!r}" for n in type(self).model_fields]

@@ -9,7 +9,7 @@ from typing import Annotated, Any, ClassVar, Literal
 from pydantic import ConfigDict
 
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
-from mpc.compiler.schema.base import Before, Expr, Field, Length, Node, OneOrMore, Vec3, one_of, str_or_list
+from mpc.compiler.schema.base import ONE_OF, Before, Expr, Field, Length, Node, OneOrMore, Vec3, str_or_list
 
 Color = Annotated[list[Expr], Length(3, 4)]
 
@@ -130,7 +130,7 @@ class MotorDef(Node):
     maxSpeed: Expr | None = None
 
 
-Active = one_of(bool, MotorDef)
+Active = Annotated[bool | MotorDef, ONE_OF]
 
 
 class ConstraintAxis(Node):
@@ -227,12 +227,12 @@ def _exclude_without_default(section: Node) -> list[tuple[str, str, str]]:
     return []
 
 
-RemoveWhat = Annotated[one_of(bool, list[str]), Before(
+RemoveWhat = Annotated[bool | list[str], ONE_OF, Before(
     lambda v: str_or_list(v) if isinstance(v, str) else v)]
 ShapeName = Literal["box", "cylinder", "sphere", "convex", "convex_decomposition", "mesh", "remove"]
 
 
-Join = one_of(bool, Literal["union"])
+Join = Annotated[bool | Literal["union"], ONE_OF]
 
 
 class CollisionDef(Node):

@@ -3,6 +3,8 @@
 from typing import Annotated, ClassVar, Literal
 
 from mpc.compiler.schema.base import (
+    BY_TYPE,
+    ONE_OF,
     Before,
     Expr,
     FileName,
@@ -10,8 +12,6 @@ from mpc.compiler.schema.base import (
     Node,
     OneOrMore,
     RelativeName,
-    one_of,
-    tagged,
 )
 
 
@@ -27,7 +27,7 @@ class _Kinematic(_Export):
 
     ALIASES: ClassVar[dict[str, str]] = {"add_floatingbase": "add_floating_base"}
     mesh_format: MeshFormat = "input_type"
-    additional_meshes: one_of(list[MeshFormat], MeshFormat) | None = None
+    additional_meshes: Annotated[list[MeshFormat] | MeshFormat, ONE_OF] | None = None
     link_in_smurf: bool = False
     include_cut_joints: bool = False
     filename_suffix: FileSuffix = ""
@@ -78,7 +78,7 @@ class RenderExport(_Export):
     geometry: Literal["visual", "collision", "both"] = "visual"
     poses: OneOrMore = ["all"]
     size: list[int] = [640, 480]
-    background: one_of(str, list[Expr]) = "white"
+    background: Annotated[str | list[Expr], ONE_OF] = "white"
 
 
 class JointLimitsExport(_Export):
@@ -106,7 +106,7 @@ class KccdExport(_Export):
     keep_urdf: bool = False
     dirname: str = "kccd"  # a folder inside the output: E0521 when lowering
     reduce_meshes: Expr | None = None
-    edit_collisions: dict[str, dict[str, one_of(int, str)]] = {}
+    edit_collisions: dict[str, dict[str, Annotated[int | str, ONE_OF]]] = {}
     braking_model: BrakingModel | None = None
     simplify_swept_from: list[str] = []
     safety_distance: Expr = 0
@@ -137,6 +137,6 @@ class SubmodelExport(_Export):
     export_config: list["ExportEntry"] | None = None
 
 
-# Told apart by `type` (compiler/schema/base.py: tagged).
-ExportEntry = tagged(UrdfExport, SdfExport, MjcfExport, SmurfExport, PdfExport, RenderExport,
-                     JointLimitsExport, KccdExport, SubmodelExport)
+# Told apart by `type` (compiler/schema/base.py: BY_TYPE).
+ExportEntry = Annotated[UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | RenderExport
+                        | JointLimitsExport | KccdExport | SubmodelExport, BY_TYPE]

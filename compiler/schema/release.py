@@ -2,7 +2,7 @@
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.base import After, Expr, Node, OneOrMore, one_of
+from mpc.compiler.schema.base import ONE_OF, After, Expr, Node, OneOrMore
 from mpc.core.diagnostics import did_you_mean
 
 TESTS = frozenset({
@@ -39,7 +39,7 @@ def _test_item(item: Any) -> Any:
     return item
 
 
-TestList = list[Annotated[one_of(str, dict[str, Any]), After(_test_item)]]
+TestList = list[Annotated[str | dict[str, Any], ONE_OF, After(_test_item)]]
 
 
 class Tolerances(Node):

@@ -479,7 +479,7 @@ class CompleteSubmechanisms(Op):
         for s in robot.submechanisms:
             for key in ("jointnames_spanningtree", "jointnames", "jointnames_independent",
                         "jointnames_active", "jointnames_dependent"):
-                covered |= set(s.definition.get(key, ()))  # type: ignore[arg-type]
+                covered |= set(s.definition.get(key, ()))
         order = [j.name for j, _ in depth_first(robot) if j is not None]
         groups: list[tuple[bool, list[str]]] = []
         group_of: dict[str, int] = {}

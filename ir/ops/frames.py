@@ -165,7 +165,7 @@ def move_frame(robot: Robot, link_name: str, T: Pose) -> Robot:
         if axis is not None or parent.type not in ("fixed", "floating"):
             axis = tuple(float(x) for x in R_inv @ (axis or (1.0, 0.0, 0.0)))
         joints[parent.name] = replace(parent, origin=compose_poses(parent.origin, T),
-                                      axis=axis)  # type: ignore[arg-type]
+                                      axis=axis)
     for name, j in robot.joints.items():
         if j.parent == link_name:
             joints[name] = replace(j, origin=compose_poses(T_inv, j.origin))

@@ -84,7 +84,7 @@ class ReplaceJointTypes(Op):
 
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         table = dict(self.mapping)
-        return replace(robot, joints={n: replace(j, type=table[j.type]) if j.type in table else j  # type: ignore[arg-type]
+        return replace(robot, joints={n: replace(j, type=table[j.type]) if j.type in table else j
                                       for n, j in robot.joints.items()})
 
 
@@ -141,7 +141,7 @@ class EditJoint(Op):
     def apply(self, robot: Robot, effects: Effects) -> Robot:
         joint = set_values(robot.joints[self.joint], self.values)
         if self.type is not None:
-            joint = replace(joint, type=self.type)  # type: ignore[arg-type]
+            joint = replace(joint, type=self.type)
         if self.axis is not None:
             joint = replace(joint, axis=self.axis)
         if self.mimic is not None:
