@@ -18,6 +18,7 @@ from __future__ import annotations
 import sys
 import types
 from collections.abc import Iterable
+from importlib.abc import Loader, MetaPathFinder
 from importlib.machinery import ModuleSpec
 
 PRIVATE = "pydantic.plugin._loader"
@@ -31,25 +32,22 @@ def _get_plugins() -> Iterable[object]:
 REPLACED = {"get_plugins": _get_plugins}
 
 
-class _StandIn:
+class _StandIn(MetaPathFinder, Loader):
     """Finds and makes the stand-in when pydantic imports its loader (a finder first on
     `sys.meta_path`): a run that never validates a definition imports nothing of pydantic."""
 
-    @staticmethod
-    def find_spec(name: str, path: object = None, target: object = None) -> ModuleSpec | None:
-        return ModuleSpec(name, _StandIn, origin=None) if name == PRIVATE else None
+    def find_spec(self, name: str, path: object = None, target: object = None) -> ModuleSpec | None:
+        return ModuleSpec(name, self, origin=None) if name == PRIVATE else None
 
-    @staticmethod
-    def create_module(spec: ModuleSpec) -> None:
+    def create_module(self, spec: ModuleSpec) -> None:
         return None  # a plain module
 
-    @staticmethod
-    def exec_module(module: types.ModuleType) -> None:
+    def exec_module(self, module: types.ModuleType) -> None:
         module.__doc__ = "mpc: no pydantic plugins (cli/pydantic_plugins.py)"
         module.__dict__.update(REPLACED)
 
 
 def install() -> None:
     """Give pydantic no plugins; nothing when pydantic's own loader is imported already."""
-    if PRIVATE not in sys.modules and _StandIn not in sys.meta_path:
-        sys.meta_path.insert(0, _StandIn)  # type: ignore[arg-type]
+    if PRIVATE not in sys.modules and not any(isinstance(f, _StandIn) for f in sys.meta_path):
+        sys.meta_path.insert(0, _StandIn())

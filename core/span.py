@@ -12,7 +12,7 @@ from collections.abc import Callable
 from functools import lru_cache
 from operator import attrgetter
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from mpc.core.files import quotable
 from mpc.core.record import is_record, record, record_values
@@ -120,7 +120,7 @@ def settle_spans(value: object) -> int:
         kind = type(item)
         if kind is LazySpan:
             if object.__getattribute__(item, "_find") is not None:
-                item.line  # noqa: B018  (asking for it finds it)
+                cast(LazySpan, item).line  # noqa: B018  (asking for it finds it)
                 found += 1
             continue
         if kind in _PLAIN or kind is Span or id(item) in seen:
