@@ -10,6 +10,7 @@ another format, is computed with trimesh (DAE through pycollada, with its unit).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
@@ -20,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
+from mpc.core.files import why_absent
 from mpc.core.numbers import zero_small
 from mpc.core.span import Span
 from mpc.ir.geometry import (
@@ -96,7 +98,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
             continue
         if not src.path.is_file():
             sink.error(span, "E0602", f"mesh file '{src.path}' of a {use.element} of link "
-                       f"'{use.link}' does not exist")
+                       f"'{use.link}' {why_absent(src.path)}")
             ok = False
             continue
         fmt = src.format if mesh_format == KEEP_FORMAT else mesh_format
@@ -182,6 +184,13 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             continue
         if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
                 and not dest.name.endswith(".mars.obj"):
+            problem = _copy_problem(src)
+            if problem is not None:
+                span, of = where(src, ops)
+                sink.error(span, "E0585", f"mesh '{src}'{of} cannot be copied into the build: {problem}",
+                           hint="export the mesh again from its modelling tool")
+                ok = False
+                continue
             plan_.append((src, dest, rel))
             continue
         try:
@@ -231,6 +240,34 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         else:
             shutil.copyfile(source, dest)  # a regular file, checked when the model was read
     return ok
+
+
+def _copy_problem(src: Path) -> str | None:
+    """Why a mesh file copied as it is would be refused by the programs that load it, or
+    None: a DAE must be well-formed XML (a STL or OBJ has no such rule to check). The
+    verdict on a file's content is kept in the cache (`verdicts/dae/`, as pipeline/verdicts.py
+    keeps its own), so that a large DAE is parsed once, not by every build that copies it."""
+    if src.suffix.lower() != ".dae":
+        return None
+    from lxml import etree
+
+    from mpc.core.cache import cache_dir, file_digest
+    from mpc.core.span import hardened_parser
+
+    try:
+        digest = file_digest(src)
+        mark = cache_dir("verdicts") / "dae" / digest[:2] / digest
+        if mark.is_file():
+            return None
+        etree.parse(str(src), hardened_parser(huge=True))
+    except etree.XMLSyntaxError as e:
+        return f"it is not well-formed XML ({e})"
+    except OSError:
+        return None  # copying it reports what cannot be read
+    with contextlib.suppress(OSError):  # a read-only cache: parsed again next time
+        mark.parent.mkdir(parents=True, exist_ok=True)
+        mark.touch()
+    return None
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:

@@ -15,8 +15,9 @@ from types import SimpleNamespace
 from lxml import etree
 
 from mpc.backends.urdf_fragments import Fragments
-from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
+from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.core.record import maker
 from mpc.core.span import Span
@@ -77,7 +78,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
     src = load(path, sink, "URDF", display)
     if src is None:
         return None
-    return _robot(src, sink, resolver, path.parent.resolve())
+    return _robot(src, sink, resolver, resolved(path.parent))
 
 
 def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
@@ -98,6 +99,9 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
     if robot is None or sink.error_count > errors_before:
         return None
     return robot
+
+
+_XML_NAMESPACE = "http://www.w3.org/XML/1998/namespace"  # the `xml:` prefix's, never declared
 
 
 class _Reader:
@@ -137,8 +141,26 @@ class _Reader:
         items = el.items()
         for item in items:
             if item[0] not in known:
-                return tuple([item for item in items if item[0] not in known])
+                extra = tuple([item for item in items if item[0] not in known])
+                return self.prefixed(el, extra) if any(k[0] == "{" for k, _ in extra) else extra
         return ()
+
+    def prefixed(self, el: etree._Element, attrs: Attrs) -> Attrs:
+        """The attributes with each namespaced name (lxml's `{uri}name`, which no XML file
+        may hold) written `prefix:name` as the file wrote it, and the declaration of each
+        prefix that `<robot>` does not declare: the URDF written keeps them well-formed."""
+        out: list[tuple[str, str]] = []
+        declare: dict[str, str] = {}
+        for key, value in attrs:
+            if key[0] == "{":
+                uri, local = key[1:].split("}", 1)
+                prefix = "xml" if uri == _XML_NAMESPACE else next(
+                    p for p, u in sorted(el.nsmap.items(), key=lambda pu: pu[0] or "") if u == uri and p)
+                key = f"{prefix}:{local}"
+                if prefix != "xml" and self.fragments.nsmap.get(prefix) != uri:
+                    declare[f"xmlns:{prefix}"] = uri
+            out.append((key, value))
+        return (*out, *sorted(declare.items()))
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -149,9 +171,9 @@ class _Reader:
             return None
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
-            values = self.numbers[text] = parse_floats(text)
-        if values is None or len(values) != n:
-            self.not_numbers(el, attr, n, where, text)
+            values = self.numbers[text] = finite_floats(text)
+        if values is None or values is NOT_FINITE or len(values) != n:
+            self.not_numbers(el, attr, n, where, text, values is NOT_FINITE)
             return None
         return values
 
@@ -165,14 +187,20 @@ class _Reader:
             return None
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
-            values = self.numbers[text] = parse_floats(text)
-        if values is None or len(values) != 1:
-            self.not_numbers(el, attr, 1, where, text)
+            values = self.numbers[text] = finite_floats(text)
+        if values is None or values is NOT_FINITE or len(values) != 1:
+            self.not_numbers(el, attr, 1, where, text, values is NOT_FINITE)
             return None
         return values[0]
 
-    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str) -> None:
+    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str,
+                    infinite: bool = False) -> None:
         what = "a number" if n == 1 else f"{n} numbers"
+        if infinite:
+            what = "a finite number" if n == 1 else f"{n} finite numbers"
+            self.error(el, "E0480", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr,
+                       hint="URDF readers (urdfdom, check_urdf) refuse nan and inf; write a finite number")
+            return
         self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr)
 
     def pose(self, el: etree._Element | None, where: str) -> Pose | None:

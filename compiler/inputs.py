@@ -13,6 +13,7 @@ from pathlib import Path
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.files import why_absent
 from mpc.core.span import Span
 from mpc.ir.geometry import Mesh
 from mpc.ir.names import Names
@@ -168,6 +169,6 @@ def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
                         hint="map the package with --package NAME=DIR or ROS_PACKAGE_PATH"))
                 elif src.path not in seen and not src.path.is_file():
                     out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{src.path}' of a "
-                                          f"{element} of link '{name}' does not exist", span))
+                                          f"{element} of link '{name}' {why_absent(src.path)}", span))
                     seen.add(src.path)
     return out

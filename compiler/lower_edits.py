@@ -20,6 +20,7 @@ from mpc.compiler.lower_context import LowerContext, items_span, pair_span
 from mpc.compiler.schema.annotations import MULTI_LINK_SENSORS, SINGLE_LINK_SENSORS, sensor_entries
 from mpc.compiler.schema.base import Node
 from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
+from mpc.core.files import resolved
 from mpc.ir import ops
 from mpc.ir.ops import Op
 
@@ -398,7 +399,7 @@ def submechanisms(ctx: LowerContext) -> list[Op]:
             ctx.sink.error(m.key_span("submechanisms_file"), "E0315", "give either "
                            "'submechanisms_file' or 'submechanisms'/'exoskeletons', not both")
             return []
-        path = (ctx.folder_of(m, "submechanisms_file") / m.submechanisms_file).resolve()
+        path = resolved(ctx.folder_of(m, "submechanisms_file") / m.submechanisms_file)
         if not path.is_file():
             ctx.sink.error(m.value_span("submechanisms_file"), "E0601",
                            f"submechanisms_file '{path}' does not exist")
