@@ -261,7 +261,7 @@ def _copy_problem(src: Path) -> str | None:
             return None
         etree.parse(str(src), hardened_parser(huge=True))
     except etree.XMLSyntaxError as e:
-        return f"it is not well-formed XML ({e})"
+        return f"it is not well-formed XML ({e.msg})"
     except OSError:
         return None  # copying it reports what cannot be read
     with contextlib.suppress(OSError):  # a read-only cache: parsed again next time

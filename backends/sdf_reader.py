@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from mpc.backends.xml import NOT_FINITE, XmlSource, finite_floats, load
+from mpc.backends.xml import NOT_FINITE, XmlSource, finite_floats, load, parse_floats
 from mpc.core.diagnostics import Sink
 from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
@@ -99,17 +99,19 @@ class _Reader:
         self.sink.error(self.src.span(el, attr), code, message)
 
     def floats(self, el: etree._Element | None, n: int, where: str) -> tuple[float, ...] | None:
-        values = finite_floats(el.text or "") if el is not None else None
-        if values is NOT_FINITE:
-            assert el is not None
+        if el is None:
+            return None
+        text = el.text or ""
+        values = finite_floats(text)
+        if values is NOT_FINITE and len(parse_floats(text) or ()) == n:
             self.error(el, "E0480", f"<{el.tag}> in {where} must be {n} finite number{'s' * (n > 1)}, "
-                       f"got '{(el.text or '').strip()}'")
+                       f"got '{text.strip()}'")
             return None
-        if el is not None and (values is None or len(values) != n):
+        if values is None or values is NOT_FINITE or len(values) != n:
             self.error(el, "E0404", f"<{el.tag}> in {where} must be {n} number{'s' * (n > 1)}, "
-                       f"got '{(el.text or '').strip()}'")
+                       f"got '{text.strip()}'")
             return None
-        return tuple(values) if values is not None else None
+        return tuple(values)
 
     def number(self, parent: etree._Element, tag: str, where: str, default: float | None = None
                ) -> float | None:

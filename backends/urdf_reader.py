@@ -15,7 +15,7 @@ from types import SimpleNamespace
 from lxml import etree
 
 from mpc.backends.urdf_fragments import Fragments
-from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load
+from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
@@ -141,14 +141,15 @@ class _Reader:
         items = el.items()
         for item in items:
             if item[0] not in known:
-                extra = tuple([item for item in items if item[0] not in known])
-                return self.prefixed(el, extra) if any(k[0] == "{" for k, _ in extra) else extra
+                return self.prefixed(el, tuple([item for item in items if item[0] not in known]))
         return ()
 
     def prefixed(self, el: etree._Element, attrs: Attrs) -> Attrs:
         """The attributes with each namespaced name (lxml's `{uri}name`, which no XML file
         may hold) written `prefix:name` as the file wrote it, and the declaration of each
         prefix that `<robot>` does not declare: the URDF written keeps them well-formed."""
+        if not any(key[0] == "{" for key, _ in attrs):
+            return attrs
         out: list[tuple[str, str]] = []
         declare: dict[str, str] = {}
         for key, value in attrs:
@@ -196,7 +197,7 @@ class _Reader:
     def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str,
                     infinite: bool = False) -> None:
         what = "a number" if n == 1 else f"{n} numbers"
-        if infinite:
+        if infinite and len(parse_floats(text) or ()) == n:
             what = "a finite number" if n == 1 else f"{n} finite numbers"
             self.error(el, "E0480", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr,
                        hint="URDF readers (urdfdom, check_urdf) refuse nan and inf; write a finite number")
@@ -234,7 +235,7 @@ class _Reader:
         items = el.items()
         if len(items) == 1 and items[0][0] == "name":
             return items[0][1], ()
-        return el.get("name"), tuple([item for item in items if item[0] not in known])
+        return el.get("name"), self.prefixed(el, tuple([item for item in items if item[0] not in known]))
 
     def sort_children(self, el: etree._Element, known: frozenset[str]
                       ) -> tuple[dict[str, etree._Element], tuple[Fragment, ...]]:
@@ -483,7 +484,8 @@ class _Reader:
         name, extra_attrs = self.named(el)
         return self.new.visual(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
-            material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            material=material, inline_material=inline,
+            geometry_attrs=self.prefixed(geometry_el, tuple(geometry_el.items())),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 
@@ -495,7 +497,7 @@ class _Reader:
         name, extra_attrs = self.named(el)
         return self.new.collision(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
-            geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            geometry_attrs=self.prefixed(geometry_el, tuple(geometry_el.items())),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 
