@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import math
 import os
+import re
 import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -244,9 +246,10 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 
 def _copy_problem(src: Path) -> str | None:
     """Why a mesh file copied as it is would be refused by the programs that load it, or
-    None: a DAE must be well-formed XML (a STL or OBJ has no such rule to check). The
-    verdict on a file's content is kept in the cache (`verdicts/dae/`, as pipeline/verdicts.py
-    keeps its own), so that a large DAE is parsed once, not by every build that copies it."""
+    None: a DAE must be well-formed XML and hold finite numbers (a STL or OBJ is read when
+    it is converted, not when it is copied). The verdict on a file's content is kept in the
+    cache (`verdicts/dae/`, as pipeline/verdicts.py keeps its own), so that a large DAE is
+    parsed once, not by every build that copies it."""
     if src.suffix.lower() != ".dae":
         return None
     from lxml import etree
@@ -259,15 +262,26 @@ def _copy_problem(src: Path) -> str | None:
         mark = cache_dir("verdicts") / "dae" / digest[:2] / digest
         if mark.is_file():
             return None
-        etree.parse(str(src), hardened_parser(huge=True))
+        data = src.read_bytes()
+        etree.fromstring(data, hardened_parser(huge=True))
     except etree.XMLSyntaxError as e:
         return f"it is not well-formed XML ({e.msg})"
     except OSError:
         return None  # copying it reports what cannot be read
+    for m in _NOT_FINITE.finditer(data):
+        if not math.isfinite(float(m[1])):
+            line = data.count(b"\n", 0, m.start(1)) + 1
+            return f"it holds a number that is not finite ('{m[1].decode()}', line {line})"
     with contextlib.suppress(OSError):  # a read-only cache: parsed again next time
         mark.parent.mkdir(parents=True, exist_ok=True)
         mark.touch()
     return None
+
+
+# A word of an XML file that may be a number that is not finite: nan, inf, or an exponent of
+# three digits (1e999 overflows), between spaces, quotes or tags.
+_NOT_FINITE = re.compile(rb"""(?:^|(?<=[\s"'>]))([-+]?(?:nan|inf(?:inity)?|\d*\.?\d+e\+?\d{3,}))"""
+                         rb"""(?=[\s"'<]|$)""", re.IGNORECASE)
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:

@@ -17,10 +17,15 @@ import contextlib
 import hashlib
 import io
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
 import trimesh
+
+# trimesh reports what it could not read through logging, with a traceback (an ASCII STL
+# whose normals do not parse); mpc reports what matters as diagnostics, so they go nowhere.
+logging.getLogger("trimesh").addHandler(logging.NullHandler())
 
 FORM = "1"  # changes when the normalized form or the readers change, so old entries go unused
 

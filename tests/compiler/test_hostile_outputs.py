@@ -7,6 +7,7 @@ input responsible, or a sound output checked by its consumer (check_urdf, expat)
 
 from __future__ import annotations
 
+import os
 import subprocess
 from pathlib import Path
 from xml.parsers import expat
@@ -16,6 +17,7 @@ import pytest
 from mpc.cli.main import main
 from tests.conftest import definition, write
 from tests.fixtures import ARM_URDF, arm
+from tests.mpc_command import mpc_process
 
 
 def _mpc(capsys: pytest.CaptureFixture[str], *args: str | Path) -> tuple[int, str]:
@@ -216,3 +218,33 @@ def test_a_dae_that_is_not_well_formed_is_not_copied_into_the_build(
             "'base' cannot be copied into the build: it is not well-formed XML (Entity 'e' not defined, "
             "line 3, column 53)") in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(("old", "new", "shown"), [
+    ('<unit meter="1"/>', '<unit meter="nan"/>', "'nan', line 3"),
+    ("<up_axis>Z_UP</up_axis>&e;", "<up_axis>Z_UP</up_axis>\n  <extra>1 -INF</extra>", "'-INF', line 4"),
+    ("<up_axis>Z_UP</up_axis>&e;", "<up_axis>Z_UP</up_axis><extra>2.5e999</extra>", "'2.5e999', line 3"),
+])
+def test_a_dae_holding_a_number_that_is_not_finite_is_not_copied_into_the_build(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], old: str, new: str, shown: str) -> None:
+    dae = NOT_WELL_FORMED_DAE.replace("&e;", "").replace(old.replace("&e;", ""), new)
+    write(tmp_path / "meshes/nan.dae", dae)
+    spec = _model(tmp_path, ARM_URDF.replace("meshes/tetra.stl", "meshes/nan.dae"))
+    code, err = _mpc(capsys, "compile", spec, "-o", tmp_path / "out")
+    assert code == 1
+    assert (f"error[E0585]: mesh '{tmp_path}/meshes/nan.dae' of a visual of link 'base' cannot be copied "
+            f"into the build: it holds a number that is not finite ({shown})") in err
+
+
+def test_an_stl_whose_normals_do_not_parse_is_read_without_a_traceback(tmp_path: Path) -> None:
+    """trimesh logs such a file with its traceback; mpc's users must never see one."""
+    facet = "facet normal {n}\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+    write(tmp_path / "meshes/n.stl", "solid s\n" + facet.format(n="0 0 1") + facet.format(n="0 0.outer")
+          + "endsolid s\n")
+    spec = _model(tmp_path, ARM_URDF.replace("meshes/tetra.stl", "meshes/n.stl"))
+    spec.write_text(spec.read_text().replace("mesh_format: input_type", "mesh_format: obj"))
+    # A process of its own: pytest's logging plugin would take the record in this one.
+    done = mpc_process("compile", spec, "-o", tmp_path / "out",
+                       env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")})
+    assert "Traceback" not in done.stderr and "failed to extract" not in done.stderr
+    assert done.returncode == 0
