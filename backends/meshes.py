@@ -278,10 +278,10 @@ def _copy_problem(src: Path) -> str | None:
     return None
 
 
-# A word of an XML file that may be a number that is not finite: nan, inf, or an exponent of
-# three digits (1e999 overflows), between spaces, quotes or tags.
-_NOT_FINITE = re.compile(rb"""(?:^|(?<=[\s"'>]))([-+]?(?:nan|inf(?:inity)?|\d*\.?\d+e\+?\d{3,}))"""
-                         rb"""(?=[\s"'<]|$)""", re.IGNORECASE)
+# A word of an XML file that may be a number that is not finite: nan, inf, an exponent of
+# three digits (1e999 overflows) or 309 digits before the point, between spaces, quotes or tags.
+_NOT_FINITE = re.compile(rb"""(?:^|(?<=[\s"'>]))([-+]?(?:nan|inf(?:inity)?|\d*\.?\d+e\+?\d{3,}"""
+                         rb"""|\d{309,}(?:\.\d*)?))(?=[\s"'<]|$)""", re.IGNORECASE)
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:

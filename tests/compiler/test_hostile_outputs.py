@@ -224,6 +224,7 @@ def test_a_dae_that_is_not_well_formed_is_not_copied_into_the_build(
     ('<unit meter="1"/>', '<unit meter="nan"/>', "'nan', line 3"),
     ("<up_axis>Z_UP</up_axis>&e;", "<up_axis>Z_UP</up_axis>\n  <extra>1 -INF</extra>", "'-INF', line 4"),
     ("<up_axis>Z_UP</up_axis>&e;", "<up_axis>Z_UP</up_axis><extra>2.5e999</extra>", "'2.5e999', line 3"),
+    ('<unit meter="1"/>', f'<unit meter="{"9" * 309}"/>', f"'{'9' * 309}', line 3"),
 ])
 def test_a_dae_holding_a_number_that_is_not_finite_is_not_copied_into_the_build(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], old: str, new: str, shown: str) -> None:
