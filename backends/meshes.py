@@ -10,8 +10,11 @@ another format, is computed with trimesh (DAE through pycollada, with its unit).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import math
 import os
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +24,7 @@ from mpc.backends.missing_packages import unfound_packages
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
+from mpc.core.files import why_absent
 from mpc.core.numbers import zero_small
 from mpc.core.packages import package_of
 from mpc.core.span import Span
@@ -122,7 +126,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
             continue
         if not src.path.is_file():
             sink.error(span, "E0602", f"mesh file '{src.path}' of a {use.element} of link "
-                       f"'{use.link}' does not exist")
+                       f"'{use.link}' {why_absent(src.path)}")
             ok = False
             continue
         fmt = src.format if mesh_format == KEEP_FORMAT else mesh_format
@@ -212,6 +216,13 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             continue
         if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
                 and not dest.name.endswith(".mars.obj"):
+            problem = _copy_problem(src)
+            if problem is not None:
+                span, of = where(src, ops)
+                sink.error(span, "E0585", f"mesh '{src}'{of} cannot be copied into the build: {problem}",
+                           hint="export the mesh again from its modelling tool")
+                ok = False
+                continue
             plan_.append((src, dest, rel))
             continue
         try:
@@ -261,6 +272,46 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         else:
             copy_file(source, dest)  # a regular file, checked when the model was read
     return ok
+
+
+def _copy_problem(src: Path) -> str | None:
+    """Why a mesh file copied as it is would be refused by the programs that load it, or
+    None: a DAE must be well-formed XML and hold finite numbers (a STL or OBJ is read when
+    it is converted, not when it is copied). The verdict on a file's content is kept in the
+    cache (`verdicts/dae/`, as pipeline/verdicts.py keeps its own), so that a large DAE is
+    parsed once, not by every build that copies it."""
+    if src.suffix.lower() != ".dae":
+        return None
+    from lxml import etree
+
+    from mpc.core.cache import cache_dir, file_digest
+    from mpc.core.span import hardened_parser
+
+    try:
+        digest = file_digest(src)
+        mark = cache_dir("verdicts") / "dae" / digest[:2] / digest
+        if mark.is_file():
+            return None
+        data = src.read_bytes()
+        etree.fromstring(data, hardened_parser(huge=True))
+    except etree.XMLSyntaxError as e:
+        return f"it is not well-formed XML ({e.msg})"
+    except OSError:
+        return None  # copying it reports what cannot be read
+    for m in _NOT_FINITE.finditer(data):
+        if not math.isfinite(float(m[1])):
+            line = data.count(b"\n", 0, m.start(1)) + 1
+            return f"it holds a number that is not finite ('{m[1].decode()}', line {line})"
+    with contextlib.suppress(OSError):  # a read-only cache: parsed again next time
+        mark.parent.mkdir(parents=True, exist_ok=True)
+        mark.touch()
+    return None
+
+
+# A word of an XML file that may be a number that is not finite: nan, inf, an exponent of
+# three digits (1e999 overflows) or 309 digits before the point, between spaces, quotes or tags.
+_NOT_FINITE = re.compile(rb"""(?:^|(?<=[\s"'>]))([-+]?(?:nan|inf(?:inity)?|\d*\.?\d+e\+?\d{3,}"""
+                         rb"""|\d{309,}(?:\.\d*)?))(?=[\s"'<]|$)""", re.IGNORECASE)
 
 
 def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:

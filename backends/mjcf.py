@@ -112,6 +112,25 @@ def principal(inertial: Inertial) -> tuple[tuple[float, float, float], Quat]:
     return d, _quat_matrix(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
 
 
+def unusable_inertial(inertial: Inertial) -> str | None:
+    """Why MuJoCo cannot be given this inertial at all, or None: a number that is not finite
+    (a definition's `.inf`, or a product that overflowed), or an inertia so large that its
+    principal moments are not finite numbers (eigh overflows, or does not converge)."""
+    i = inertial.inertia
+    xyz = inertial.origin.xyz if inertial.origin is not None else (0.0, 0.0, 0.0)
+    numbers = (inertial.mass, i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz, *xyz)
+    if not all(math.isfinite(x) for x in numbers):
+        return "its mass, inertia or centre of mass holds a number that is not finite"
+    try:
+        moments = np.linalg.eigvalsh(np.array([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz],
+                                               [i.ixz, i.iyz, i.izz]]))
+    except np.linalg.LinAlgError:
+        moments = np.array([math.nan])
+    if not np.isfinite(moments).all():
+        return "its inertia is too large for its principal moments to be numbers (they overflow)"
+    return None
+
+
 def _mass_ok(inertial: Inertial | None) -> bool:
     return inertial is not None and inertial.mass >= MJMINVAL and min(principal(inertial)[0]) >= MJMINVAL
 
@@ -505,6 +524,13 @@ def _diagnose(robot: Robot, sink: Sink, span: Span) -> bool:
                    f"deep (down to link '{deepest}'), and MuJoCo's XML reader refuses elements nested "
                    f"deeper than {MAX_BODY_DEPTH} bodies; no MJCF is written",
                    hint="export this model as URDF or SDF, or cut it into submodels")
+        return False
+    unusable = [(link, problem) for link, body in robot.links.items() if body.inertial is not None
+                and (problem := unusable_inertial(body.inertial)) is not None]
+    for link, problem in unusable:
+        sink.error(robot.links[link].span or span, "E0586", f"link '{link}' has an inertial MuJoCo "
+                   f"cannot hold: {problem}; no MJCF is written", hint="fix its <inertial>")
+    if unusable:
         return False
     check(robot, sink, span)
     missing = left_out(robot)

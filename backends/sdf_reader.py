@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from mpc.backends.xml import XmlSource, load, parse_floats
+from mpc.backends.xml import NOT_FINITE, XmlSource, finite_floats, load, parse_floats
 from mpc.core.diagnostics import Sink
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
@@ -58,7 +59,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     if src is None:
         return None
     errors_before = sink.error_count
-    robot = _Reader(src, sink, resolver or PackageResolver(), path.parent.resolve()).robot()
+    robot = _Reader(src, sink, resolver or PackageResolver(), resolved(path.parent)).robot()
     return None if robot is None or sink.error_count > errors_before else robot
 
 
@@ -98,12 +99,19 @@ class _Reader:
         self.sink.error(self.src.span(el, attr), code, message)
 
     def floats(self, el: etree._Element | None, n: int, where: str) -> tuple[float, ...] | None:
-        values = parse_floats(el.text or "") if el is not None else None
-        if el is not None and (values is None or len(values) != n):
-            self.error(el, "E0404", f"<{el.tag}> in {where} must be {n} number{'s' * (n > 1)}, "
-                       f"got '{(el.text or '').strip()}'")
+        if el is None:
             return None
-        return tuple(values) if values is not None else None
+        text = el.text or ""
+        values = finite_floats(text)
+        if values is NOT_FINITE and len(parse_floats(text) or ()) == n:
+            self.error(el, "E0480", f"<{el.tag}> in {where} must be {n} finite number{'s' * (n > 1)}, "
+                       f"got '{text.strip()}'")
+            return None
+        if values is None or values is NOT_FINITE or len(values) != n:
+            self.error(el, "E0404", f"<{el.tag}> in {where} must be {n} number{'s' * (n > 1)}, "
+                       f"got '{text.strip()}'")
+            return None
+        return tuple(values)
 
     def number(self, parent: etree._Element, tag: str, where: str, default: float | None = None
                ) -> float | None:
@@ -455,8 +463,8 @@ class _Reader:
         for tag, key in _COLOURS.items():
             if (colour_el := el.find(tag) if el is not None else None) is None:
                 continue
-            values = parse_floats(colour_el.text or "")
-            if values is None or len(values) not in (3, 4):
+            values = finite_floats(colour_el.text or "")
+            if values is None or values is NOT_FINITE or len(values) not in (3, 4):
                 self.error(colour_el, "E0404", f"<{tag}> in {where} must be 3 or 4 numbers")
             else:
                 colours[key] = tuple(values) + (1.0,) * (4 - len(values))

@@ -16,8 +16,9 @@ from types import SimpleNamespace
 from lxml import etree
 
 from mpc.backends.urdf_fragments import Fragments
-from mpc.backends.xml import XmlError, XmlSource, load, parse_floats
+from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load, parse_floats
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.core.record import maker
 from mpc.core.span import Span
@@ -81,7 +82,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
     src = load(path, sink, "URDF", display)
     if src is None:
         return None
-    return _robot(src, sink, resolver, path.parent.resolve())
+    return _robot(src, sink, resolver, resolved(path.parent))
 
 
 def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
@@ -102,6 +103,9 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
     if robot is None or sink.error_count > errors_before:
         return None
     return robot
+
+
+_XML_NAMESPACE = "http://www.w3.org/XML/1998/namespace"  # the `xml:` prefix's, never declared
 
 
 class _Reader:
@@ -141,8 +145,27 @@ class _Reader:
         items = el.items()
         for item in items:
             if item[0] not in known:
-                return tuple([item for item in items if item[0] not in known])
+                return self.prefixed(el, tuple([item for item in items if item[0] not in known]))
         return ()
+
+    def prefixed(self, el: etree._Element, attrs: Attrs) -> Attrs:
+        """The attributes with each namespaced name (lxml's `{uri}name`, which no XML file
+        may hold) written `prefix:name` as the file wrote it, and the declaration of each
+        prefix that `<robot>` does not declare: the URDF written keeps them well-formed."""
+        if not any(key[0] == "{" for key, _ in attrs):
+            return attrs
+        out: list[tuple[str, str]] = []
+        declare: dict[str, str] = {}
+        for key, value in attrs:
+            if key[0] == "{":
+                uri, local = key[1:].split("}", 1)
+                prefix = "xml" if uri == _XML_NAMESPACE else next(
+                    p for p, u in sorted(el.nsmap.items(), key=lambda pu: pu[0] or "") if u == uri and p)
+                key = f"{prefix}:{local}"
+                if prefix != "xml" and self.fragments.nsmap.get(prefix) != uri:
+                    declare[f"xmlns:{prefix}"] = uri
+            out.append((key, value))
+        return (*out, *sorted(declare.items()))
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -153,9 +176,9 @@ class _Reader:
             return None
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
-            values = self.numbers[text] = parse_floats(text)
-        if values is None or len(values) != n:
-            self.not_numbers(el, attr, n, where, text)
+            values = self.numbers[text] = finite_floats(text)
+        if values is None or values is NOT_FINITE or len(values) != n:
+            self.not_numbers(el, attr, n, where, text, values is NOT_FINITE)
             return None
         return values
 
@@ -169,14 +192,20 @@ class _Reader:
             return None
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
-            values = self.numbers[text] = parse_floats(text)
-        if values is None or len(values) != 1:
-            self.not_numbers(el, attr, 1, where, text)
+            values = self.numbers[text] = finite_floats(text)
+        if values is None or values is NOT_FINITE or len(values) != 1:
+            self.not_numbers(el, attr, 1, where, text, values is NOT_FINITE)
             return None
         return values[0]
 
-    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str) -> None:
+    def not_numbers(self, el: etree._Element, attr: str, n: int, where: str, text: str,
+                    infinite: bool = False) -> None:
         what = "a number" if n == 1 else f"{n} numbers"
+        if infinite and len(parse_floats(text) or ()) == n:
+            what = "a finite number" if n == 1 else f"{n} finite numbers"
+            self.error(el, "E0480", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr,
+                       hint="URDF readers (urdfdom, check_urdf) refuse nan and inf; write a finite number")
+            return
         self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr)
 
     def pose(self, el: etree._Element | None, where: str) -> Pose | None:
@@ -210,7 +239,7 @@ class _Reader:
         items = el.items()
         if len(items) == 1 and items[0][0] == "name":
             return items[0][1], ()
-        return el.get("name"), tuple([item for item in items if item[0] not in known])
+        return el.get("name"), self.prefixed(el, tuple([item for item in items if item[0] not in known]))
 
     def sort_children(self, el: etree._Element, known: frozenset[str]
                       ) -> tuple[dict[str, etree._Element], tuple[Fragment, ...]]:
@@ -485,7 +514,8 @@ class _Reader:
         name, extra_attrs = self.named(el)
         return self.new.visual(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
-            material=material, inline_material=inline, geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            material=material, inline_material=inline,
+            geometry_attrs=self.prefixed(geometry_el, tuple(geometry_el.items())),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 
@@ -497,7 +527,7 @@ class _Reader:
         name, extra_attrs = self.named(el)
         return self.new.collision(
             geometry=geometry, name=name, origin=self.pose(origin_el, where),
-            geometry_attrs=tuple(geometry_el.items()),  # type: ignore[union-attr]
+            geometry_attrs=self.prefixed(geometry_el, tuple(geometry_el.items())),  # type: ignore[union-attr]
             extra_attrs=extra_attrs, extras=extras, span=self.src.lazy_span(el),
         )
 

@@ -304,6 +304,18 @@ def parse_floats(text: str | None) -> tuple[float, ...] | None:
         return None
 
 
+NOT_FINITE = (math.nan,)  # finite_floats: numbers, one of them nan or ±inf
+
+
+def finite_floats(text: str | None) -> tuple[float, ...] | None:
+    """parse_floats(text), or NOT_FINITE when a number is nan or ±inf: URDF's and SDFormat's
+    readers refuse them, so an input holding one is refused where it is read (E0480)."""
+    values = parse_floats(text)
+    if values is not None and not all(map(math.isfinite, values)):
+        return NOT_FINITE
+    return values
+
+
 def write_path(path: Path, data: str) -> None:
     """Write a text output file (core/files.py: all or nothing)."""
     from mpc.core.files import write_atomic

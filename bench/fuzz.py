@@ -2,11 +2,14 @@
 
     python bench/fuzz.py [--minutes 10] [--cases N] [--seed 1]
 
-Each case mutates one input (definition, pipeline file, URDF, SDF, SMURF; tests/fuzzing.py)
-with 1–4 hostile edits and runs `mpc compile` (`mpc run` or `mpc check` for pipelines) in
-process. Prints the cases tried, exit codes by count, cases per kind, and every internal
-error or broken invariant (exit 3, a traceback, a file outside `-o`) with its edits; exits 1
-if there was any.
+Each case mutates one input (definition, pipeline file, URDF, SDF, SMURF, an STL, OBJ or DAE
+mesh, a symbolic link loop, MJCF inertias; tests/fuzzing.py) with 1–4 hostile edits and runs
+`mpc compile` (`mpc run` or `mpc check` for pipelines) in process, one case at a time. Every
+file an accepted case wrote is checked: well-formed, finite numbers, and (in batches of
+--batch cases) every URDF by check_urdf, one SDF in --sdf-every by `ign sdf -k`. Prints the
+cases tried, exit codes by count, cases per kind, outputs checked, and every internal error,
+broken invariant (exit 3, a traceback, a file outside `-o`) or invalid output with its
+edits; exits 1 if there was any.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from tests.fuzzing import KINDS, OPS, TOKENS, Edit, Seeds, run_case
+from tests.fuzzing import KINDS, OPS, TOKENS, Edit, Outputs, Seeds, run_case
 
 
 def main() -> int:
@@ -29,6 +32,8 @@ def main() -> int:
     parser.add_argument("--minutes", type=float, default=10.0)
     parser.add_argument("--cases", type=int, default=0, help="stop after N cases (0: the time decides)")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--batch", type=int, default=200, help="check the kept URDFs and SDFs every N cases")
+    parser.add_argument("--sdf-every", type=int, default=20, help="check one SDF in N with `ign sdf -k`")
     args = parser.parse_args()
     rnd = random.Random(args.seed)
     codes: Counter[int] = Counter()
@@ -39,6 +44,8 @@ def main() -> int:
         seeds = Seeds.make(Path(work))
         base = Path(work) / "a/b/cases"
         base.mkdir(parents=True)
+        outputs = Outputs(Path(work) / "kept", sdf_every=args.sdf_every)
+        refused: list[str] = []
         n = 0
         while time.monotonic() < stop and (not args.cases or n < args.cases):
             kind = KINDS[n % len(KINDS)]
@@ -49,20 +56,27 @@ def main() -> int:
             n += 1
             kinds[kind] += 1
             try:
-                codes[run_case(seeds, base, kind, edits, command)] += 1
+                codes[run_case(seeds, base, kind, edits, command, outputs)] += 1
             except AssertionError as e:
                 codes[3] += 1
                 failures.append(f"{kind} {command} {edits}: {str(e)[:2000]}")
             except Exception as e:
                 codes[3] += 1
                 failures.append(f"{kind} {command} {edits}: {type(e).__name__}: {e}")
+            if n % args.batch == 0:
+                refused += outputs.consumers_refuse()
+        refused += outputs.consumers_refuse()
     print(f"cases tried: {n}")
     print("exit codes: " + ", ".join(f"{code}: {count}" for code, count in sorted(codes.items())))
     print("cases per kind: " + ", ".join(f"{k}: {c}" for k, c in sorted(kinds.items())))
     print(f"internal errors or broken invariants: {len(failures)}")
     for failure in failures[:20]:
         print("  " + failure)
-    return 1 if failures else 0
+    print(f"output files checked: {outputs.files}; not well-formed or not finite: {len(outputs.invalid)}; "
+          f"refused by check_urdf or ign sdf -k: {len(refused)}")
+    for problem in (outputs.invalid + refused)[:20]:
+        print("  " + problem)
+    return 1 if failures or outputs.invalid or refused else 0
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from mpc.core.diagnostics import Sink
+from mpc.core.files import resolved
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
@@ -103,7 +104,7 @@ def load_built(program: Program, built: Path, robot: Robot | None) -> tuple[Mode
     if robot is not None:
         submechanisms = robot.submechanisms
         if not submechanisms and robot.submechanisms_file:  # a file used as it is
-            folder = Path(program.span.file).resolve().parent
+            folder = resolved(program.span.file).parent
             submechanisms = read_submechanisms(folder / robot.submechanisms_file) or ()
         read = replace(read, cut_joints=read.cut_joints or robot.cut_joints, motors=robot.motors,
                        submechanisms=submechanisms, poses=robot.poses, sensors=robot.sensors)

@@ -18,6 +18,7 @@ from mpc.checks.pictures import VisualDiff
 from mpc.checks.protocol import Protocol, Result, failed
 from mpc.checks.registry import DYNAMICS_CHECKS, TESTS, Context
 from mpc.core.diagnostics import Sink
+from mpc.core.files import resolved
 from mpc.ir.program import ModelTest, PdfExport, Program, TestPlan
 from mpc.ir.robot import Robot
 
@@ -29,7 +30,7 @@ def apply_program(program: Program, sink: Sink) -> Robot | None:
     from mpc.compiler.driver import Options
     from mpc.compiler.front_end import apply, input_loader
 
-    loader = input_loader(sink, Options(), (Path(program.span.file).resolve(),))
+    loader = input_loader(sink, Options(), (resolved(program.span.file),))
     return apply(program, sink, loader)
 
 

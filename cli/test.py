@@ -9,6 +9,7 @@ import tempfile
 from pathlib import Path
 
 from mpc.cli.output import print_diagnostics, resolver_of, sink_of, summary
+from mpc.core.files import resolved
 
 
 def run(args: argparse.Namespace) -> int:
@@ -20,7 +21,7 @@ def run(args: argparse.Namespace) -> int:
     sink = sink_of(args)
     options = Options(out=args.out, resolver=resolver_of(args))
     if args.built is not None:
-        loader = input_loader(sink, options, (args.definition.resolve(),))
+        loader = input_loader(sink, options, (resolved(args.definition),))
         program = load_program(args.definition, sink, options, loader=loader)
         robot = apply(program, sink, loader) if program is not None else None
         out = args.built

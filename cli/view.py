@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from mpc.core.diagnostics import Sink
+from mpc.core.files import resolved
 from mpc.core.span import Span
 
 if TYPE_CHECKING:
@@ -41,7 +42,7 @@ def load_model(path: Path, sink: Sink, package: dict[str, Path] | None = None) -
     from mpc.core.packages import PackageResolver
 
     options = Options(resolver=PackageResolver(package_map=dict(package or {})))
-    loader = InputLoader(sink, options, (path.resolve(),))
+    loader = InputLoader(sink, options, (resolved(path),))
     program = load_program(path, sink, options, loader=loader)
     return apply(program, sink, loader) if program is not None else None
 

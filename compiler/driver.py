@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Severity, Sink
-from mpc.core.files import NotAFileName, OutsideOutput, confined, describe
+from mpc.core.files import NotAFileName, OutsideOutput, confined, describe, resolved
 from mpc.core.profile import stage
 from mpc.core.span import Span
 
@@ -309,7 +309,7 @@ def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Progra
     from mpc.compiler.front_end import apply, input_loader, load_program
 
     try:
-        loader = input_loader(sink, options, (path.resolve(),))
+        loader = input_loader(sink, options, (resolved(path),))
         program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
         if program is None:
             return None, None

@@ -20,7 +20,7 @@ from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Severity, Sink
-from mpc.core.files import describe
+from mpc.core.files import describe, resolved
 from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
@@ -49,10 +49,10 @@ def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severi
     ast = schema.validate(doc, sink)                                      # validate schema
     if ast is None:
         return None
-    program = lower(ast, path.resolve().parent, sink, options.resolver, later)  # lower
+    program = lower(ast, resolved(path).parent, sink, options.resolver, later)  # lower
     if program is None or not passes:
         return None if sink.has_errors() else program
-    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    loader = loader or input_loader(sink, options, (resolved(path),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later, loader.name_span))  # run passes
     loader.report_missing_meshes()                                        # check: mesh files
     return None if sink.has_errors() else program
@@ -107,7 +107,7 @@ def load_program(path: Path, sink: Sink, options: Options, later: Severity = Sev
         return None
     if not passes:
         return program
-    loader = loader or input_loader(sink, options, (path.resolve(),), symbolic=later is Severity.WARNING)
+    loader = loader or input_loader(sink, options, (resolved(path),), symbolic=later is Severity.WARNING)
     program = run_passes(program, PassContext(sink, loader.names, later, loader.name_span))  # run passes
     return None if sink.has_errors() else program
 

@@ -33,7 +33,7 @@ from typing import Any
 
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Sink, did_you_mean
-from mpc.core.files import input_problem, project_root
+from mpc.core.files import input_problem, project_root, resolved
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document, Path_
 
@@ -64,7 +64,7 @@ def resolve(doc: Document, path: Path, sink: Sink) -> Document | None:
 
 def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
     """The defaults files named from `doc`, nearest first; None after an error that ends the walk."""
-    seen: list[tuple[Path, str, Span | None]] = [(path.resolve(), "", None)]  # file, name, named at
+    seen: list[tuple[Path, str, Span | None]] = [(resolved(path), "", None)]  # file, name, named at
     chain: list[Document] = []
     roots = (project_root(path.parent),)
     current, current_path = doc, path
@@ -75,9 +75,9 @@ def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
             sink.error(at, "E0203", f"'defaults' must be the path of a defaults file, got {written!r}")
             return None
         target = current_path.parent / written
-        resolved = target.resolve()
+        real = resolved(target)
         for i, (other, _, _) in enumerate(seen):
-            if other == resolved:
+            if other == real:
                 names = [written, *(name for _, name, _ in seen[i + 1:]), written]
                 notes = tuple((span, "named here") for _, _, span in seen[i + 1:] if span is not None)
                 sink.error(at, "E0220", f"defaults cycle: {' → '.join(names)}", notes=notes)
@@ -96,7 +96,7 @@ def _chain(doc: Document, path: Path, sink: Sink) -> list[Document] | None:
         if loaded is None:
             return None
         _check_defaults_file(loaded, sink)
-        seen.append((resolved, written, at))
+        seen.append((real, written, at))
         chain.append(loaded)
         current, current_path = loaded, target
     return chain

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
-from mpc.core.files import project_root
+from mpc.core.files import project_root, why_absent
 from mpc.core.span import Span
 from mpc.ir.geometry import Mesh
 from mpc.ir.names import Names
@@ -191,6 +191,6 @@ def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
         path = mesh.source.path  # None: its package was not found (reported above)
         if path is not None and path not in seen and not path.is_file():
             out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{path}' of a {element} of "
-                                  f"link '{name}' does not exist", mesh.span or where))
+                                  f"link '{name}' {why_absent(path)}", mesh.span or where))
             seen.add(path)
     return out

@@ -17,6 +17,7 @@ from mpc.compiler.expr import evaluate
 from mpc.compiler.schema.assembly import NameEditing
 from mpc.compiler.schema.base import Node
 from mpc.core.diagnostics import Severity, Sink
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.naming import SCOPES, NameRule, bad_pattern
@@ -65,7 +66,7 @@ class LowerContext:
     def folder_of(self, node: Node, key: str) -> Path:
         """The folder of the file that wrote `key` (a defaults file, or the definition)."""
         file = node.value_span(key).file
-        return Path(file).resolve().parent if file else self.base_dir
+        return resolved(file).parent if file else self.base_dir
 
     # -- names -----------------------------------------------------------------------------
 

@@ -20,7 +20,7 @@ from mpc.compiler.lower_context import LowerContext, items_span, pair_span
 from mpc.compiler.schema.annotations import MULTI_LINK_SENSORS, SINGLE_LINK_SENSORS, sensor_entries
 from mpc.compiler.schema.base import Node
 from mpc.compiler.schema.editing import FrameDef, JointDef, MotorDef
-from mpc.core.files import input_problem, project_root
+from mpc.core.files import input_problem, project_root, resolved
 from mpc.ir import ops
 from mpc.ir.ops import Op
 
@@ -401,7 +401,7 @@ def submechanisms(ctx: LowerContext) -> list[Op]:
                            "'submechanisms_file' or 'submechanisms'/'exoskeletons', not both")
             return []
         folder = ctx.folder_of(m, "submechanisms_file")
-        path = (folder / m.submechanisms_file).resolve()
+        path = resolved(folder / m.submechanisms_file)
         if not path.is_file():
             ctx.sink.error(m.value_span("submechanisms_file"), "E0601",
                            f"submechanisms_file '{path}' does not exist")

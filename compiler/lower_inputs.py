@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from mpc.compiler.lower_context import LowerContext
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.ir.program import Input, RepoRef
 
@@ -21,7 +22,7 @@ def resolve_file(written: str, base_dir: Path, resolver: PackageResolver) -> Pat
         path, _ = resolver.locate(written, base_dir)
         if path is not None:
             return path
-    return (base_dir / written).resolve()
+    return resolved(base_dir / written)
 
 
 def lower_inputs(ctx: LowerContext) -> dict[str, Input]:
@@ -42,7 +43,7 @@ def lower_inputs(ctx: LowerContext) -> dict[str, Input]:
                               path=path, is_human=entry.is_human, xacro_args=args, xacro_env=env)
         elif entry.derived_base is not None:
             out[name] = Input(name=name, kind="derived_base", span=entry.value_span("derived_base"),
-                              path=(ctx.folder_of(entry, "derived_base") / entry.derived_base).resolve(),
+                              path=resolved(ctx.folder_of(entry, "derived_base") / entry.derived_base),
                               is_human=entry.is_human,
                               smurf_data=ctx.model.inherit_smurf_properties)
         elif entry.repo is not None:

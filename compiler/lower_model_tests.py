@@ -13,6 +13,7 @@ from typing import Any
 from mpc.compiler.expr import evaluate
 from mpc.compiler.schema.release import TestSection
 from mpc.core.diagnostics import Sink
+from mpc.core.files import resolved
 from mpc.core.span import Span
 from mpc.ir.program import DENSITY, FACTOR, CompareTarget, ModelTest, TestPlan, Tolerances
 
@@ -68,11 +69,11 @@ class _TestLowering:
         path = None
         if c.path is not None:
             file = c.value_span("path").file
-            folder = Path(file).resolve().parent if file else self.base_dir
-            path = (folder / c.path).resolve()
+            folder = resolved(file).parent if file else self.base_dir
+            path = resolved(folder / c.path)
         git = c.git or ""
         if git and "://" not in git and "@" not in git.split("/")[0] and not Path(git).is_absolute():
-            git = str((self.base_dir / git).resolve())  # a local repository next to the definition
+            git = str(resolved(self.base_dir / git))  # a local repository next to the definition
         return CompareTarget(span=c.span, git=git, path=path, branch=c.branch or "", commit=c.commit or "",
                              model_in_repo=c.model_in_repo or "",
                              submechanisms_in_repo=c.submechanisms_in_repo or "",

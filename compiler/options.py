@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.core.diagnostics import Diagnostic, Sink
+from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 
 if TYPE_CHECKING:
@@ -67,7 +68,7 @@ class ModelCache:
             stat = path.stat()
         except OSError:
             return reader(sink)  # the reader says why
-        key, stamp = (str(path.resolve()), xacro_args), (stat.st_mtime_ns, stat.st_size)
+        key, stamp = (str(resolved(path)), xacro_args), (stat.st_mtime_ns, stat.st_size)
         entry = self._models.get(key)
         if entry is None or entry[0] != stamp:
             from mpc.core.span import settle_spans

@@ -77,17 +77,36 @@ def confined(root: Path, *names: str) -> Path:
     for name in names:
         if Path(name).is_absolute() or ".." in Path(name).parts:
             raise OutsideOutput(f"'{name}' leads out of the output folder")
-    real_root = root.resolve()
-    real = path.resolve()
+    real_root = resolved(root)
+    real = resolved(path)
     if real != real_root and real_root not in real.parents:
         raise OutsideOutput(f"'{path}' resolves to '{real}', outside the output folder")
     return path
 
 
+def resolved(path: Path | str) -> Path:
+    """`Path(path).resolve()` that never raises: Python 3.11's raises RuntimeError on a
+    symlink loop, where this returns the path resolved as far as the loop (os.path.realpath),
+    so that reading it fails with an OSError (ELOOP) its reader reports against the input
+    that named it."""
+    return Path(os.path.realpath(path))
+
+
+def why_absent(path: Path | str) -> str:
+    """Why a file that is not there is not: "does not exist", or that it is a symbolic link
+    that loops (Path.is_file and Path.exists say False for both)."""
+    try:
+        os.stat(path)
+    except OSError as e:
+        if e.errno == errno.ELOOP:
+            return "is a symbolic link that loops (it never reaches a file)"
+    return "does not exist"
+
+
 def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
     """The folders whose files inputs may link to, resolved (the definitions' folders,
     --package roots, the package search path, a checkout: core/packages.py names them)."""
-    return tuple(dict.fromkeys(Path(f).resolve() for f in folders))
+    return tuple(dict.fromkeys(resolved(f) for f in folders))
 
 
 def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] | None = None,

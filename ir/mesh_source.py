@@ -17,10 +17,15 @@ import contextlib
 import hashlib
 import io
 import json
+import logging
 from pathlib import Path
 
 import numpy as np
 import trimesh
+
+# trimesh reports what it could not read through logging, with a traceback (an ASCII STL
+# whose normals do not parse); mpc reports what matters as diagnostics, so they go nowhere.
+logging.getLogger("trimesh").addHandler(logging.NullHandler())
 
 FORM = "1"  # changes when the normalized form or the readers change, so old entries go unused
 
@@ -43,9 +48,10 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
             notes = notes_file(entry)
             if ignored is not None and notes.is_file():
                 ignored.extend(notes.read_text(encoding="utf-8").splitlines())
-            return _rebuild(stored)
+            return _checked(_rebuild(stored))
         broken: list[str] = []
         mesh = _parse(path, path.suffix.lower(), broken)
+        _checked(mesh)
         if ignored is not None:
             ignored.extend(broken)
         form = _normalized(mesh)
@@ -53,6 +59,30 @@ def read(path: Path, ignored: list[str] | None = None) -> trimesh.Trimesh:
             with contextlib.suppress(OSError):  # a read-only or full cache: parsed again next time
                 _store(entry, form, broken)
         return mesh
+
+
+def geometry_problem(mesh: trimesh.Trimesh) -> str | None:
+    """Why the triangles a reader gave cannot be a mesh, or None. trimesh reads a broken
+    file (an OBJ vertex of one number, an STL or DAE coordinate `nan`) into arrays of the
+    wrong shape or into numbers that are not finite, and fails later, writing it; every
+    consumer of the written file (a DAE that holds `nan`) refuses it."""
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    if vertices.ndim != 2 or vertices.shape[1] != 3:
+        return f"its vertices are not points of 3 coordinates (an array of shape {vertices.shape})"
+    if faces.ndim != 2 or faces.shape[1] != 3:
+        return f"its triangles are not 3 vertices each (an array of shape {faces.shape})"
+    if not np.isfinite(vertices).all():
+        return "a vertex has a coordinate that is not a finite number (nan or inf)"
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+        return f"a triangle names a vertex it does not have (it has {len(vertices)})"
+    return None
+
+
+def _checked(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    problem = geometry_problem(mesh)
+    if problem is not None:
+        raise ValueError(problem)
+    return mesh
 
 
 def entry_of(content: str, name: str) -> Path:

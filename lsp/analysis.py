@@ -21,7 +21,7 @@ from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
-from mpc.core.files import describe
+from mpc.core.files import describe, resolved
 from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir.names import Names
@@ -181,7 +181,7 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
 def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, options: Options) -> None:
     """The front end and passes of front_end.front_end, keeping the program and the names per op."""
     path = analysis.path
-    loader = front_end.input_loader(sink, options, (path.resolve(),), symbolic=True)
+    loader = front_end.input_loader(sink, options, (resolved(path),), symbolic=True)
     lowered = front_end.front_end(path, sink, options, Severity.WARNING, loader, doc=doc, passes=False)
     if lowered is None:
         return

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from mpc.compiler import inherit
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
-from mpc.core.files import input_problem, project_root
+from mpc.core.files import input_problem, project_root, resolved, why_absent
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document
 from mpc.pipeline import dag, verdicts
@@ -97,7 +97,7 @@ def load_plan(path: Path, sink: Sink, root_outside: Severity | None = Severity.E
     settings = doc.data["pipeline"]
     # Relative to the pipeline file, never to the working directory (Phobos: the CWD).
     expanded = os.path.expandvars(settings.get("root", ".."))
-    root = (path.resolve().parent / expanded).resolve()  # a NUL byte stopped source.load (E0106)
+    root = resolved(resolved(path).parent / expanded)  # a NUL byte stopped source.load (E0106)
     if not root.is_dir():
         problem = "is not a folder" if root.exists() else "does not exist"
         unset = re.findall(r"\$\{?(\w+)", expanded)
@@ -120,7 +120,7 @@ def load_plan(path: Path, sink: Sink, root_outside: Severity | None = Severity.E
     derived: dict[Path, list[tuple[Path, Span]]] = {}
     for i, written in enumerate(settings["model_definitions"]):
         span = doc.value_span(("pipeline", "model_definitions", i))
-        definition = (path.resolve().parent / written).resolve()
+        definition = resolved(resolved(path).parent / written)
         if definition in by_file:
             sink.warning(span, "W0611", f"model definition '{written}' is listed twice; it is built once",
                          notes=((by_file[definition].span, "first listed here"),))
@@ -189,7 +189,7 @@ def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span
             if definition.is_dir():
                 sink.error(span, "E0601", f"model definition '{written}' is a folder, not a file")
             elif not definition.is_file():
-                sink.error(span, "E0601", f"model definition '{written}' does not exist")
+                sink.error(span, "E0601", f"model definition '{written}' {why_absent(definition)}")
             elif why := input_problem(definition, (root,)):
                 sink.error(span, "E0650", f"model definition '{written}' is not read: {why}")
         except OSError as e:  # a name too long, a loop of links
@@ -214,8 +214,8 @@ def _load_model(pipeline: Path, root: Path, written: str, definition: Path, span
         if isinstance(entry, dict) and isinstance(entry.get("derived_base"), str):
             at = doc.value_span(("model", "input_models", key, "derived_base"))
             # Relative to the file that wrote it (a defaults file, or the definition).
-            folder = Path(at.file).resolve().parent if at.file else definition.parent
-            parents.append(((folder / entry["derived_base"]).resolve(), at))
+            folder = resolved(at.file).parent if at.file else definition.parent
+            parents.append((resolved(folder / entry["derived_base"]), at))
     return model, parents
 
 

@@ -16,6 +16,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from mpc.core.files import resolved
 from mpc.pipeline import dag
 
 UNKNOWN_SECONDS = 1.0  # a model's expected time when no model of the pipeline was ever built
@@ -55,7 +56,7 @@ def sources(definition: Path, data: Any) -> frozenset[str]:
     for entry in inputs.values() if isinstance(inputs, dict) else ():
         basefile = entry.get("basefile") if isinstance(entry, dict) else None
         if isinstance(basefile, str):
-            out.add(basefile if "://" in basefile else str((definition.parent / basefile).resolve()))
+            out.add(basefile if "://" in basefile else str(resolved(definition.parent / basefile)))
     return frozenset(out)
 
 

@@ -1,5 +1,7 @@
 """Mutated inputs → one mpc run each, checked: exit 0 or 1, no traceback, nothing written
-outside `-o` (and mpc's cache). Shared by the bounded Hypothesis suite (tests/test_fuzz.py)
+outside `-o` (and mpc's cache), and every file an accepted run wrote is sound (`Outputs`:
+well-formed XML and DAE, finite numbers; URDFs for check_urdf and SDFs for `ign sdf -k`,
+collected to be checked in a batch). Shared by the bounded Hypothesis suite (tests/test_fuzz.py)
 and the long run (bench/fuzz.py); neither decides how many cases to try, this module does
 not either.
 
@@ -8,6 +10,10 @@ file that mpc reads well) and a list of edits; each edit puts a hostile token (`
 absolute path, a NUL, an alias loop, a 300-character name, an entity, a link to /proc, a
 xacro expression that reaches for Python or the environment…) at a place in the text,
 deletes, repeats or cuts it. A secret in the environment must reach no message and no output.
+The mesh kinds mutate an STL (ASCII), OBJ or DAE file the URDF uses (copied as it is,
+converted to STL, OBJ and DAE); `loop` makes a file mpc reads a symbolic link that loops;
+`inertia` writes extreme numbers into the inertials of a model exported to MJCF (its
+principal axes).
 """
 
 from __future__ import annotations
@@ -15,15 +21,19 @@ from __future__ import annotations
 import contextlib
 import io
 import itertools
+import math
 import os
+import re
 import shutil
-from dataclasses import dataclass
+import subprocess
+from dataclasses import dataclass, field
 from pathlib import Path
+from xml.parsers import expat
 
 from tests.conftest import definition
 from tests.fixtures import arm
 
-KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf", "xacro")
+KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf", "xacro", "stl", "obj", "dae", "loop", "inertia")
 ESCAPE = "MPCFUZZESCAPE"  # any file with this name outside the case folder is an escape
 ABSOLUTE = f"/tmp/{ESCAPE}"
 SECRET = "MPCFUZZ_SECRET_4e1b"  # the value of MPC_FUZZ_SECRET while a case runs
@@ -47,6 +57,9 @@ TOKENS = (
     "$(env MPC_FUZZ_SECRET)", "$(optenv MPC_FUZZ_SECRET)", "${xacro.load_yaml('/proc/self/environ')}",
     '<xacro:include filename="/etc/passwd"/>', '<xacro:include filename="/proc/self/environ"/>',
 )
+# The numbers an `inertia` case writes into an inertial: huge, tiny, negative, not finite.
+INERTIAS = ("1e308", "-1e308", "1.7e308", "1e200", "1e-320", "-1", "0", "nan", "inf", "-inf", "1e16",
+            "5e-324", "3.4e38", "1e154", "-0")
 
 
 # The exports of the seeds, with the routes from a name to a file name (issue 35.3): a ROS
@@ -131,6 +144,8 @@ class Seeds:
         files["parts.xacro"] = (b'<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
                                 b'  <xacro:property name="half" value="${0.5}"/>\n</robot>\n')
         files["xacro.yml"] = definition("arm.urdf.xacro").encode()
+        files.update(_mesh_seeds())
+        files["inertia.yml"] = (definition("arm.urdf") + "    - type: mjcf\n").encode()
         for kind, basefile in (("sdf", "built/sdf/robot.sdf"), ("smurf", "built/smurf/robot.smurf")):
             files[f"{kind}.yml"] = (definition(basefile) + ROUTES).encode()
         shutil.rmtree(folder)
@@ -141,16 +156,178 @@ class Seeds:
         return {"definition": ("model.yml", "model.yml"), "pipeline": ("pipeline.yml", "pipeline.yml"),
                 "urdf": ("arm.urdf", "model.yml"), "sdf": ("built/sdf/robot.sdf", "sdf.yml"),
                 "smurf": ("built/smurf/robot.smurf", "smurf.yml"),
-                "xacro": ("arm.urdf.xacro", "xacro.yml")}[kind]
+                "xacro": ("arm.urdf.xacro", "xacro.yml"), "stl": ("meshes/m.stl", "meshes.yml"),
+                "obj": ("meshes/m.obj", "meshes.yml"), "dae": ("meshes/m.dae", "meshes.yml"),
+                "loop": ("model.yml", "pipeline.yml"), "inertia": ("arm.urdf", "inertia.yml")}[kind]
+
+
+def _mesh_seeds() -> dict[str, bytes]:
+    """A box as ASCII STL, OBJ and DAE, a URDF whose links use them, and a definition that
+    copies them (URDF, input_type) and converts them (SDF to DAE, MJCF to OBJ)."""
+    import trimesh
+
+    from mpc.core.collada import stable
+
+    box = trimesh.creation.box(extents=(0.1, 0.2, 0.3))
+    links = "".join(f'''
+  <link name="{fmt}">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <visual><geometry><mesh filename="meshes/m.{fmt}"/></geometry></visual>
+    <collision><geometry><mesh filename="meshes/m.{fmt}"/></geometry></collision></link>'''
+                    for fmt in ("stl", "obj", "dae"))
+    joints = "".join(f'''
+  <joint name="{a}_{b}" type="revolute"><parent link="{a}"/><child link="{b}"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'''
+                     for a, b in (("stl", "obj"), ("obj", "dae")))
+    urdf = f'<?xml version="1.0"?>\n<robot name="meshes">{links}{joints}\n</robot>\n'
+    exports = ("    - type: sdf\n      mesh_format: dae\n    - type: mjcf\n      mesh_format: obj\n")
+    return {"meshes/m.stl": box.export(file_type="stl_ascii").encode(),
+            "meshes/m.obj": box.export(file_type="obj").encode(),
+            "meshes/m.dae": stable(box.export(file_type="dae")), "meshes.urdf": urdf.encode(),
+            "meshes.yml": (definition("meshes.urdf") + exports).encode()}
 
 
 _COUNTER = itertools.count()
 
 
-def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: str = "compile") -> int:
+_INERTIAL_VALUE = re.compile(r'\b(?:ixx|ixy|ixz|iyy|iyz|izz|value)="([^"]*)"')
+LOOPED = ("arm.urdf", "meshes/tetra.stl", "model.yml", "meshes", "pipeline.yml")  # what `loop` cases loop
+
+
+def mutate_inertia(text: str, edits: list[Edit]) -> str:
+    """Each edit writes one of INERTIAS into the mass or an inertia entry it points at."""
+    for e in edits:
+        spans = [m.span(1) for m in _INERTIAL_VALUE.finditer(text)]
+        start, end = spans[min(int(e.where * len(spans)), len(spans) - 1)]
+        text = text[:start] + INERTIAS[e.token % len(INERTIAS)] + text[end:]
+    return text
+
+
+def make_loop(case: Path, edits: list[Edit]) -> None:
+    """Make a file mpc reads a symbolic link that loops: to itself, or through a second link."""
+    for e in edits[:2]:
+        path = case / LOOPED[e.token % len(LOOPED)]
+        if not path.parent.is_dir():  # inside a folder the first edit looped
+            continue
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            path.unlink(missing_ok=True)
+        if e.where < 0.5:
+            path.symlink_to(path.name)
+        else:
+            other = path.with_name(path.name + ".other")
+            other.unlink(missing_ok=True)
+            other.symlink_to(path.name)
+            path.symlink_to(other.name)
+
+
+@dataclass
+class Outputs:
+    """What accepted runs wrote, checked: `check` at once (well-formed XML and DAE, finite
+    numbers in XML and YAML), URDFs and a sample of SDFs kept under `folder` for
+    `consumers_refuse` (check_urdf, `ign sdf -k`: a process each, run in a batch)."""
+
+    folder: Path
+    sdf_every: int = 20  # `ign sdf -k` takes a second: one SDF in this many
+    invalid: list[str] = field(default_factory=list)
+    urdfs: list[tuple[Path, str]] = field(default_factory=list)
+    sdfs: list[tuple[Path, str]] = field(default_factory=list)
+    files: int = 0
+    _sdf_seen: int = 0
+
+    def check(self, out: Path, label: str) -> None:
+        for path in sorted(out.rglob("*")):
+            if not path.is_file() or path.suffix not in (".urdf", ".sdf", ".xml", ".dae", ".config", ".smurf",
+                                                         ".yml"):
+                continue
+            self.files += 1
+            problem = output_problem(path)
+            if problem is not None:
+                self.invalid.append(f"{label}: {path.relative_to(out)}: {problem}")
+                continue
+            if path.suffix == ".urdf":
+                self.urdfs.append((self._keep(path), f"{label}: {path.relative_to(out)}"))
+            elif path.suffix == ".sdf":
+                self._sdf_seen += 1
+                if self._sdf_seen % self.sdf_every == 1 or self.sdf_every == 1:
+                    kept = self._keep(path, with_meshes=out)
+                    self.sdfs.append((kept, f"{label}: {path.relative_to(out)}"))
+
+    def _keep(self, path: Path, with_meshes: Path | None = None) -> Path:
+        folder = self.folder / f"o{len(self.urdfs) + len(self.sdfs)}"
+        if with_meshes is not None:  # the SDF with the meshes it names, where it names them
+            shutil.copytree(with_meshes, folder, symlinks=True)
+            return folder / path.relative_to(with_meshes)
+        folder.mkdir(parents=True)
+        return Path(shutil.copy(path, folder))
+
+    def consumers_refuse(self) -> list[str]:
+        """check_urdf on every URDF kept and `ign sdf -k` on every SDF kept: what they refuse."""
+        refused = []
+        for path, label in self.urdfs:
+            run = subprocess.run(["check_urdf", str(path)], capture_output=True, text=True)
+            said = run.stdout + run.stderr
+            if run.returncode != 0 or "Error" in said or "ERROR" in said:
+                refused.append(f"{label}: check_urdf: {said.strip()[-500:]}")
+        for path, label in self.sdfs:
+            run = subprocess.run([shutil.which("ign") or "ign", "sdf", "-k", str(path)], capture_output=True,
+                                 text=True, cwd=path.parent)
+            if run.returncode != 0 or "Error" in run.stdout + run.stderr:
+                refused.append(f"{label}: ign sdf -k: {(run.stdout + run.stderr).strip()[-500:]}")
+        self.urdfs.clear()
+        self.sdfs.clear()
+        shutil.rmtree(self.folder, ignore_errors=True)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        return refused
+
+
+def output_problem(path: Path) -> str | None:
+    """Why a file mpc wrote is unsound, or None: XML (URDF, SDF, MJCF, DAE) that is not
+    well-formed for a namespace-aware parser (expat), a number in it that is not finite; YAML
+    (SMURF) that does not load, or holds a number that is not finite."""
+    data = path.read_bytes()
+    if path.suffix in (".smurf", ".yml"):
+        import yaml
+
+        try:
+            doc = yaml.safe_load(data)
+        except yaml.YAMLError as e:
+            return f"not YAML: {e}"
+        stack = [doc]
+        while stack:
+            x = stack.pop()
+            if isinstance(x, float) and not math.isfinite(x):
+                return f"a number that is not finite: {x}"
+            stack.extend(x.values() if isinstance(x, dict) else x if isinstance(x, list) else ())
+        return None
+    numbers: list[str] = []
+    parser = expat.ParserCreate(namespace_separator=" ")
+    parser.StartElementHandler = lambda _tag, attrs: numbers.extend(
+        v for k, v in attrs.items() if k not in _NAMES)
+    parser.CharacterDataHandler = numbers.append
+    try:
+        parser.Parse(data, True)
+    except expat.ExpatError as e:
+        return f"not well-formed XML: {e}"
+    for text in numbers:
+        words = text.split()
+        if words and all(map(_NUMBER.fullmatch, words)) and not all(math.isfinite(float(w)) for w in words):
+            return f"a number that is not finite: '{text.strip()[:80]}'"
+    return None
+
+
+_NAMES = frozenset(("name", "link", "joint", "parent", "child", "filename", "type", "body", "mesh", "class",
+                    "material", "texture", "file", "uri", "id", "url", "sid", "source", "target", "symbol",
+                    "profile", "semantic", "version", "meta", "axis_name"))
+_NUMBER = re.compile(r"[-+]?(\d+\.?\d*(e[-+]?\d+)?|\.\d+(e[-+]?\d+)?|nan|inf|infinity)", re.IGNORECASE)
+
+
+def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: str = "compile",
+             outputs: Outputs | None = None) -> int:
     """Write the seeds into a fresh folder under `base` with the one file mutated, run mpc
     (`compile`, `check`, or `run` for a pipeline), check the invariants (AssertionError when
-    one fails) and return the exit status."""
+    one fails), hand what an accepted run wrote to `outputs` and return the exit status."""
     from mpc.cli.main import main
 
     case = Path(os.path.realpath(base)) / f"case{next(_COUNTER)}"
@@ -160,10 +337,18 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
     original = seeds.files[target].decode()
-    (case / target).write_bytes(mutate(original, edits).encode("utf-8", "surrogatepass"))
-    (case / "meshes/link.stl").symlink_to("/proc/self/environ")  # for mutations that name it
+    if kind == "loop":
+        make_loop(case, edits)
+        run = "pipeline.yml" if command in ("check", "run") else "model.yml"
+    elif kind == "inertia":
+        (case / target).write_text(mutate_inertia(original, edits))
+    else:
+        (case / target).write_bytes(mutate(original, edits).encode("utf-8", "surrogatepass"))
+    if (case / "meshes").is_dir() and not (case / "meshes").is_symlink():
+        (case / "meshes/link.stl").symlink_to("/proc/self/environ")  # for mutations that name it
     before = {p for p in case.rglob("*")}
-    args = [command if kind != "pipeline" or command == "check" else "run", str(case / run),
+    pipeline = kind == "pipeline" or (kind == "loop" and run == "pipeline.yml")
+    args = [command if not pipeline or command == "check" else "run", str(case / run),
             "-o", str(case / "out")]
     if args[0] == "check":
         args = args[:2]
@@ -192,6 +377,8 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
             if p.is_file():
                 data = p.read_bytes()
                 assert b"ghp_" not in data and b"PATH=" not in data and SECRET.encode() not in data, p
+        if status == 0 and outputs is not None:
+            outputs.check(case / "out", f"{kind} {command} {edits}")
     shutil.rmtree(case, ignore_errors=True)
     return status
 

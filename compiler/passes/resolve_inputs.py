@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 from mpc.compiler.passes.context import PassContext
+from mpc.core.files import why_absent
 from mpc.ir.program import Program
 
 READABLE = (".urdf", ".sdf", ".smurf", ".xacro")
@@ -25,7 +26,7 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
             continue
         if not exists:
             ctx.sink.error(inp.span, "E0601", f"{what} '{inp.path}' of input model "
-                           f"'{inp.name}' does not exist")
+                           f"'{inp.name}' {why_absent(inp.path)}")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
                            "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf) and xacro "

@@ -1,7 +1,8 @@
 """A frozen copy of backends/urdf_reader.py as it was before it became faster (issue 19), on
 the frozen XmlSource beside it: tests/backends/test_reader_differential.py requires the new
 reader to read every URDF into the same IR with the same diagnostics. A test fixture, never
-imported by mpc.
+imported by mpc. Changed since only where the reader's behaviour was meant to change:
+issue 29 (a number that is not finite is E0480; a namespaced attribute is `prefix:name`).
 
 The original docstring: URDF file → ir.Robot, reporting every problem with its line and column.
 
@@ -13,6 +14,7 @@ they mention. Comments are kept. Mesh files are resolved to paths, never opened.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from lxml import etree
@@ -100,6 +102,7 @@ class _Reader:
         self.joint_names: set[str] = set()
         self.names: set[str] = set()  # both
         self.mesh_sources: dict[str, tuple[MeshSource, str | None]] = {}  # uri → (source, refusal)
+        self.robot_nsmap = dict(src.root.nsmap)
         # What tostring adds to a fragment's start tag for the namespaces <robot> declares.
         self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
                                        for prefix, uri in src.root.nsmap.items()]
@@ -119,7 +122,19 @@ class _Reader:
                 )
 
     def extra_attrs(self, el: etree._Element, known: tuple[str, ...]) -> Attrs:
-        return tuple([item for item in el.items() if item[0] not in known])
+        out, declare = [], {}
+        for key, value in el.items():
+            if key in known:
+                continue
+            if key.startswith("{"):  # issue 29: written `prefix:name`, declared where <robot> does not
+                uri, local = key[1:].split("}", 1)
+                prefixes = sorted(p for p, u in el.nsmap.items() if u == uri and p)
+                prefix = "xml" if uri == "http://www.w3.org/XML/1998/namespace" else prefixes[0]
+                key = f"{prefix}:{local}"
+                if prefix != "xml" and self.robot_nsmap.get(prefix) != uri:
+                    declare[f"xmlns:{prefix}"] = uri
+            out.append((key, value))
+        return (*out, *sorted(declare.items()))
 
     def floats(self, el: etree._Element, attr: str, n: int, where: str,
                required: bool = False) -> tuple[float, ...] | None:
@@ -129,6 +144,11 @@ class _Reader:
                 self.error(el, "E0403", f"<{el.tag}> in {where} has no '{attr}' attribute")
             return None
         values = parse_floats(text)
+        if values is not None and len(values) == n and not all(map(math.isfinite, values)):  # issue 29
+            what = "a finite number" if n == 1 else f"{n} finite numbers"
+            self.error(el, "E0480", f"'{attr}' of <{el.tag}> in {where} must be {what}, got '{text}'", attr,
+                       hint="URDF readers (urdfdom, check_urdf) refuse nan and inf; write a finite number")
+            return None
         if values is None or len(values) != n:
             what = "a number" if n == 1 else f"{n} numbers"
             self.error(el, "E0404", f"'{attr}' of <{el.tag}> in {where} must be {what}, "
@@ -401,7 +421,7 @@ class _Reader:
         return Visual(
             geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
             material=material, inline_material=inline,
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
+            geometry_attrs=self.extra_attrs(geometry_el, ()) if geometry_el is not None else (),
             extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
         )
 
@@ -414,7 +434,7 @@ class _Reader:
             return None
         return Collision(
             geometry=geometry, name=el.get("name"), origin=self.pose(first.get("origin"), where),
-            geometry_attrs=tuple(geometry_el.attrib.items()) if geometry_el is not None else (),
+            geometry_attrs=self.extra_attrs(geometry_el, ()) if geometry_el is not None else (),
             extra_attrs=self.extra_attrs(el, ("name",)), extras=extras, span=self.src.span(el),
         )
 
