@@ -285,7 +285,8 @@ class Outputs:
 def output_problem(path: Path) -> str | None:
     """Why a file mpc wrote is unsound, or None: XML (URDF, SDF, MJCF, DAE) that is not
     well-formed for a namespace-aware parser (expat), a number in it that is not finite; YAML
-    (SMURF) that does not load, or holds a number that is not finite."""
+    (SMURF) that does not load, or holds a number that is not finite (but a `.nan` bound of a
+    joint_limits file, where ROCK reads it as "no limit": a continuous joint's position)."""
     data = path.read_bytes()
     if path.suffix in (".smurf", ".yml"):
         import yaml
@@ -297,7 +298,8 @@ def output_problem(path: Path) -> str | None:
         stack = [doc]
         while stack:
             x = stack.pop()
-            if isinstance(x, float) and not math.isfinite(x):
+            if isinstance(x, float) and not math.isfinite(x) and not (
+                    math.isnan(x) and path.name.startswith("joint_limits")):
                 return f"a number that is not finite: {x}"
             stack.extend(x.values() if isinstance(x, dict) else x if isinstance(x, list) else ())
         return None
