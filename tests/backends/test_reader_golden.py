@@ -115,23 +115,25 @@ def _name(path: Path) -> str:
     return str(path.relative_to(ERD)) if path.is_relative_to(ERD) else str(path.relative_to(HERE.parent))
 
 
-def _record(found: dict[str, str], case: str, text: str) -> None:
-    found[case] = digest(text)
-    if case in WHOLE or Path(case).name in WHOLE:
-        check_text(f"reader/{case.replace('/', '_').replace(' ', '_')}", text)
+def _check(name: str, texts: dict[str, str]) -> None:
+    """The digest of every case against record NAME, then the cases of WHOLE against their
+    whole texts (which show what changed)."""
+    check_digests(name, {case: digest(text) for case, text in texts.items()})
+    for case, text in texts.items():
+        if case in WHOLE or Path(case).name in WHOLE:
+            check_text(f"reader/{case.replace('/', '_').replace(' ', '_')}", text)
 
 
 def test_every_urdf_reads_as_recorded() -> None:
     found: dict[str, str] = {}
     for path in URDFS:
         data = path.read_bytes()
-        text = case_text(data, str(path), path.parent.resolve())
-        _record(found, _name(path), text)
+        text = found[_name(path)] = case_text(data, str(path), path.parent.resolve())
         sink = Sink()  # and through read(): the file's own path, the same IR and diagnostics
         robot = urdf_reader.read(path, sink)
         assert text.startswith(stable("\n".join([*read_lines(robot, sink), "# spans\n"])))
     assert len(found) > 50
-    check_digests("reader_urdfs", found)
+    _check("reader_urdfs", found)
 
 
 def test_every_sdf_is_located_as_recorded() -> None:
@@ -159,8 +161,8 @@ def test_hostile_inputs_read_as_recorded(tmp_path: Path) -> None:
     found = {}
     for name, data in HOSTILE.items():
         for case, variant in ((name, data), (f"{name} link", data.replace(b"m.stl", b"link.stl"))):
-            _record(found, f"hostile {case}", case_text(variant, name, tmp_path, tmp_path))
-    check_digests("reader_hostile", found)
+            found[f"hostile {case}"] = case_text(variant, name, tmp_path, tmp_path)
+    _check("reader_hostile", found)
 
 
 def test_mutated_urdfs_read_as_recorded() -> None:
@@ -172,8 +174,8 @@ def test_mutated_urdfs_read_as_recorded() -> None:
         rng = random.Random(seed)
         path, data = rng.choices(documents, weights)[0]
         text = case_text(mutate(data, seed), str(path), path.parent.resolve())
-        _record(found, f"seed {seed}", f"# {_name(path)}\n{text}")
-    check_digests("reader_mutations", found)
+        found[f"seed {seed}"] = f"# {_name(path)}\n{text}"
+    _check("reader_mutations", found)
 
 
 _WORDS = ["0", "1", "-2.5", "1e3", ".5", "inf", "nan", "1_0", "x", "0x1", "", "١"]
