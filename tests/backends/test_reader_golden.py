@@ -39,7 +39,7 @@ SDFS = sorted(HERE.parent.rglob("*.sdf"))
 MUTATIONS = 480
 # Readable cases kept whole besides their digests.
 WHOLE = {"double_pendulum_simple.urdf", "hostile crlf.urdf", "hostile escape.urdf",
-         "hostile one_line.urdf", "seed 3", "seed 7"}
+         "hostile one_line.urdf", "seed 6", "seed 7"}
 
 HOSTILE = {
     "entity.urdf": b'<!DOCTYPE robot [<!ENTITY e "x">]><robot name="r"><link name="&e;"/></robot>',
