@@ -57,3 +57,35 @@ def assert_same_physics(a_path: Path, b_path: Path, tol: float = 1e-9, n_random:
             bid = b.getFrameId(frame.name, frame.type)
             np.testing.assert_allclose(da.oMf[fid].homogeneous, db.oMf[bid].homogeneous,
                                        atol=tol, rtol=0, err_msg=frame.name)
+
+
+Shape = tuple[str, str, tuple[object, ...], np.ndarray]
+
+
+def _shapes(path: Path, kind: pin.GeometryType, package_dirs: list[str]) -> list[Shape]:
+    """Each visual or collision shape of `path` as Pinocchio reads it (its meshes loaded by
+    hpp-fcl): the link it is on, its kind, its size (its bounding box, scale applied, and a
+    mesh's vertex count) and its placement in the world at q = 0, in a stable order."""
+    model = load(path)
+    geometry = pin.buildGeomFromUrdf(model, str(path), kind, package_dirs=[*package_dirs, str(path.parent)])
+    data, geometry_data = model.createData(), pin.GeometryData(geometry)
+    pin.updateGeometryPlacements(model, data, geometry, geometry_data, pin.neutral(model))
+    shapes = []
+    for i, g in enumerate(geometry.geometryObjects):
+        shape = g.geometry
+        shape.computeLocalAABB()
+        box = shape.aabb_local
+        size = (getattr(shape, "num_vertices", None), *np.round(box.min_, 9), *np.round(box.max_, 9))
+        shapes.append((model.frames[g.parentFrame].name, type(shape).__name__, size,
+                       geometry_data.oMg[i].homogeneous))
+    return sorted(shapes, key=lambda s: (s[0], s[1], str(s[2]), tuple(s[3].round(6).ravel() + 0.0)))
+
+
+def assert_same_shapes(a_path: Path, b_path: Path, package_dirs: list[str], tol: float = 1e-9) -> None:
+    """The same visuals and collisions, link by link: kind, size (a mesh's vertex count and
+    bounds) and placement, as Pinocchio loads them."""
+    for kind in (pin.GeometryType.VISUAL, pin.GeometryType.COLLISION):
+        a, b = _shapes(a_path, kind, package_dirs), _shapes(b_path, kind, package_dirs)
+        assert [s[:3] for s in a] == [s[:3] for s in b], kind
+        for sa, sb in zip(a, b, strict=True):
+            np.testing.assert_allclose(sa[3], sb[3], atol=tol, rtol=0, err_msg=f"{kind} {sa[0]}")

@@ -1,6 +1,6 @@
 """Every URDF of example-robot-data, compiled through a one-input definition, is the
-same robot: physically identical in Pinocchio, every gazebo/transmission/mimic kept,
-accepted by check_urdf."""
+same robot: physically identical in Pinocchio (its visuals and collisions too), every
+gazebo/transmission/mimic kept, accepted by check_urdf."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import pinocchio as pin
 import pytest
 from lxml import etree
 
-from tests.backends.pin_compare import assert_same_physics
-from tests.conftest import ERD, Diags, compile_file, definition, write
+from tests.backends.pin_compare import assert_same_physics, assert_same_shapes
+from tests.conftest import ERD, ERD_PACKAGE, Diags, compile_file, definition, write
 
 ALL = sorted(str(p.relative_to(ERD)) for p in ERD.rglob("*.urdf"))
 # The two broken models of the package; their diagnostics are tested below.
@@ -51,6 +51,7 @@ def test_compiled_model_is_the_same_robot(model: str, tmp_path: Path) -> None:
     out = result.out / "urdf" / f"{source.stem}.urdf"
 
     assert_same_physics(source, out)
+    assert_same_shapes(source, out, [str(ERD_PACKAGE.parent)])
     for tag in ("gazebo", "transmission", "mimic", "ros2_control"):
         assert _count(out, tag) == _count(source, tag), tag
     checked = subprocess.run([shutil.which("check_urdf") or "check_urdf", str(out)],

@@ -1,5 +1,6 @@
 """Seeded mutations of URDF text: a well-formed model → a variant that is broken, hostile or
-only written differently, for the reader differential (test_reader_differential.py).
+only written differently, for the recorded reader and writer outputs (test_reader_golden.py,
+test_writer_golden.py).
 
 Tree mutations (delete, duplicate, move, rename elements; remove, add or spoil attributes)
 break the model; text mutations (tags several to a line or over several lines, quotes, CRLF,

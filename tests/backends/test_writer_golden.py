@@ -1,10 +1,12 @@
-"""The URDF writer against a frozen copy of itself as it was before it became faster (issue 19):
-the same bytes for every robot of example-robot-data, seeded mutations of them (odd names,
-extra attributes, comments, fragments) and variants of their IR the reader never makes, with
-and without float formats.
+"""The URDF writer against its recorded outputs (tests/golden.py): the bytes it writes for
+every robot of example-robot-data, seeded mutations of them (odd names, extra attributes,
+comments, fragments) and variants of their IR the reader never makes, with and without float
+formats.
 
-The frozen copy (urdf_writer_before.py) exists only for this test: mpc's outputs are
-byte-stable, and nothing else compares a faster writer with the old one byte for byte.
+mpc's outputs are byte-stable: the digests were recorded by the writer of issue 19 (the one
+that wrote the same bytes as its frozen predecessor), and `MPC_UPDATE_GOLDEN=1` records them
+again. That what is written is *right* (Pinocchio reads the same model, check_urdf accepts
+it) is for test_roundtrip.py and test_urdf_writer.py.
 """
 
 from __future__ import annotations
@@ -13,18 +15,17 @@ import dataclasses
 import random
 from collections.abc import Iterator
 
-import pytest
-
 from mpc.backends import urdf_reader, urdf_writer
 from mpc.backends.float_formats import URDF_KEYS, Formats
 from mpc.core.diagnostics import Sink
 from mpc.core.packages import PackageResolver
 from mpc.ir.geometry import Mesh
 from mpc.ir.robot import Limit, Material, Mimic, Pose, Robot, SafetyController
-from tests.backends import urdf_writer_before
-from tests.backends.test_reader_differential import URDFS
+from tests.backends.test_reader_golden import URDFS
 from tests.backends.urdf_mutations import mutate
+from tests.golden import check_digests, check_text, digest, stable
 
+WHOLE = "double_pendulum_simple.urdf variant"  # kept whole as well
 FORMATS = [None, {"default": "%.6f"}, {"xyz": "%.3f", "ixx": "%g", "value": "%e"}, {"rpy": "%+.2f"}]
 
 
@@ -73,18 +74,19 @@ def _robots() -> Iterator[tuple[str, Robot]]:
 ROBOTS = list(_robots())
 
 
-@pytest.mark.parametrize("formats", FORMATS, ids=str)
-def test_every_robot_is_written_the_same(formats: dict[str, str] | None) -> None:
-    different = []
+def _written(robot: Robot, formats: dict[str, str] | None) -> str:
+    try:
+        return urdf_writer.to_string(robot, _uri, Formats(formats, URDF_KEYS) if formats else None)
+    except ValueError as e:  # a format of a text that is no number
+        return f"ValueError: {e}"
+
+
+def test_every_robot_is_written_as_recorded() -> None:
+    """One digest a robot: its texts in every float format of FORMATS."""
+    found = {}
     for name, robot in ROBOTS:
-        old = new = None
-        for writer in (urdf_writer_before, urdf_writer):
-            try:
-                text = writer.to_string(robot, _uri, Formats(formats, URDF_KEYS) if formats else None)
-            except ValueError as e:  # a format of a text that is no number, then and now
-                text = f"ValueError: {e}"
-            old, new = (text, None) if old is None else (old, text)
-        if old != new:
-            different.append(name)
+        texts = [f"# formats {formats}\n{_written(robot, formats)}" for formats in FORMATS]
+        found[name] = digest(stable("\n".join(texts)))
     assert len(ROBOTS) > 300
-    assert different == []
+    check_digests("writer_urdfs", found)
+    check_text("writer/double_pendulum_simple", stable(_written(dict(ROBOTS)[WHOLE], None)))
