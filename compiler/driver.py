@@ -138,7 +138,7 @@ def _running(pid: int) -> bool:
 def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink: Sink,
                   target: Path | None) -> bool:
     """Write every export into `staging`; whether all succeeded."""
-    from mpc.backends import BACKENDS
+    from mpc.backends.formats import write
     from mpc.ir.program import CommandExport, JointLimitsExport, RobotExport, SubmodelExport
 
     submodels: dict[str, Robot | None] = {}
@@ -172,7 +172,7 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
         folder.mkdir(parents=True, exist_ok=True)
         with stage(export.type):
             try:
-                BACKENDS[export.type]().emit(model, export, folder, sink)
+                write(model, export, folder, sink)
             except NotAFileName as e:  # a name check_file_names could not see (a submodel's)
                 sink.error(export.span, "E0540", f"{e}; nothing is written")
     return not sink.has_errors()
