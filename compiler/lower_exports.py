@@ -12,13 +12,16 @@ from __future__ import annotations
 import re
 import shlex
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from mpc.backends.formats import FORMATS
 from mpc.compiler.lower_context import LowerContext, strings
+from mpc.compiler.lower_joint_limits import lower_joint_limits
 from mpc.compiler.lower_smurf import SmurfLowering
+from mpc.compiler.schema import exports as schema
+from mpc.compiler.schema.base import Node
 from mpc.core.diagnostics import did_you_mean
 from mpc.ir.program import (
     CommandExport,
@@ -79,12 +82,12 @@ class _Exports:
         """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/,
         where its meshes are too: its `package://` paths point there). Its lowering is its
         type's in `LOWERING`."""
-        lower = LOWERING.get(entry.type)
-        if lower is None:
+        lowering = LOWERING.get(entry.type)
+        if lowering is None:
             self.ctx.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
                              + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
-        return lower(self, entry, robotname, submodel, inherited)
+        return lowering.lower(self, entry, robotname, submodel, inherited)
 
     def kccd(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
         from mpc.compiler.lower_kccd import lower_kccd
@@ -312,34 +315,37 @@ class _Exports:
         return RosPackageExport(span=m.span, package=package, version=version,
                                 description=m.description or "", license=m.license or "")
 
-    def joint_limits(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
-        """A joint_limits entry (no meshes, no kinematic options). An entry a submodel inherits
-        reports nothing: the model's own use of it did."""
-        from mpc.ir.program import JOINT_SELECTIONS as SELECTIONS
-
-        joints = tuple(entry.joints)
-        # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
-        submodels = {e.name for e in self.entries() if e.type == "submodel"}
-        as_string = isinstance(entry.data_at("joints"), str)
-        if len(joints) == 1 and as_string and joints[0] in submodels:
-            return [JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0],
-                                      submodel=submodel)]
-        if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:
-            if not inherited:
-                self.ctx.sink.error(entry.value_span("joints"), "E0524", f"joints: '{joints[0]}' is none of "
-                                    f"{', '.join(SELECTIONS)} and names no submodel of this export_config"
-                                    f"{did_you_mean(joints[0], set(SELECTIONS) | submodels)}")
-            return []
-        return [JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name,
-                                  submodel=submodel)]
+    def submodel_names(self) -> set[str]:
+        return {e.name for e in self.entries() if e.type == "submodel"}
 
 
-# How each export type is lowered (its format's other facts: backends/formats.py). A type not
-# here is reported as not supported yet.
-LOWERING: dict[str, Callable[[_Exports, Any, str, str, bool], list[Export]]] = {
-    "urdf": _Exports.kinematic, "sdf": _Exports.kinematic, "mjcf": _Exports.kinematic,
-    "smurf": _Exports.smurf_entry, "pdf": _Exports.pdf, "render": _Exports.render,
-    "joint_limits": _Exports.joint_limits, "kccd": _Exports.kccd,
+Lower = Callable[[_Exports, Any, str, str, bool], list[Export]]
+
+
+@dataclass(frozen=True)
+class Lowering:
+    """How the compiler takes an export type: its schema node (the `export_config` entry) and the
+    function that lowers an entry (the exports, the entry, the robot's name, the submodel that
+    writes it or "", whether a submodel inherits it) to IR exports. The format's other facts are
+    its descriptor's (backends/formats.py)."""
+
+    schema: type[Node]
+    lower: Lower
+
+
+# Each export type the compiler lowers; an entry of another type is reported as not supported
+# yet. (`submodel` entries are lowered apart: they hold exports of their own.)
+LOWERING: dict[str, Lowering] = {
+    "urdf": Lowering(schema.UrdfExport, _Exports.kinematic),
+    "sdf": Lowering(schema.SdfExport, _Exports.kinematic),
+    "mjcf": Lowering(schema.MjcfExport, _Exports.kinematic),
+    "smurf": Lowering(schema.SmurfExport, _Exports.smurf_entry),
+    "pdf": Lowering(schema.PdfExport, _Exports.pdf),
+    "render": Lowering(schema.RenderExport, _Exports.render),
+    "joint_limits": Lowering(schema.JointLimitsExport, lambda exports, entry, robotname, submodel, inherited:
+                             lower_joint_limits(exports.ctx, entry, exports.submodel_names(), submodel,
+                                                inherited)),
+    "kccd": Lowering(schema.KccdExport, _Exports.kccd),
 }
 
 
