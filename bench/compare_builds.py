@@ -33,7 +33,8 @@ _EXPORTS = """\
 
 
 def erd_definitions(work: Path, limit: int | None) -> list[Path]:
-    """One definition per example-robot-data URDF, written into `work/erd/`."""
+    """One definition per example-robot-data URDF, written into `work/erd/` beside a copy of
+    the URDF (each tree reads the meshes from its own installed example-robot-data)."""
     from mpc.core.packages import PackageResolver
 
     package = PackageResolver().find("example-robot-data")
@@ -43,8 +44,9 @@ def erd_definitions(work: Path, limit: int | None) -> list[Path]:
         name = urdf.relative_to(package / "robots").with_suffix("").as_posix().replace("/", "__")
         path = work / "erd" / f"{name}.yml"
         path.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(urdf, path.with_suffix(".urdf"))
         path.write_text(f"model:\n  robotname: robot\n  modelname: {name}\n  input_models:\n"
-                        f"    base:\n      basefile: \"{urdf}\"\n" + _EXPORTS)
+                        f"    base:\n      basefile: {name}.urdf\n  assemble:\n    model: base\n" + _EXPORTS)
         out.append(path)
     return out
 
