@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from mpc.backends.formats import FORMATS
+from mpc.backends.formats import FORMATS, Format
 from mpc.compiler.lower_context import LowerContext, strings
 from mpc.compiler.lower_joint_limits import lower_joint_limits
 from mpc.compiler.lower_smurf import SmurfLowering
@@ -125,14 +125,8 @@ class _Exports:
         """A urdf, sdf or mjcf entry: a model file and its meshes, as its format's descriptor
         (backends/formats.py) says."""
         fmt = FORMATS[entry.type]
-        if not fmt.package_paths and not inherited:  # the model's own use of the entry reported
-            self.no_package_paths(entry)
-        if entry.provide_primitives and not inherited:
-            self.ctx.sink.warning(entry.key_span("provide_primitives"), "W0260", "'provide_primitives' has "
-                                  "no effect: Phobos's export reads it from no export entry (its default "
-                                  "preset sets it on sdf), and mpc writes the collisions as they are",
-                                  hint="collisions' `shape` with `apply_primitives: true` makes primitive "
-                                  "collisions")
+        if not inherited:  # the model's own use of the entry reported
+            self.no_effect(entry, fmt)
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in self.written:
@@ -147,6 +141,23 @@ class _Exports:
         export = fmt.record(mesh_format=mesh_format, span=entry.span,
                             add_floating_base=entry.add_floating_base, submodel=submodel,
                             filename=filename if filename != (submodel or robotname) else "")
+        export = self.smurf.link(entry, self.options(entry, fmt, export), submodel)
+        self.written[target] = export
+        return [export]
+
+    def no_effect(self, entry: Any, fmt: Format) -> None:
+        """Report the keys of a urdf, sdf or mjcf entry that its format ignores or cannot honour."""
+        if not fmt.package_paths:
+            self.no_package_paths(entry)
+        if entry.provide_primitives:
+            self.ctx.sink.warning(entry.key_span("provide_primitives"), "W0260", "'provide_primitives' has "
+                                  "no effect: Phobos's export reads it from no export entry (its default "
+                                  "preset sets it on sdf), and mpc writes the collisions as they are",
+                                  hint="collisions' `shape` with `apply_primitives: true` makes primitive "
+                                  "collisions")
+
+    def options(self, entry: Any, fmt: Format, export: Any) -> Any:
+        """`export` with the options of its entry that its format takes."""
         package = self.ctx.model.ros_pkg_name or ros_name(self.ctx.model.modelname)
         if fmt.package_paths:
             export = replace(export, ros_package=package if entry.ros_pathes else None,
@@ -160,11 +171,8 @@ class _Exports:
             self.ctx.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
                                 f"no meaning in a {entry.type} export: {fmt.cut_joints}")
         extra = entry.additional_meshes
-        export = replace(export, enforce_zero=entry.enforce_zero,
-                         additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
-        export = self.smurf.link(entry, export, submodel)
-        self.written[target] = export
-        return [export]
+        return replace(export, enforce_zero=entry.enforce_zero,
+                       additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
 
     def no_package_paths(self, entry: Any) -> None:
         """`ros_pathes` and `copy_with_other_pathes` on an mjcf entry: MuJoCo cannot read them."""
