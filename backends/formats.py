@@ -35,11 +35,9 @@ Read = Callable[[Path, "Sink", "PackageResolver | None"], "Robot | None"]
 
 @dataclass(frozen=True)
 class Meshes:
-    """A format that writes the meshes its file references (backends/meshes.py): the mesh
-    formats its consumer reads, and what `mesh_format: input_type` becomes (empty: each
-    mesh's own format)."""
+    """A format that writes the meshes its file references (backends/meshes.py `for_export`):
+    what `mesh_format: input_type` becomes for it (empty: each mesh's own format)."""
 
-    readable: tuple[str, ...] = ()
     input_type: str = ""
 
 
@@ -162,7 +160,7 @@ _FORMATS = (
            float_keys=SDF_KEYS, numbers="element of an SDF", meshes=Meshes(), package_paths=True,
            holds=_sdf_holds),
     Format("mjcf", program.MjcfExport, _write_mjcf, kept=True, float_keys=MJCF_KEYS,
-           numbers="attribute of an MJCF", meshes=Meshes(("stl", "obj"), input_type="obj"),
+           numbers="attribute of an MJCF", meshes=Meshes(input_type="obj"),
            cut_joints="MJCF always closes loops with equality constraints", holds=_mjcf_holds),
     Format("smurf", program.SmurfExport, _write_smurf, _read_smurf, (".smurf",), kept=True),
     Format("pdf", program.PdfExport, _write_pdf),

@@ -70,3 +70,11 @@ def test_the_table_loads_no_backend() -> None:
             "('numpy', 'scipy', 'trimesh', 'lxml')))")
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert loaded.strip() == "['mpc.backends.formats']"
+
+
+def test_the_formats_that_leave_things_out_name_their_tables() -> None:
+    """W0500's tables (backends/holds.py) are the descriptors' `holds`."""
+    from mpc.backends import mjcf, sdf
+
+    assert {name: fmt.holds() for name, fmt in FORMATS.items() if fmt.holds is not None} == {
+        "mjcf": mjcf.CANNOT_HOLD, "sdf": sdf.CANNOT_HOLD}
