@@ -48,6 +48,9 @@ class Format:
     numbers: what one of `float_keys` is in the format's file ("attribute of a URDF"), for E0530.
     package_paths: whether its file may hold `package://` mesh paths (`ros_pathes`).
     cut_joints: why `include_cut_joints` means nothing to the format, or "" when it is an option.
+    exact_inertials: whether its consumer forgives no rounding, so that `correct_inertials`
+    corrects exactly (SDFormat, MuJoCo).
+    in_smurf: whether a SMURF can link its file (`link_in_smurf`).
     holds: the table of what the format cannot hold (None: it leaves nothing out to report),
     loaded with its backend.
     """
@@ -63,6 +66,8 @@ class Format:
     meshes: Meshes | None = None
     package_paths: bool = False
     cut_joints: str = ""
+    exact_inertials: bool = False
+    in_smurf: bool = False
     holds: Callable[[], Sequence[Tally]] | None = None
 
 
@@ -155,13 +160,14 @@ def _write_ros_package(robot: Robot, export: Any, out: Path, sink: Sink) -> None
 _FORMATS = (
     Format("urdf", program.UrdfExport, _write_urdf, _read_urdf, (".urdf",), kept=True,
            float_keys=URDF_KEYS, numbers="attribute of a URDF", meshes=Meshes(), package_paths=True,
-           cut_joints="URDF cannot hold loops"),
+           cut_joints="URDF cannot hold loops", in_smurf=True),
     Format("sdf", program.SdfExport, _write_sdf, _read_sdf, (".sdf",), kept=True,
            float_keys=SDF_KEYS, numbers="element of an SDF", meshes=Meshes(), package_paths=True,
-           holds=_sdf_holds),
+           exact_inertials=True, in_smurf=True, holds=_sdf_holds),
     Format("mjcf", program.MjcfExport, _write_mjcf, kept=True, float_keys=MJCF_KEYS,
            numbers="attribute of an MJCF", meshes=Meshes(input_type="obj"),
-           cut_joints="MJCF always closes loops with equality constraints", holds=_mjcf_holds),
+           cut_joints="MJCF always closes loops with equality constraints", exact_inertials=True,
+           holds=_mjcf_holds),
     Format("smurf", program.SmurfExport, _write_smurf, _read_smurf, (".smurf",), kept=True),
     Format("pdf", program.PdfExport, _write_pdf),
     Format("render", program.RenderExport, _write_render),

@@ -191,9 +191,10 @@ def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
 def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
     """`robot` with its non-physical inertials made physical (ir/physical.py); W0530 names them.
     SDFormat and MuJoCo forgive no rounding: for their exports the correction is exact."""
+    from mpc.backends.formats import FORMATS
     from mpc.ir.physical import correct_inertials
 
-    robot, changed = correct_inertials(robot, exact=export.type in ("sdf", "mjcf"))
+    robot, changed = correct_inertials(robot, exact=FORMATS[export.type].exact_inertials)
     if changed:
         more = f" and {len(changed) - 8} more" if len(changed) > 8 else ""
         shown = ", ".join(f"'{n}'" for n in changed[:8]) + more
