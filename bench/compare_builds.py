@@ -72,12 +72,14 @@ def definitions(work: Path, limit: int | None) -> list[Path]:
 
 
 def build(mpc: str, definition: Path, out: Path, cache: Path) -> str:
-    """The diagnostics and exit status of one build into `out`."""
+    """The diagnostics and exit status of one build into `out`, the output folder and the
+    environment of `mpc` (its `.venv`) shown as `<out>` and `<venv>`."""
     env = {**os.environ, "MPC_CACHE_DIR": str(cache), "MPC_MESH_WORKERS": "1"}
     command = [mpc, "compile", "--force", "--no-post-processing", "-o", str(out), str(definition)]
     run = subprocess.run(command, capture_output=True, text=True, env=env, cwd=definition.parent)
     text = f"exit {run.returncode}\n--- stdout\n{run.stdout}--- stderr\n{run.stderr}"
-    return text.replace(str(out), "<out>")
+    # Each tree reads example-robot-data's meshes from its own environment.
+    return text.replace(str(out), "<out>").replace(str(Path(mpc).absolute().parents[1]), "<venv>")
 
 
 def files(folder: Path) -> dict[str, bytes]:
