@@ -14,9 +14,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from mpc.ir.float_format_keys import DEFAULT, KEYS, MJCF_KEYS, SDF_KEYS, URDF_KEYS, bad_format
+from mpc.ir.float_format_keys import DEFAULT, MJCF_KEYS, SDF_KEYS, URDF_KEYS, bad_format
 
-__all__ = ["DEFAULT", "KEYS", "MJCF_KEYS", "SDF_KEYS", "URDF_KEYS", "Formats", "bad_format"]
+__all__ = ["DEFAULT", "MJCF_KEYS", "SDF_KEYS", "URDF_KEYS", "Formats", "bad_format"]
 
 
 def _one(token: str, fmt: str) -> str:

@@ -33,13 +33,13 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from mpc.backends import meshes, xml_escape
+from mpc.backends import holds, meshes, xml_escape
 from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.core.diagnostics import Sink
@@ -230,60 +230,93 @@ def _one_dof(joint: Joint | None) -> bool:
 
 
 def left_out(robot: Robot) -> list[str]:
-    """What the robot holds that this MJCF does not: fragments, sensors, velocity limits, …"""
-    links, joints = list(robot.links.values()), list(robot.joints.values())
-    shapes: list[Visual | Collision] = [s for lk in links for s in (*lk.visuals, *lk.collisions)]
-    named = Counter(s.name for s in shapes if s.name is not None)
-    materials = [*robot.materials.values(), *(v.inline_material for lk in links for v in lk.visuals
-                                               if v.inline_material is not None)]
-    inner = [f for el in (*links, *joints, *shapes) for f in el.extras] + [
-        f for lk in links if lk.inertial is not None for f in lk.inertial.extras]
-    counts = {
-        ("sensor", "sensors"): len(robot.sensors), ("pose", "poses"): len(robot.poses),
-        ("submechanism", "submechanisms"): len(robot.submechanisms),
-        ("annotation category", "annotation categories"): len(robot.annotations),
-        ("annotated link or joint", "annotated links and joints"):
-            sum(bool(e.annotations) for e in (*links, *joints)),
-        ("annotated visual or collision", "annotated visuals and collisions"):
-            sum(bool(s.annotations) for s in shapes),
-        ("joint velocity limit", "joint velocity limits"):
-            sum(j.limit is not None and j.limit.velocity is not None for j in joints),
-        ("joint calibration", "joint calibrations"): sum(j.calibration is not None for j in joints),
-        ("safety controller", "safety controllers"): sum(j.safety_controller is not None for j in joints),
-        ("empty position range (lower ≥ upper)", "empty position ranges (lower ≥ upper)"):
-            sum((r := _limits(j)) is not None and r[0] >= r[1] for j in joints),
-        ("material texture or property beyond colour", "material textures or properties beyond colour"):
-            sum(m.texture is not None or m.normal_texture is not None or bool(m.annotations) or any(
-                getattr(m, k) is not None for k in ("ambient", "specular", "emissive", "shininess",
-                                                    "transparency")) for m in materials),
-        ("name of a visual or collision used twice", "names of visuals or collisions used twice"):
-            sum(n for n in named.values() if n > 1),
-        ("attribute URDF does not define", "attributes URDF does not define"):
-            sum(len(e.extra_attrs) for e in (*links, *joints, *shapes)),
-        ("mimic of or by a joint without one degree of freedom",
-         "mimics of or by joints without one degree of freedom"): sum(
-            j.mimic is not None and not (_one_dof(j) and _one_dof(robot.joints.get(j.mimic.joint)))
-            for j in joints),
-        ("motor setting", "motor settings"): sum(len(m.settings) for m in robot.motors.values()),
-        ("cut joint constraint axis", "cut joint constraint axes"):
-            sum(len(c.constraint_axes) for c in robot.cut_joints.values()),
-        ("rotational cut joint's axis (without one, a connect is a ball joint)",
-         "rotational cut joints' axes (without one, a connect is a ball joint)"):
-            sum(c.type in _POINT_CUTS and c.type != "ball" and _cut_axis(c) is None
-                for c in robot.cut_joints.values()),
-    }
-    out = [f"{n} {words[n != 1]}" for words, n in counts.items() if n]
-    out += [f"{c.type} cut joint '{c.name}' (MJCF has no equality for it)"
-            for c in sorted(robot.cut_joints.values(), key=lambda c: c.name)
-            if c.type != "fixed" and c.type not in _POINT_CUTS]
-    tags = Counter(f.tag for f in (*robot.fragments, *inner))
-    out += [f"{n} <{tag}> element{'s' * (n != 1)}" for tag, n in sorted(tags.items())]
-    root = robot.links[robot.root]
-    if robot.root == "world" and root.inertial is not None and root.inertial.mass != 0:
-        out.append("the mass of the root link 'world' (MuJoCo's world body has none)")
-    if robot.submechanisms_file:
-        out.append("the submechanisms file")
-    return out
+    """What the robot holds that this MJCF does not: fragments, sensors, velocity limits, …
+    (the table `CANNOT_HOLD`, read by backends/holds.py)."""
+    return holds.left_out(robot, CANNOT_HOLD)
+
+
+def _shapes(robot: Robot) -> list[Visual | Collision]:
+    return [s for lk in robot.links.values() for s in (*lk.visuals, *lk.collisions)]
+
+
+def _elements(robot: Robot) -> tuple[Link | Joint | Visual | Collision, ...]:
+    return (*robot.links.values(), *robot.joints.values(), *_shapes(robot))
+
+
+def _beyond_colour(robot: Robot) -> int:
+    """The materials with a texture or a property MJCF's `rgba` cannot say."""
+    inline = [v.inline_material for lk in robot.links.values() for v in lk.visuals]
+    return sum(m.texture is not None or m.normal_texture is not None or bool(m.annotations) or any(
+        getattr(m, k) is not None for k in ("ambient", "specular", "emissive", "shininess", "transparency"))
+        for m in (*robot.materials.values(), *(m for m in inline if m is not None)))
+
+
+def _mimic_without_one_dof(robot: Robot, joint: Joint) -> bool:
+    mimic = joint.mimic
+    return mimic is not None and not (_one_dof(joint) and _one_dof(robot.joints.get(mimic.joint)))
+
+
+def _uncloseable_cuts(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    for c in sorted(robot.cut_joints.values(), key=lambda c: c.name):
+        if c.type != "fixed" and c.type not in _POINT_CUTS:
+            yield holds.Named(f"{c.type} cut joint '{c.name}' (MJCF has no equality for it)"), 1
+
+
+def _element_tags(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    """The extra elements of the robot, its links, joints, shapes and inertials, by tag."""
+    inertials = [lk.inertial for lk in robot.links.values() if lk.inertial is not None]
+    tags = Counter(f.tag for f in (*robot.fragments, *(f for el in (*_elements(robot), *inertials)
+                                                       for f in el.extras)))
+    for tag, n in sorted(tags.items()):
+        yield holds.noun(f"<{tag}> element"), n
+
+
+def _world_mass(robot: Robot, options: holds.Options) -> bool:
+    inertial = robot.links[robot.root].inertial
+    return robot.root == "world" and inertial is not None and inertial.mass != 0
+
+
+_C = holds.Counted
+# What MJCF cannot hold, in the order W0500 names it.
+CANNOT_HOLD: tuple[holds.Tally, ...] = (
+    holds.count(_C("sensor", "sensors"), lambda r, o: len(r.sensors)),
+    holds.count(_C("pose", "poses"), lambda r, o: len(r.poses)),
+    holds.count(_C("submechanism", "submechanisms"), lambda r, o: len(r.submechanisms)),
+    holds.count(_C("annotation category", "annotation categories"), lambda r, o: len(r.annotations)),
+    holds.count(_C("annotated link or joint", "annotated links and joints"), lambda r, o: sum(
+        bool(e.annotations) for e in (*r.links.values(), *r.joints.values()))),
+    holds.count(_C("annotated visual or collision", "annotated visuals and collisions"), lambda r, o: sum(
+        bool(s.annotations) for s in _shapes(r))),
+    holds.count(_C("joint velocity limit", "joint velocity limits"), lambda r, o: sum(
+        j.limit is not None and j.limit.velocity is not None for j in r.joints.values())),
+    holds.count(_C("joint calibration", "joint calibrations"), lambda r, o: sum(
+        j.calibration is not None for j in r.joints.values())),
+    holds.count(_C("safety controller", "safety controllers"), lambda r, o: sum(
+        j.safety_controller is not None for j in r.joints.values())),
+    holds.count(_C("empty position range (lower ≥ upper)", "empty position ranges (lower ≥ upper)"),
+                lambda r, o: sum((x := _limits(j)) is not None and x[0] >= x[1] for j in r.joints.values())),
+    holds.count(_C("material texture or property beyond colour", "material textures or properties beyond "
+                   "colour"), lambda r, o: _beyond_colour(r)),
+    holds.count(_C("name of a visual or collision used twice", "names of visuals or collisions used twice"),
+                lambda r, o: sum(n for n in Counter(s.name for s in _shapes(r) if s.name is not None).values()
+                                 if n > 1)),
+    holds.count(_C("attribute URDF does not define", "attributes URDF does not define"), lambda r, o: sum(
+        len(e.extra_attrs) for e in _elements(r))),
+    holds.count(_C("mimic of or by a joint without one degree of freedom", "mimics of or by joints without "
+                   "one degree of freedom"), lambda r, o: sum(_mimic_without_one_dof(r, j)
+                                                               for j in r.joints.values())),
+    holds.count(_C("motor setting", "motor settings"), lambda r, o: sum(len(m.settings)
+                                                                         for m in r.motors.values())),
+    holds.count(_C("cut joint constraint axis", "cut joint constraint axes"), lambda r, o: sum(
+        len(c.constraint_axes) for c in r.cut_joints.values())),
+    holds.count(_C("rotational cut joint's axis (without one, a connect is a ball joint)",
+                   "rotational cut joints' axes (without one, a connect is a ball joint)"), lambda r, o: sum(
+        c.type in _POINT_CUTS and c.type != "ball" and _cut_axis(c) is None for c in r.cut_joints.values())),
+    _uncloseable_cuts,
+    _element_tags,
+    holds.named(holds.Named("the mass of the root link 'world' (MuJoCo's world body has none)"), _world_mass),
+    holds.named(holds.Named("the submechanisms file"), lambda r, o: bool(r.submechanisms_file)),
+)
 
 
 class _Writer:

@@ -10,11 +10,10 @@ motors, sensors, cut joints, …) is left out and named in one W0500 warning.
 
 from __future__ import annotations
 
-from collections import Counter
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 
-from mpc.backends import meshes, xml_escape
+from mpc.backends import holds, meshes, xml_escape
 from mpc.backends.float_formats import SDF_KEYS, Formats
 from mpc.backends.mesh_paths import variants
 from mpc.backends.sdf_reader import read
@@ -78,49 +77,96 @@ def _unique(name: str, suffix: str, taken: set[str]) -> str:
 
 
 def left_out(robot: Robot, cut_joints: bool = False) -> list[str]:
-    """What the robot holds that this writer does not write to SDF, for one W0500.
+    """What the robot holds that this writer does not write to SDF, for one W0500 (the table
+    `CANNOT_HOLD`, read by backends/holds.py).
 
     cut_joints: whether the loop-closure joints are written (`include_cut_joints`).
     """
-    joints = sorted(robot.joints.values(), key=lambda j: j.name)
-    out = [f"{j.type} joint '{j.name}' (SDF has none: link '{j.child}' is written free)"
-           for j in joints if j.type in _SKIPPED]
-    if mimics := [j.name for j in joints if j.mimic is not None]:
-        out.append("the mimic of joint" + "s" * (len(mimics) > 1) + " " + ", ".join(f"'{m}'" for m in mimics))
-    counts: Counter[tuple[str, str]] = Counter({
-        ("", "motor"): len(robot.motors),
-        ("", "sensor SDF has no type for"): sum(x.type not in (*LINK_SENSORS, "Joint6DOF") or (not x.link
-                                               and not x.joint) for x in robot.sensors.values()),
-        ("", "named pose"): len(robot.poses),
-        ("", "loop-closure joint"): 0 if cut_joints else len(robot.cut_joints),
-        ("", "submechanism"): len(robot.submechanisms), ("", "annotation category"): len(robot.annotations),
-        ("", "joint calibration"): sum(j.calibration is not None for j in joints),
-        ("", "joint safety controller"): sum(j.safety_controller is not None for j in joints)})
-    counts.update(("", f"<{f.tag}> fragment") for f in robot.fragments)
-    elements: list[tuple[str, Link | Joint | Visual | Collision]] = [("joint", j) for j in joints]
+    return holds.left_out(robot, CANNOT_HOLD, cut_joints=cut_joints)
+
+
+def _joints(robot: Robot) -> list[Joint]:
+    return sorted(robot.joints.values(), key=lambda j: j.name)
+
+
+def _skipped_joints(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    for j in _joints(robot):
+        if j.type in _SKIPPED:
+            yield holds.Named(f"{j.type} joint '{j.name}' (SDF has none: link '{j.child}' "
+                              "is written free)"), 1
+
+
+def _mimics(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    if mimics := [j.name for j in _joints(robot) if j.mimic is not None]:
+        yield holds.Named("the mimic of joint" + "s" * (len(mimics) > 1) + " "
+                          + ", ".join(f"'{m}'" for m in mimics)), 1
+
+
+def _untyped_sensor(sensor: Sensor) -> bool:
+    return sensor.type not in (*LINK_SENSORS, "Joint6DOF") or (not sensor.link and not sensor.joint)
+
+
+def _fragments(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    for f in robot.fragments:
+        yield holds.noun(f"<{f.tag}> fragment"), 1
+
+
+def _inertial_extras(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    """Link by link: the extra elements of its inertial, then its collisions' bitmasks."""
+    for lk in robot.links.values():
+        for f in lk.inertial.extras if lk.inertial else ():
+            yield holds.noun("inertial", f"<{f.tag}> in "), 1
+        yield holds.noun("collision bitmask"), sum(c.bitmask is not None for c in lk.collisions)
+
+
+def _element_extras(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
+    """The joints', links', visuals' and collisions' extra elements, annotations and attributes."""
+    elements: list[tuple[str, Link | Joint | Visual | Collision]] = [("joint", j) for j in _joints(robot)]
     for lk in robot.links.values():
         elements += [("link", lk)] + [("visual", v) for v in lk.visuals]
         elements += [("collision", c) for c in lk.collisions]
-        counts.update((f"<{f.tag}> in ", "inertial") for f in (lk.inertial.extras if lk.inertial else ()))
-        counts["", "collision bitmask"] += sum(c.bitmask is not None for c in lk.collisions)
     for kind, el in elements:
-        counts.update((f"<{f.tag}> in ", kind) for f in el.extras)
-        counts["annotations of ", kind] += bool(el.annotations)
+        for f in el.extras:
+            yield holds.noun(kind, f"<{f.tag}> in "), 1
+        yield holds.noun(kind, "annotations of "), int(bool(el.annotations))
         attrs = list(el.extra_attrs)
         if isinstance(el, Visual | Collision):
-            counts.update((f"attribute '{a}' of the geometry in ", kind)
-                          for a, _ in (*el.geometry_attrs, *el.geometry.extra_attrs))
+            for a, _ in (*el.geometry_attrs, *el.geometry.extra_attrs):
+                yield holds.noun(kind, f"attribute '{a}' of the geometry in "), 1
         elif isinstance(el, Joint):
             attrs += [a for part in (el.limit, el.dynamics) if part is not None for a in part.extra_attrs]
-        counts.update((f"attribute '{name}' of ", kind) for name, _ in attrs)
+        for name, _ in attrs:
+            yield holds.noun(kind, f"attribute '{name}' of "), 1
+
+
+def _material_details(robot: Robot, options: holds.Options) -> Iterator[tuple[holds.Phrase, int]]:
     for m in _used_materials(robot):
-        counts["", "material texture"] += m.texture is not None or m.normal_texture is not None
-        counts["", "material shininess"] += m.shininess is not None
-        counts["annotations of ", "material"] += bool(m.annotations)
-    out += [f"{pre}{n} {noun}{'s' * (n != 1)}" for (pre, noun), n in counts.items() if n]
-    if robot.submechanisms_file:
-        out.append("the submechanisms file")
-    return out
+        yield holds.noun("material texture"), int(m.texture is not None or m.normal_texture is not None)
+        yield holds.noun("material shininess"), int(m.shininess is not None)
+        yield holds.noun("material", "annotations of "), int(bool(m.annotations))
+
+
+# What SDF cannot hold or this writer does not translate, in the order W0500 names it.
+CANNOT_HOLD: tuple[holds.Tally, ...] = (
+    _skipped_joints,
+    _mimics,
+    holds.count(holds.noun("motor"), lambda r, o: len(r.motors)),
+    holds.count(holds.noun("sensor SDF has no type for"),
+                lambda r, o: sum(map(_untyped_sensor, r.sensors.values()))),
+    holds.count(holds.noun("named pose"), lambda r, o: len(r.poses)),
+    holds.count(holds.noun("loop-closure joint"), lambda r, o: 0 if o["cut_joints"] else len(r.cut_joints)),
+    holds.count(holds.noun("submechanism"), lambda r, o: len(r.submechanisms)),
+    holds.count(holds.noun("annotation category"), lambda r, o: len(r.annotations)),
+    holds.count(holds.noun("joint calibration"), lambda r, o: sum(j.calibration is not None
+                                                                   for j in r.joints.values())),
+    holds.count(holds.noun("joint safety controller"), lambda r, o: sum(j.safety_controller is not None
+                                                                         for j in r.joints.values())),
+    _fragments,
+    _inertial_extras,
+    _element_extras,
+    _material_details,
+    holds.named(holds.Named("the submechanisms file"), lambda r, o: bool(r.submechanisms_file)),
+)
 
 
 def _used_materials(robot: Robot) -> list[Material]:

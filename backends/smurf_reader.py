@@ -109,12 +109,12 @@ class _Reader:
         return path
 
     def model(self, name: str, where: tuple[str | int, ...]) -> Robot | None:
-        from mpc.backends import BACKENDS
+        from mpc.backends import sdf_reader, urdf_reader
 
         path = self.listed(name, where)
         if path is None:
             return None
-        reader = BACKENDS["sdf" if path.suffix.lower() == ".sdf" else "urdf"]()
+        reader = sdf_reader if path.suffix.lower() == ".sdf" else urdf_reader  # a SMURF lists no SMURF
         return reader.read(path, self.sink, self.resolver)
 
     def annotation_file(self, name: str, where: tuple[str | int, ...]) -> None:

@@ -77,8 +77,6 @@ _SESSION = frozenset({
     "XDG_SEAT", "MPC_PROFILE", "MPC_CACHE_TRACE", "MPC_MESH_WORKERS", "PYTHONDONTWRITEBYTECODE",
     "PYTHONUNBUFFERED", "PYTHONFAULTHANDLER", "PYTHONPROFILEIMPORTTIME", "PYTHONBREAKPOINT",
 })
-# Exports whose files depend only on the program, the robot and the files mpc reads.
-_KEPT_EXPORTS = frozenset({"urdf", "sdf", "smurf", "mjcf", "joint_limits", "submodel", "ros_package"})
 # What a build says about the state of mpc's own cache (W0650: a damaged mesh entry, computed
 # again), which the next build of the same inputs does not find: not said again.
 _OF_THE_CACHE = frozenset({"W0650"})
@@ -262,8 +260,12 @@ class KeptBuild:
                       "packages": sorted((p, n, f) for (p, n), f in self.recorder.packages.items()),
                       "diagnostics": diagnostics, "modelname": program.modelname, "span": program.span,
                       "outputs": None}
+        from mpc.backends.formats import FORMATS
+
         with contextlib.suppress(OSError):
-            if out is not None and all(e.type in _KEPT_EXPORTS for e in program.exports):
+            # Kept: the exports whose files depend only on the program, the robot and the files
+            # mpc reads (`kept` in the formats' table).
+            if out is not None and all(FORMATS[e.type].kept for e in program.exports):
                 opened = {f for f, _ in header["files"]}
                 header["outputs"] = self._keep_outputs(out, output_diagnostics, opened)
             try:

@@ -138,7 +138,7 @@ def _running(pid: int) -> bool:
 def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink: Sink,
                   target: Path | None) -> bool:
     """Write every export into `staging`; whether all succeeded."""
-    from mpc.backends import BACKENDS
+    from mpc.backends.formats import write
     from mpc.ir.program import CommandExport, JointLimitsExport, RobotExport, SubmodelExport
 
     submodels: dict[str, Robot | None] = {}
@@ -172,7 +172,7 @@ def _emit_exports(program: Program, robot: Robot, staging: Path, out: Path, sink
         folder.mkdir(parents=True, exist_ok=True)
         with stage(export.type):
             try:
-                BACKENDS[export.type]().emit(model, export, folder, sink)
+                write(model, export, folder, sink)
             except NotAFileName as e:  # a name check_file_names could not see (a submodel's)
                 sink.error(export.span, "E0540", f"{e}; nothing is written")
     return not sink.has_errors()
@@ -191,9 +191,10 @@ def _floating(robot: Robot, export: Export, sink: Sink) -> Robot | None:
 def _physical(robot: Robot, export: Export, sink: Sink) -> Robot:
     """`robot` with its non-physical inertials made physical (ir/physical.py); W0530 names them.
     SDFormat and MuJoCo forgive no rounding: for their exports the correction is exact."""
+    from mpc.backends.formats import FORMATS
     from mpc.ir.physical import correct_inertials
 
-    robot, changed = correct_inertials(robot, exact=export.type in ("sdf", "mjcf"))
+    robot, changed = correct_inertials(robot, exact=FORMATS[export.type].exact_inertials)
     if changed:
         more = f" and {len(changed) - 8} more" if len(changed) > 8 else ""
         shown = ", ".join(f"'{n}'" for n in changed[:8]) + more

@@ -105,7 +105,7 @@ class InputLoader:
         return False
 
     def _parse(self, path: Path, inp: Input, sink: Sink) -> Robot | None:
-        from mpc.backends import BACKENDS
+        from mpc.backends.formats import reader_of
 
         suffix = path.suffix.lower()
         if suffix == ".xacro":
@@ -113,8 +113,9 @@ class InputLoader:
 
             return xacro_reader.read(path, sink, self.options.resolver, inp.xacro_args, inp.span,
                                      inp.xacro_env)
-        reader = BACKENDS[suffix[1:] if suffix in (".sdf", ".smurf") else "urdf"]()
-        return reader.read(path, sink, self.options.resolver)
+        read = reader_of(path).read
+        assert read is not None
+        return read(path, sink, self.options.resolver)
 
     def _repo_file(self, inp: Input, fetch: bool) -> Path | None:
         from mpc.compiler.repos import checkout

@@ -11,18 +11,22 @@ from __future__ import annotations
 
 import re
 import shlex
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from mpc.backends.formats import FORMATS, Format
 from mpc.compiler.lower_context import LowerContext, strings
+from mpc.compiler.lower_joint_limits import lower_joint_limits
 from mpc.compiler.lower_smurf import SmurfLowering
+from mpc.compiler.schema import exports as schema
+from mpc.compiler.schema.base import Node
 from mpc.core.diagnostics import did_you_mean
 from mpc.ir.program import (
     CommandExport,
     Export,
     JointLimitsExport,
-    MjcfExport,
     PdfExport,
     RosPackageExport,
     SdfExport,
@@ -76,47 +80,53 @@ class _Exports:
     def export(self, entry: Any, robotname: str,
                submodel: str = "", inherited: bool = False) -> list[Export]:
         """One export_config entry; `submodel` names the submodel it writes (in submodels/<name>/,
-        where its meshes are too: its `package://` paths point there)."""
-        if entry.type == "kccd":
-            from mpc.compiler.lower_kccd import lower_kccd
-
-            if not inherited:
-                return lower_kccd(self.ctx, entry, self.written, submodel)
-            quiet = self.ctx.quiet()  # the model's own use of the entry reported
-            lowered = lower_kccd(quiet, entry, self.written, submodel)
-            return [] if quiet.sink.has_errors() else lowered
-        if entry.type == "render":
-            from mpc.compiler.lower_render import lower_render
-
-            target = f"{'submodels/' + submodel + '/' if submodel else ''}render/"
-            if target in self.written:
-                if not inherited:
-                    self.ctx.sink.error(entry.span, "E0576", f"two render exports would write {target}",
-                                        notes=((self.written[target].span, "the other export"),))
-                return []
-            render = lower_render(entry, (self.ctx.quiet() if inherited else self.ctx).sink, submodel)
-            if render is None:
-                return []
-            self.written[target] = render
-            return [render]
-        if entry.type in ("pdf", "joint_limits"):
-            export = self.simple_export(entry, inherited)
-            return [] if export is None else [replace(export, submodel=submodel)]
-        if entry.type == "smurf":
-            self.smurf.entry(entry, submodel)
-            return []
-        if entry.type not in BUILT_EXPORTS:
+        where its meshes are too: its `package://` paths point there). Its lowering is its
+        type's in `LOWERING`."""
+        lowering = LOWERING.get(entry.type)
+        if lowering is None:
             self.ctx.not_yet(entry.value_span("type"), f"export type '{entry.type}'"
                              + (" in a submodel" if submodel and entry.type == "submodel" else ""))
             return []
-        if entry.type == "mjcf" and not inherited:  # the model's own use of the entry reported
-            self.no_package_paths(entry)
-        if entry.provide_primitives and not inherited:
-            self.ctx.sink.warning(entry.key_span("provide_primitives"), "W0260", "'provide_primitives' has "
-                                  "no effect: Phobos's export reads it from no export entry (its default "
-                                  "preset sets it on sdf), and mpc writes the collisions as they are",
-                                  hint="collisions' `shape` with `apply_primitives: true` makes primitive "
-                                  "collisions")
+        return lowering.lower(self, entry, robotname, submodel, inherited)
+
+    def kccd(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        from mpc.compiler.lower_kccd import lower_kccd
+
+        if not inherited:
+            return lower_kccd(self.ctx, entry, self.written, submodel)
+        quiet = self.ctx.quiet()  # the model's own use of the entry reported
+        lowered = lower_kccd(quiet, entry, self.written, submodel)
+        return [] if quiet.sink.has_errors() else lowered
+
+    def render(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        from mpc.compiler.lower_render import lower_render
+
+        target = f"{'submodels/' + submodel + '/' if submodel else ''}render/"
+        if target in self.written:
+            if not inherited:
+                self.ctx.sink.error(entry.span, "E0576", f"two render exports would write {target}",
+                                    notes=((self.written[target].span, "the other export"),))
+            return []
+        render = lower_render(entry, (self.ctx.quiet() if inherited else self.ctx).sink, submodel)
+        if render is None:
+            return []
+        self.written[target] = render
+        return [render]
+
+    def pdf(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        """A pdf entry: no meshes, no kinematic options."""
+        return [PdfExport(span=entry.span, submodel=submodel)]
+
+    def smurf_entry(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        self.smurf.entry(entry, submodel)
+        return []
+
+    def kinematic(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        """A urdf, sdf or mjcf entry: a model file and its meshes, as its format's descriptor
+        (backends/formats.py) says."""
+        fmt = FORMATS[entry.type]
+        if not inherited:  # the model's own use of the entry reported
+            self.no_effect(entry, fmt)
         filename = (entry.filename or robotname) + entry.filename_suffix
         target = f"{'submodels/' + submodel + '/' if submodel else ''}{entry.type}/{filename}"
         if target in self.written:
@@ -125,31 +135,44 @@ class _Exports:
                                 notes=((self.written[target].span, "the other export"),))
             return []
         mesh_format = entry.mesh_format
-        if entry.type == "mjcf" and mesh_format == "input_type":
-            mesh_format = "obj"  # MuJoCo reads no DAE, and OBJ has no 200k-face limit
-        export = BUILT_EXPORTS[entry.type](mesh_format=mesh_format, span=entry.span,
-                                           add_floating_base=entry.add_floating_base, submodel=submodel,
-                                           filename=filename if filename != (submodel or robotname) else "")
+        if mesh_format == "input_type" and fmt.meshes is not None and fmt.meshes.input_type:
+            mesh_format = fmt.meshes.input_type  # MJCF: MuJoCo reads no DAE, and OBJ has no 200k-face limit
+        assert fmt.record is not None
+        export = fmt.record(mesh_format=mesh_format, span=entry.span,
+                            add_floating_base=entry.add_floating_base, submodel=submodel,
+                            filename=filename if filename != (submodel or robotname) else "")
+        export = self.smurf.link(entry, self.options(entry, fmt, export), submodel)
+        self.written[target] = export
+        return [export]
+
+    def no_effect(self, entry: Any, fmt: Format) -> None:
+        """Report the keys of a urdf, sdf or mjcf entry that its format ignores or cannot honour."""
+        if not fmt.package_paths:
+            self.no_package_paths(entry)
+        if entry.provide_primitives:
+            self.ctx.sink.warning(entry.key_span("provide_primitives"), "W0260", "'provide_primitives' has "
+                                  "no effect: Phobos's export reads it from no export entry (its default "
+                                  "preset sets it on sdf), and mpc writes the collisions as they are",
+                                  hint="collisions' `shape` with `apply_primitives: true` makes primitive "
+                                  "collisions")
+
+    def options(self, entry: Any, fmt: Format, export: Any) -> Any:
+        """`export` with the options of its entry that its format takes."""
         package = self.ctx.model.ros_pkg_name or ros_name(self.ctx.model.modelname)
-        if entry.type in ("urdf", "sdf"):
+        if fmt.package_paths:
             export = replace(export, ros_package=package if entry.ros_pathes else None,
                              copy_package=package if entry.copy_with_other_pathes else "")
         export = replace(export, correct_inertials=entry.correct_inertials)
         if entry.float_fmt_dict:
             export = replace(export, float_formats=self.float_formats(entry))
-        if entry.type == "sdf":
+        if not fmt.cut_joints:
             export = replace(export, version=entry.version, include_cut_joints=entry.include_cut_joints)
         elif entry.include_cut_joints:
             self.ctx.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
-                                f"no meaning in a {entry.type} export: "
-                                + ("URDF cannot hold loops" if entry.type == "urdf"
-                                   else "MJCF always closes loops with equality constraints"))
+                                f"no meaning in a {entry.type} export: {fmt.cut_joints}")
         extra = entry.additional_meshes
-        export = replace(export, enforce_zero=entry.enforce_zero,
-                         additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
-        export = self.smurf.link(entry, export, submodel)
-        self.written[target] = export
-        return [export]
+        return replace(export, enforce_zero=entry.enforce_zero,
+                       additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))
 
     def no_package_paths(self, entry: Any) -> None:
         """`ros_pathes` and `copy_with_other_pathes` on an mjcf entry: MuJoCo cannot read them."""
@@ -163,15 +186,14 @@ class _Exports:
 
     def float_formats(self, entry: Any) -> tuple[tuple[str, str], ...]:
         """`float_fmt_dict` of a urdf, sdf or mjcf entry, checked (backends/float_formats.py); sorted."""
-        from mpc.ir.float_format_keys import DEFAULT, KEYS, bad_format
+        from mpc.ir.float_format_keys import DEFAULT, bad_format
 
-        keys = KEYS[entry.type]
+        keys = FORMATS[entry.type].float_keys
         out = []
         for key, fmt in sorted(entry.float_fmt_dict.items()):
             span = entry.value_span("float_fmt_dict", key)
             if key != DEFAULT and key not in keys:
-                what = {"urdf": "attribute of a URDF", "sdf": "element of an SDF",
-                        "mjcf": "attribute of an MJCF"}[entry.type]
+                what = FORMATS[entry.type].numbers
                 self.ctx.sink.error(entry.key_span("float_fmt_dict", key), "E0530",
                                     f"float_fmt_dict: '{key}' is no number {what} file"
                                     f"{did_you_mean(key, set(keys) | {DEFAULT})}",
@@ -301,27 +323,38 @@ class _Exports:
         return RosPackageExport(span=m.span, package=package, version=version,
                                 description=m.description or "", license=m.license or "")
 
-    def simple_export(self, entry: Any, inherited: bool = False) -> Export | None:
-        """The pdf and joint_limits entries (no meshes, no kinematic options). An entry a
-        submodel inherits reports nothing: the model's own use of it did."""
-        if entry.type == "pdf":
-            return PdfExport(span=entry.span)
-        joints = tuple(entry.joints)
-        from mpc.ir.program import JOINT_SELECTIONS as SELECTIONS
+    def submodel_names(self) -> set[str]:
+        return {e.name for e in self.entries() if e.type == "submodel"}
 
-        # `joints: name` (a string, not a list) of a submodel lists that submodel's joints.
-        submodels = {e.name for e in self.entries() if e.type == "submodel"}
-        as_string = isinstance(entry.data_at("joints"), str)
-        if len(joints) == 1 and as_string and joints[0] in submodels:
-            return JointLimitsExport(span=entry.span, file_name=entry.file_name, joints_of=joints[0])
-        if len(joints) == 1 and as_string and joints[0].isupper() and joints[0] not in SELECTIONS:
-            if inherited:
-                return None
-            self.ctx.sink.error(entry.value_span("joints"), "E0524", f"joints: '{joints[0]}' is none of "
-                                f"{', '.join(SELECTIONS)} and names no submodel of this export_config"
-                                f"{did_you_mean(joints[0], set(SELECTIONS) | submodels)}")
-            return None
-        return JointLimitsExport(span=entry.span, joints=joints, file_name=entry.file_name)
+
+Lower = Callable[[_Exports, Any, str, str, bool], list[Export]]
+
+
+@dataclass(frozen=True)
+class Lowering:
+    """How the compiler takes an export type: its schema node (the `export_config` entry) and the
+    function that lowers an entry (the exports, the entry, the robot's name, the submodel that
+    writes it or "", whether a submodel inherits it) to IR exports. The format's other facts are
+    its descriptor's (backends/formats.py)."""
+
+    schema: type[Node]
+    lower: Lower
+
+
+# Each export type the compiler lowers; an entry of another type is reported as not supported
+# yet. (`submodel` entries are lowered apart: they hold exports of their own.)
+LOWERING: dict[str, Lowering] = {
+    "urdf": Lowering(schema.UrdfExport, _Exports.kinematic),
+    "sdf": Lowering(schema.SdfExport, _Exports.kinematic),
+    "mjcf": Lowering(schema.MjcfExport, _Exports.kinematic),
+    "smurf": Lowering(schema.SmurfExport, _Exports.smurf_entry),
+    "pdf": Lowering(schema.PdfExport, _Exports.pdf),
+    "render": Lowering(schema.RenderExport, _Exports.render),
+    "joint_limits": Lowering(schema.JointLimitsExport, lambda exports, entry, robotname, submodel, inherited:
+                             lower_joint_limits(exports.ctx, entry, exports.submodel_names(), submodel,
+                                                inherited)),
+    "kccd": Lowering(schema.KccdExport, _Exports.kccd),
+}
 
 
 _ROS_NAME = re.compile(r"[a-z][a-z0-9_]*")
@@ -342,8 +375,6 @@ _ROS_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 # Submodel options not built yet, with their defaults.
 _SUBMODEL_LATER: dict[str, Any] = {
     "include_human_in_abstract": False, "remove_links": []}
-# Export types `mpc compile` writes; the others are reported as not supported yet.
-BUILT_EXPORTS: dict[str, Any] = {"urdf": UrdfExport, "sdf": SdfExport, "mjcf": MjcfExport}
 
 
 def _lists_a_submodel(export: Export) -> bool:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
+from mpc.backends.formats import FORMATS
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir.program import Export, SdfExport, SmurfExport, SubmodelExport, UrdfExport
@@ -43,7 +44,7 @@ class SmurfLowering:
         if not entry.link_in_smurf:
             return export
         span = entry.key_span("link_in_smurf")
-        if entry.type not in ("urdf", "sdf"):
+        if not FORMATS[entry.type].in_smurf:
             self.sink.error(span, "E0511", f"a SMURF links a URDF or an SDF file, not {entry.type}")
             return export
         first = self.links.get(submodel)

@@ -1,6 +1,7 @@
 """Facts of the language's `float_fmt_dict`: the keys each export type accepts (the attributes
 or elements whose values are numbers its writer writes), `default`, and what a format is.
-Lowering checks a definition against them; backends/float_formats.py applies the formats.
+Each format's descriptor names its keys (backends/formats.py `float_keys`); lowering checks a
+definition against them; backends/float_formats.py applies the formats.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ SDF_KEYS = frozenset({
 MJCF_KEYS = frozenset({
     "pos", "quat", "mass", "diaginertia", "size", "axis", "range", "rgba", "scale", "polycoef",
     "damping", "frictionloss", "actuatorfrcrange", "ctrlrange"})
-KEYS = {"urdf": URDF_KEYS, "sdf": SDF_KEYS, "mjcf": MJCF_KEYS}
 DEFAULT = "default"
 _FORMAT = re.compile(r"%[-+ 0#]*[0-9]{0,2}(\.[0-9]{1,2})?[eEfFgG]")
 

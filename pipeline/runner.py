@@ -457,7 +457,5 @@ def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
 
 def _preload() -> None:
     """Import what every build uses before forking, so workers share it instead of importing it."""
-    from mpc.backends import BACKENDS
+    from mpc.backends import urdf  # noqa: F401
     from mpc.compiler import driver, front_end  # noqa: F401
-
-    BACKENDS["urdf"]()
