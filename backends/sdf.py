@@ -151,12 +151,13 @@ CANNOT_HOLD: tuple[holds.Tally, ...] = (
     _skipped_joints,
     _mimics,
     holds.count(holds.noun("motor"), lambda r, o: len(r.motors)),
-    holds.count(holds.noun("sensor SDF has no type for"),
+    holds.count(holds.Counted("sensor SDF has no type for", "sensors SDF has no type for"),
                 lambda r, o: sum(map(_untyped_sensor, r.sensors.values()))),
     holds.count(holds.noun("named pose"), lambda r, o: len(r.poses)),
     holds.count(holds.noun("loop-closure joint"), lambda r, o: 0 if o["cut_joints"] else len(r.cut_joints)),
     holds.count(holds.noun("submechanism"), lambda r, o: len(r.submechanisms)),
-    holds.count(holds.noun("annotation category"), lambda r, o: len(r.annotations)),
+    holds.count(holds.Counted("annotation category", "annotation categories"),
+                lambda r, o: len(r.annotations)),
     holds.count(holds.noun("joint calibration"), lambda r, o: sum(j.calibration is not None
                                                                    for j in r.joints.values())),
     holds.count(holds.noun("joint safety controller"), lambda r, o: sum(j.safety_controller is not None
