@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from mpc.core.files import project_root
 from mpc.ir.program import CompareTarget
 
 
@@ -21,22 +22,11 @@ def is_local(git: str) -> bool:
     return "://" not in git and "@" not in git.split("/")[0] and Path(git).is_absolute()
 
 
-def project_root(definition: Path) -> Path:
-    """The git work tree holding the definition file, else the definition's folder."""
-    from mpc.core.gitrun import GitFailed, git
-
-    folder = definition.resolve().parent
-    try:
-        return Path(git("rev-parse", "--show-toplevel", cwd=folder)).resolve()
-    except (GitFailed, OSError):
-        return folder
-
-
 def shown_path(path: Path, definition: Path) -> str:
     """`path` relative to the definition's folder when it lies in the project, else
     `<name> (outside the project)`."""
     path = path.resolve()
-    if path.is_relative_to(project_root(definition)):
+    if path.is_relative_to(project_root(definition.resolve().parent)):
         return Path(os.path.relpath(path, definition.resolve().parent)).as_posix()
     return f"{path.name} (outside the project)"
 

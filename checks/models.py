@@ -111,8 +111,10 @@ def load_built(program: Program, built: Path, robot: Robot | None) -> tuple[Mode
     return Model(robot=read, path=path, folder=built), ""
 
 
-def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, str]:
-    """The compare model: cloned (git) or read from disk (path). The model or None, and why."""
+def load_compare(target: CompareTarget, workdir: Path, shown: str | None = None) -> tuple[Model | None, str]:
+    """The compare model: cloned (git) or read from disk (path). The model or None, and why;
+    `shown` names a folder in the reason (the protocol's name, checks/compare_name.py: not the
+    runner's path), by default its path."""
     if target.git:
         folder, commit, problem = _clone(target, workdir)
         if folder is None:
@@ -121,7 +123,7 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
         assert target.path is not None
         folder, commit = target.path, ""
         if not folder.exists():
-            return None, f"compare model path '{folder}' does not exist"
+            return None, f"compare model path '{shown or folder}' does not exist"
     root = folder if folder.is_dir() else folder.parent  # where `…_in_repo` paths start
     path = folder / target.model_in_repo if target.model_in_repo else folder
     if path.is_dir():
@@ -129,7 +131,9 @@ def load_compare(target: CompareTarget, workdir: Path) -> tuple[Model | None, st
         patterns = ("urdf/*.urdf", "*.urdf", "sdf/*.sdf")
         found = next((sorted(path.glob(p)) for p in patterns if any(path.glob(p))), [])
         if not found:
-            return None, f"no model file ({', '.join(patterns)}) in '{path}'; name it with model_in_repo"
+            inside = shown and (f"{shown}/{target.model_in_repo}" if target.model_in_repo else shown)
+            return None, (f"no model file ({', '.join(patterns)}) in '{inside or path}'; "
+                          "name it with model_in_repo")
         path = found[0]
     elif not path.is_file():
         return None, f"'{target.model_in_repo}' does not exist in the compare model" + (

@@ -49,9 +49,9 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     ctx = Context(program=program, plan=plan, sink=sink, new=new, new_problem=new_problem, robot=robot)
     protocol = Protocol(model=program.modelname)
     if plan.compare is not None:
-        ctx.old, ctx.old_problem = _load(load_compare, plan.compare, workdir)
         target = plan.compare
         where = compare_name(target, Path(program.span.file) if program.span.file else None)
+        ctx.old, ctx.old_problem = _load(load_compare, target, workdir, where)
         if ctx.old is None:
             sink.error(target.span, "E0704", ctx.old_problem)
             protocol.compare = f"`{where}`, which could not be loaded"

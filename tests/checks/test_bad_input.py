@@ -90,7 +90,7 @@ def test_edge_models_compared_with_themselves_never_crash(tmp_path: Path, name: 
 
 
 @pytest.mark.parametrize(("compare", "reason"), [
-    ("      path: nothing\n", "compare model path '{tmp}/nothing' does not exist"),
+    ("      path: nothing\n", "compare model path 'nothing' does not exist"),  # as the protocol names it
     ("      path: notes.txt\n", "cannot read the compare model 'notes.txt': {tmp}/notes.txt:1:1: "
      "malformed XML in '{tmp}/notes.txt': Start tag expected, '<' not found"),
     ("      path: broken.urdf\n", "cannot read the compare model 'broken.urdf': {tmp}/broken.urdf:1:33: "

@@ -54,3 +54,18 @@ def test_a_remote_compare_repository_is_shown_by_its_address_without_credentials
                          ("git@git.example.org:robots/solo.git", "git@git.example.org:robots/solo.git"),
                          ("ssh://git@git.example.org/robots/solo.git", "ssh://git@git.example.org/robots/solo.git")):
         assert compare_name(CompareTarget(span=span, git=given), tmp_path / "m.yml") == shown
+
+
+def test_a_compare_folder_that_cannot_be_loaded_is_named_as_the_protocol_names_it(tmp_path: Path) -> None:
+    """The reason a test failed (the compare model cannot be loaded) names the folder as the
+    protocol's "Compared with" does, not by the runner's path."""
+    subprocess.run(["git", "init", "-q", str(tmp_path / "project")], check=True)
+    (tmp_path / "project/releases/empty").mkdir(parents=True)
+    for given, shown in (("../releases/missing", "compare model path '../releases/missing' does not exist"),
+                         ("../releases/empty", "no model file (urdf/*.urdf, *.urdf, sdf/*.sdf) in "
+                                               "'../releases/empty'; name it with model_in_repo")):
+        write(tmp_path / "project/models/m.yml", definition(SOLO, "solo", TESTS, f"      path: {given}\n"))
+        protocol = run(tmp_path / "project/models/m.yml", tmp_path / "out", tmp_path / "work")
+        text = protocol.markdown()
+        assert f"the compare model cannot be loaded: {shown}" in text, text
+        assert str(tmp_path) not in text
