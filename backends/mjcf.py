@@ -50,6 +50,7 @@ from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import matrix_pose, pose_matrix
+from mpc.ir.physical import TOO_LARGE, principal_moments
 from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.tree import child_joints, depth_first
@@ -121,18 +122,12 @@ def unusable_inertial(inertial: Inertial) -> str | None:
     numbers = (inertial.mass, i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz, *xyz)
     if not all(math.isfinite(x) for x in numbers):
         return "its mass, inertia or centre of mass holds a number that is not finite"
-    try:
-        moments = np.linalg.eigvalsh(np.array([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz],
-                                               [i.ixz, i.iyz, i.izz]]))
-    except np.linalg.LinAlgError:
-        moments = np.array([math.nan])
-    if not np.isfinite(moments).all():
-        return "its inertia is too large for its principal moments to be numbers (they overflow)"
-    return None
+    return TOO_LARGE if principal_moments(i) is None else None
 
 
 def _mass_ok(inertial: Inertial | None) -> bool:
-    return inertial is not None and inertial.mass >= MJMINVAL and min(principal(inertial)[0]) >= MJMINVAL
+    return (inertial is not None and unusable_inertial(inertial) is None and inertial.mass >= MJMINVAL
+            and min(principal(inertial)[0]) >= MJMINVAL)
 
 
 def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = None) -> bool:
@@ -155,7 +150,10 @@ def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = N
         if link == robot.root == "world":
             continue
         problems = []
-        if inertial is not None:
+        unusable = unusable_inertial(inertial) if inertial is not None else None
+        if unusable is not None:
+            problems.append(unusable)
+        elif inertial is not None:
             d, _ = principal(inertial)
             a, b, c = sorted(d)
             if inertial.mass < 0:

@@ -177,7 +177,7 @@ class _Reader:
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
             values = self.numbers[text] = finite_floats(text)
-        if type(values) is not tuple or len(values) != n:
+        if values is NOT_FINITE or not isinstance(values, tuple) or len(values) != n:
             self.not_numbers(el, attr, n, where, text, values is NOT_FINITE)
             return None
         return values
@@ -193,7 +193,7 @@ class _Reader:
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
             values = self.numbers[text] = finite_floats(text)
-        if type(values) is not tuple or len(values) != 1:
+        if values is NOT_FINITE or not isinstance(values, tuple) or len(values) != 1:
             self.not_numbers(el, attr, 1, where, text, values is NOT_FINITE)
             return None
         return values[0]

@@ -38,10 +38,27 @@ def _matrix(i: Inertia) -> np.ndarray:
     return np.array([[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]])
 
 
+def principal_moments(i: Inertia) -> np.ndarray | None:
+    """The principal moments of `i`, ascending; None when they are no numbers (a tensor
+    holding a number that is not finite, or so large that the eigenvalues overflow or do not
+    converge)."""
+    try:
+        moments = np.linalg.eigvalsh(_matrix(i))
+    except np.linalg.LinAlgError:
+        return None
+    return moments if np.isfinite(moments).all() else None
+
+
+TOO_LARGE = "its inertia is too large for its principal moments to be numbers (they overflow)"
+
+
 def lift(i: Inertia, exact: bool = False) -> float:
-    """The amount to add to each principal moment of `i` (0 when it is physical); `exact`:
+    """The amount to add to each principal moment of `i` (0 when it is physical, or when its
+    moments are no numbers: nothing makes it physical, and the exports refuse it); `exact`:
     forgive no rounding beyond SDFormat's (`sdformat_problems`)."""
-    moments = np.linalg.eigvalsh(_matrix(i))  # ascending: only a + b >= c can fail
+    moments = principal_moments(i)  # ascending: only a + b >= c can fail
+    if moments is None:
+        return 0.0
     a, b, c = (float(m) for m in moments)
     broken = c - a - b
     if a > 0 and broken <= (_gz_epsilon(moments) if exact else ROUNDING * max(abs(a), abs(c))):
@@ -86,7 +103,9 @@ def sdformat_problems(inertial: Inertial) -> list[str]:
     `MassMatrix3::IsValid`): a negative mass, a tensor not positive semi-definite, or
     principal moments violating A + B ≥ C, each beyond `_gz_epsilon`. A zero mass and
     tensor is valid (a massless frame). Empty when SDFormat accepts it."""
-    moments = np.linalg.eigvalsh(_matrix(inertial.inertia))
+    moments = principal_moments(inertial.inertia)
+    if moments is None:
+        return [TOO_LARGE]
     a, b, c = (float(m) for m in moments)
     epsilon = _gz_epsilon(moments)
     problems = []

@@ -83,6 +83,9 @@ SITES: dict[tuple[str, str, str], str] = {
     ("xacro_guard.py", "checked_file", "Path(path)"): READ,
     ("xacro_origins.py", "start_element_handler", "Path(stack[-1])"): READ,
     ("xacro_origins.py", "_recording", "Path(stack[-1])"): READ,
+    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae'"): CACHE,
+    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest[:2]"): CACHE,
+    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest[:2] / digest"): CACHE,
     ("meshes.py", "key", "Path(mesh.source.uri.removeprefix(GENERATED))"):
         "a made mesh's key (`<link>_joined`); its output path goes through copy's confined",
 }

@@ -127,6 +127,28 @@ def test_an_inertia_whose_principal_moments_overflow_is_refused_for_mjcf_at_its_
     assert not (tmp_path / "out/mjcf").exists()
 
 
+MJCF, SDF = "    - type: mjcf\n      mesh_format: stl\n", "    - type: sdf\n      mesh_format: stl\n"
+
+
+# `mpc check` leaves inertials to `correct_inertials` where it is set: compiling refuses one it
+# cannot correct (not checked ahead).
+@pytest.mark.parametrize(("command", "export"), [
+    ("check", MJCF), ("check", SDF),
+    ("compile", MJCF), ("compile", SDF), ("compile", SDF + "      correct_inertials: true\n")])
+def test_an_inertia_whose_principal_moments_overflow_is_an_error_for_check_and_every_export(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], export: str, command: str) -> None:
+    """What the fuzz found (an exit 3 of `mpc check`, LinAlgError): the inertial checks of
+    `mpc check` and of the SDF export, and `correct_inertials`, meet the same tensor."""
+    urdf = ARM_URDF.replace('ixx="0.004" ixy="0" ixz="0" iyy="0.004" iyz="0" izz="0.001"',
+                            'ixx="1e308" ixy="1e308" ixz="0" iyy="1e308" iyz="0" izz="0.001"')
+    spec = _model(tmp_path, urdf, export)
+    code, err = _mpc(capsys, command, spec, *(("-o", tmp_path / "out") if command == "compile" else ()))
+    assert code == 1, err
+    assert f"{tmp_path}/arm.urdf:20:3: error[" in err
+    assert "its inertia is too large for its principal moments to be numbers (they overflow)" in err
+    assert "internal error" not in err and not (tmp_path / "out").exists()
+
+
 # -- 25. accepted, but invalid outputs ------------------------------------------------------------
 
 @pytest.mark.parametrize(("old", "new", "where"), [

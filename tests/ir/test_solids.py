@@ -239,7 +239,8 @@ def test_a_mesh_with_nan_vertices_is_an_error_and_an_empty_one_a_warning(tmp_pat
                     + "  frames:\n    $default: {estimate_missing_inertia: true}\n")
     sink = Diags()
     assert compile_file(spec, tmp_path / "out", sink).out is None
-    assert sink.take_error("E0602").message == ("estimate_missing_inertia of link 'base': mesh 'nan.stl' "
-                                                "has vertices that are not finite numbers")
+    assert sink.take_error("E0602").message == (
+        f"estimate_missing_inertia of link 'base': cannot read mesh '{tmp_path / 'nan.stl'}': a vertex "
+        "has a coordinate that is not a finite number (nan or inf)")
     assert sink.take("W0580", Severity.WARNING).message == ("estimate_missing_inertia of link 'tip': mesh "
                                                             "'empty.stl' has no triangles: it adds no volume")
