@@ -10,6 +10,7 @@ a mesh that cannot be read is left to the mesh export (E0602, E0603).
 
 from __future__ import annotations
 
+import os
 import re
 import struct
 from pathlib import Path
@@ -26,12 +27,15 @@ def has_no_triangles(path: Path) -> bool:
     """Whether the mesh file at `path` surely holds no triangle; False when unsure."""
     suffix = path.suffix.lower()
     try:
+        if suffix == ".stl":  # a binary STL says it in its header: the rest is not read
+            with open(path, "rb") as f:
+                head, size = f.read(84), os.fstat(f.fileno()).st_size
+            if len(head) == 84 and size == 84 + 50 * struct.unpack_from("<I", head, 80)[0]:
+                return struct.unpack_from("<I", head, 80)[0] == 0  # binary: the count fits the size
         data = path.read_bytes()
     except OSError:
         return False
     if suffix == ".stl":
-        if len(data) >= 84 and len(data) == 84 + 50 * struct.unpack_from("<I", data, 80)[0]:
-            return struct.unpack_from("<I", data, 80)[0] == 0  # binary: the count fits the size
         # ASCII: whole (it ends) but without a facet; a file that is neither is left to reading it
         return data.lstrip().startswith(b"solid") and b"endsolid" in data and b"facet" not in data
     if suffix == ".obj":

@@ -37,7 +37,6 @@ from collections.abc import Callable, Collection, Iterator
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from mpc.backends import holds, meshes, xml_escape
 from mpc.backends.float_formats import MJCF_KEYS, Formats
@@ -85,6 +84,8 @@ def _quat_rpy(rpy: tuple[float, float, float]) -> Quat:
 
 def _quat_matrix(R: np.ndarray) -> Quat:
     """(w, x, y, z) of a rotation matrix; w ≥ 0."""
+    from scipy.spatial.transform import Rotation  # not on `mpc check`'s path (front_end.check_inertials)
+
     x, y, z, w = (float(c) for c in Rotation.from_matrix(R).as_quat())
     return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)
 

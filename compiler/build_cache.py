@@ -55,7 +55,7 @@ from mpc.compiler.kept_values import BadValue, dumps, loads
 from mpc.core import cache
 from mpc.core.blas import user_environment
 from mpc.core.diagnostics import Diagnostic, Sink
-from mpc.core.files import clone_file, name_problem
+from mpc.core.files import copy_file, name_problem
 from mpc.core.packages import interpreter_sites
 from mpc.core.reads import ReadRecorder, recording
 from mpc.core.span import Span
@@ -297,7 +297,7 @@ class KeptBuild:
                 if source.is_symlink() or not source.is_file():
                     shutil.rmtree(copy, ignore_errors=True)
                     return None
-                clone_file(source, target)
+                copy_file(source, target)
                 with open(target, "rb") as f:
                     names.append((str(rel / name), hashlib.file_digest(f, "sha256").hexdigest()))
         return {"folder": copy.name, "files": sorted(names), "folders": sorted(folders), "read": files,

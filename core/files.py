@@ -268,18 +268,6 @@ def describe(error: OSError, operation: str | None = None) -> str:
 _WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
 
 
-def copy_file(source: Path, target: Path) -> None:
-    """shutil.copyfile, whose errors name the file that failed: shutil names the source for
-    every error of its fast copy (sendfile), a full disk included, and the user would look
-    for the problem at the mesh they gave rather than at the output."""
-    try:
-        shutil.copyfile(source, target)
-    except OSError as e:
-        if e.errno in _WRITE_ERRORS:
-            raise OSError(e.errno, e.strerror, str(target)) from e
-        raise
-
-
 def write_atomic(path: Path, data: str | bytes, *, private: bool = False) -> None:
     """Write `data` to `path` all at once: a reader, or a write that fails half-way (a full
     disk, a kill), never sees a partial file; the previous file stays until the new one is
@@ -309,11 +297,22 @@ def write_atomic(path: Path, data: str | bytes, *, private: bool = False) -> Non
 _FICLONE = 0x40049409  # linux/fs.h: _IOW(0x94, 9, int)
 
 
-def clone_file(source: Path, target: Path) -> None:
+def copy_file(source: Path, target: Path) -> None:
     """Make `target` a copy of `source` that shares no storage with it, as a later write into
     either would: a copy-on-write clone where the file system makes one (btrfs, XFS: FICLONE),
     else `copy_file_range` (which a file system may also make a clone of), else a plain copy.
-    Never a hard link. Raises OSError."""
+    Never a hard link. Raises OSError; one of writing (a full disk) names `target`, not the
+    source as shutil's fast copy does, since the user would look for the problem at the mesh
+    they gave rather than at the output."""
+    try:
+        _copy(source, target)
+    except OSError as e:
+        if e.errno in _WRITE_ERRORS:
+            raise OSError(e.errno, e.strerror, str(target)) from e
+        raise
+
+
+def _copy(source: Path, target: Path) -> None:
     import fcntl
 
     with open(source, "rb") as src, open(target, "wb") as dst:
