@@ -249,8 +249,10 @@ def test_kept_values_read_back_as_the_values_written() -> None:
              "diagnostic": Diagnostic(Severity.WARNING, "W0401", "m", span, ((None, "n"), (span, "o")), "h"),
              "list": [True, None, 2**70]}
     back = loads(dumps(value))
-    assert repr(back) == repr(value) and back["diagnostic"] == value["diagnostic"]
-    assert type(back["floats"]) is tuple and type(back["list"]) is list
+    floats = back.pop("floats")  # NaN is not equal to itself: compared by its text
+    assert type(floats) is tuple and repr(floats) == repr(value.pop("floats"))
+    assert back == value and type(back["list"]) is list and back["list"][0] is True
+    assert type(back["path"]) is PosixPath and type(back[("x", 1)]) is frozenset
 
 
 @pytest.mark.parametrize(("text", "why"), [
