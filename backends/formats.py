@@ -169,10 +169,10 @@ _FORMATS = (
            cut_joints="MJCF always closes loops with equality constraints", exact_inertials=True,
            holds=_mjcf_holds),
     Format("smurf", program.SmurfExport, _write_smurf, _read_smurf, (".smurf",), kept=True),
-    Format("pdf", program.PdfExport, _write_pdf),
-    Format("render", program.RenderExport, _write_render),
+    Format("pdf", program.PdfExport, _write_pdf, kept=True),
+    Format("render", program.RenderExport, _write_render, kept=True),
     Format("joint_limits", program.JointLimitsExport, _write_joint_limits, kept=True),
-    Format("kccd", program.KccdExport, _write_kccd),
+    Format("kccd", program.KccdExport, _write_kccd, kept=True),
     Format("ros_package", program.RosPackageExport, _write_ros_package, kept=True),
     # Not formats but exports all the same: the part of the robot others write (the driver
     # cuts it), a post_processing command (the driver runs it).

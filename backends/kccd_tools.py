@@ -12,7 +12,6 @@ for simplify_swept_from, each BODY block's points replaced by `kccdcoveriv <mesh
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from typing import Any
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
 from mpc.core.files import confined
+from mpc.core.programs import which
 from mpc.ir.program import KccdExport
 
 
@@ -27,7 +27,7 @@ def run_tools(folder: Path, robot: str, settings: dict[str, Any], export: KccdEx
               stls: list[Path], sink: Sink) -> None:
     """Run urdf2kccd and kccdcoveriv in `folder` if installed; then drop the STL hulls and
     the URDF unless keep_stls / keep_urdf (only then: without the tools they are the output)."""
-    urdf2kccd = shutil.which("urdf2kccd")
+    urdf2kccd = which("urdf2kccd")
     if urdf2kccd is None:
         sink.warning(export.span, "W0520", f"urdf2kccd is not on PATH: wrote the hulls, {export.dirname}/"
                      f"{robot}.urdf and {export.dirname}/{robot}_kccd.yml; urdf2kccd would have made "
@@ -92,7 +92,7 @@ def configured(cfg: str, settings: dict[str, Any], export: KccdExport, folder: P
             body, mesh = words[1], words[8]
             link = body[2:]  # urdf2kccd names a link's body with a two-letter prefix
             body_names[link] = body
-            covering = shutil.which("kccdcoveriv")
+            covering = which("kccdcoveriv")
             if covering is not None and link in n_points:
                 out = _run(export, [covering, mesh, str(n_points[link]), body], folder, sink)
                 if out is None:
@@ -101,7 +101,7 @@ def configured(cfg: str, settings: dict[str, Any], export: KccdExport, folder: P
                         if not line.startswith(("BODYRADIUS", "BODYPOINT"))]
                 block = "\n".join(kept).strip() + "\n" + out[out.find("# Fitted volume"):].strip()
         blocks.append(block.strip() + "\n\n")
-    if shutil.which("kccdcoveriv") is None:
+    if which("kccdcoveriv") is None:
         sink.warning(export.span, "W0520", "kccdcoveriv is not on PATH: the bodies keep the points "
                      "urdf2kccd gave them, without a fitted volume")
     for a, b in settings["dont_check"]:

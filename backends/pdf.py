@@ -11,7 +11,6 @@ still written and a warning says how to get the PDF.
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 from collections.abc import Collection, Iterable
 from pathlib import Path
@@ -19,6 +18,7 @@ from pathlib import Path
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink
 from mpc.core.files import confined
+from mpc.core.programs import which
 from mpc.ir.program import PdfExport
 from mpc.ir.robot import Joint, Robot
 from mpc.ir.tree import depth_first
@@ -88,7 +88,7 @@ def to_gv(robot: Robot, changed: Collection[str] | None = None) -> str:
 def render_pdf(gv: str) -> bytes | str:
     """The PDF of a Graphviz source, byte-stable (`_stable`), or why not (no `dot`, or its
     complaint)."""
-    dot = shutil.which("dot")
+    dot = which("dot")
     if dot is None:
         return "'dot' (Graphviz) is not installed"
     done = subprocess.run([dot, "-Tpdf"], input=gv.encode(), capture_output=True,
@@ -104,7 +104,7 @@ def emit(robot: Robot, export: PdfExport, out: Path, sink: Sink) -> None:
     gv = confined(out, f"{name}.pdf.gv")
     text = to_gv(robot)
     write_path(gv, text)
-    dot = shutil.which("dot")
+    dot = which("dot")
     if dot is None:
         sink.warning(export.span, "W0502", f"'dot' (Graphviz) is not installed: wrote {gv.name} but "
                      "not the PDF", hint=f"apt-get install graphviz, then: dot -Tpdf {gv.name} -o {name}.pdf")

@@ -16,6 +16,7 @@ from pathlib import Path
 from mpc.backends.scene import GLMissing, Scene, frame, missing_gl_hint, png
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.files import confined
+from mpc.core.programs import note_loaded_libraries
 from mpc.ir.kinematics import zero_within_limits
 from mpc.ir.program import RenderExport
 from mpc.ir.robot import Robot
@@ -105,6 +106,7 @@ def emit(robot: Robot, export: RenderExport, out: Path, sink: Sink) -> None:
     pictures = draw_all(robot, export, sink)
     if pictures is None:
         return
+    note_loaded_libraries()  # EGL and Mesa drew them: a kept render depends on their files
     folder = confined(out, "render")
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in sorted(pictures.items()):

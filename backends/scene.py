@@ -99,10 +99,12 @@ def _mesh_files(robot: Robot, workdir: Path, sink: Sink, span: Span) -> dict[Any
 
 def _gl_context(width: int, height: int) -> Any:
     """An EGL context (mujoco.egl); GLMissing with the reason when there is none."""
-    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
-    if os.environ["PYOPENGL_PLATFORM"] != "egl":
-        raise GLMissing(f"PYOPENGL_PLATFORM is '{os.environ['PYOPENGL_PLATFORM']}'; mpc renders "
-                        "through EGL")
+    given = os.environ.get("PYOPENGL_PLATFORM")
+    if given not in (None, "egl"):
+        raise GLMissing(f"PYOPENGL_PLATFORM is '{given}'; mpc renders through EGL")
+    # PyOpenGL reads the variable when it is first imported; it is not left set, since the
+    # environment is part of what a build is kept by (compiler/build_cache.py).
+    os.environ["PYOPENGL_PLATFORM"] = "egl"
     try:
         from mujoco.egl import GLContext
 
@@ -110,6 +112,9 @@ def _gl_context(width: int, height: int) -> Any:
         ctx.make_current()
     except Exception as e:  # ImportError (no libEGL), RuntimeError / EGLError (no device)
         raise GLMissing(f"{type(e).__name__}: {e}".strip()) from None
+    finally:
+        if given is None:
+            del os.environ["PYOPENGL_PLATFORM"]
     return ctx
 
 

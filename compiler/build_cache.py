@@ -16,8 +16,9 @@ the ops) depends only on:
   which file each path leads to and what it is, since the readers refuse a link out of the
   package roots or a special file, and must refuse a file swapped for one.
 The outputs depend, besides, on the files that writing them opened (the mesh files, by
-their bytes); exports that run other programs (`pdf`: Graphviz, `render`: EGL, `kccd`'s
-tools, `post_processing` commands) make outputs that are not kept.
+their bytes) and on the programs they were made with (`pdf`: Graphviz, `render`: EGL and
+Mesa, `kccd`'s tools: core/programs.py notes their files); `post_processing` commands, whose
+reads no one sees, make outputs that are not kept.
 
 A kept build is used only when all of this is as it was, and its diagnostics are reported
 again. Not kept: a build that failed (it runs again and says why again), one that fetched a

@@ -42,6 +42,7 @@ class ReadRecorder:
         self.written: set[str] = set()
         self.packages: dict[tuple[str, str], str | None] = {}  # (package, near) → its folder
         self.volatile: list[str] = []  # why the result may differ with no file changed
+        self.programs: dict[str, None] = {}  # files of the programs outputs were made with (`note_files`)
         # The Python installation holds code; its `share/` folders hold data (robot packages).
         prefixes = (sys.prefix, sys.base_prefix, sys.exec_prefix)
         self.code = tuple({os.path.realpath(p) + os.sep for p in prefixes})
@@ -69,8 +70,9 @@ class ReadRecorder:
 
     def inputs(self, first: int | None = None) -> list[Path]:
         """The files read that are inputs of the build (see the filters above); files that were
-        looked for and not found included. first: only among the first so many files read."""
-        out = set()
+        looked for and not found included. first: only among the first so many files read; without
+        it, the files of programs noted (`note_files`) too."""
+        out = {Path(p) for p in self.programs} if first is None else set()
         for text in itertools.islice(self.read, first):
             if text in self.written or text.startswith(_SYSTEM) or text.startswith(self.ignore):
                 continue
@@ -108,6 +110,15 @@ def note_package(package: str, near: Path | None, found: Path | None) -> None:
     for recorder in _active:
         recorder.packages[(package, str(near) if near is not None else "")] = \
             str(found) if found is not None else None
+
+
+def note_files(paths: Iterable[str]) -> None:
+    """Files a result depends on that it did not open: the programs it was made with
+    (core/programs.py), libraries included; a path that does not exist is one looked for."""
+    paths = tuple(paths)
+    for recorder in _active:
+        for path in paths:
+            recorder.programs.setdefault(path)
 
 
 def note_volatile(why: str) -> None:

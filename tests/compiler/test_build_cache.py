@@ -9,6 +9,7 @@ its outputs` when its outputs are.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -216,13 +217,56 @@ def test_a_package_that_appears_earlier_on_the_search_path_builds_again(
     assert (result.out / "meshes/stl/tetra.stl").read_bytes() == nearer.read_bytes()
 
 
-def test_outputs_of_other_programs_are_not_kept(tmp_path: Path, trace: Path) -> None:
-    spec = _model(tmp_path / "model", more="- {type: pdf}")
+def test_outputs_drawn_by_other_programs_are_kept(tmp_path: Path, trace: Path) -> None:
+    render = "- {type: render, views: [front], size: [64, 48]}"
+    spec = _model(tmp_path / "model", more=f"- {{type: pdf}}\n        {render}")
     first, _, events = _build(spec, tmp_path / "out1", trace)
     assert first.out is not None and events == ["keep build"]
+    assert (first.out / "arm.pdf").stat().st_size > 0 and (first.out / "render/zero_front.png").is_file()
     second, _, events = _build(spec, tmp_path / "out2", trace)
-    assert events == ["reuse build", "keep build"]  # its program and robot, not Graphviz's PDF
+    assert events == ["reuse build with its outputs"]
     assert second.out is not None and _files(second.out) == _files(first.out)
+
+
+def test_a_changed_or_installed_program_draws_its_output_again(tmp_path: Path, trace: Path,
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    spec = _model(tmp_path / "model", more="- {type: pdf}")
+    bin_folder = tmp_path / "bin"
+    bin_folder.mkdir()
+    monkeypatch.setenv("PATH", str(bin_folder))  # no `dot` on it: W0502, the Graphviz source only
+    first, sink, events = _build(spec, tmp_path / "out1", trace)
+    assert first.out is not None and events == ["keep build"] and not (first.out / "arm.pdf").exists()
+    assert "W0502" in [d.code for d in sink.diagnostics]
+    dot = bin_folder / "dot"  # installed: Graphviz's own, run through a script
+    dot.write_text(f"#!/bin/sh\nexec {shutil.which('dot', path='/usr/bin:/bin')} \"$@\"\n")
+    dot.chmod(0o755)
+    _settle()
+    second, sink, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build", "keep build"] and "W0502" not in [d.code for d in sink.diagnostics]
+    assert second.out is not None and (second.out / "arm.pdf").read_bytes().startswith(b"%PDF")
+    assert _build(spec, tmp_path / "out3", trace)[2] == ["reuse build with its outputs"]
+    dot.write_text(dot.read_text() + "# upgraded\n")  # another version of the program
+    _settle()
+    assert _build(spec, tmp_path / "out4", trace)[2] == ["reuse build", "keep build"]
+
+
+def test_a_render_depends_on_the_graphics_libraries_that_drew_it(tmp_path: Path) -> None:
+    from mpc.backends import render
+    from mpc.backends.urdf_reader import read
+    from mpc.core.reads import ReadRecorder, recording
+    from mpc.core.span import Span
+    from mpc.ir.program import RenderExport
+
+    arm(tmp_path)
+    robot = read(tmp_path / "arm.urdf", Sink(), None)
+    assert robot is not None
+    with recording(ReadRecorder()) as recorder:
+        render.emit(robot, RenderExport(span=Span("a.yml", 1, 1, 1, 1), views=("front",), size=(32, 24)),
+                    tmp_path / "out", Sink())
+    assert (tmp_path / "out/render/zero_front.png").is_file()
+    drawn_with = [os.path.basename(p) for p in recorder.programs]
+    assert any(name.startswith("libEGL_mesa.so") for name in drawn_with), drawn_with
+    assert all(not p.startswith(sys.prefix) for p in recorder.programs)
 
 
 def test_a_build_that_failed_is_not_kept(tmp_path: Path, trace: Path) -> None:
