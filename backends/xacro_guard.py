@@ -16,6 +16,8 @@ not all of Python's. `$(env NAME)` and `$(optenv NAME)` read only the variables 
 model lists in `xacro_env`. Every file xacro opens (an include, `xacro.load_yaml`) must pass
 the read rule of every input (core/packages.py `refusal`). A refusal raises `Refused`, which
 the reader turns into a diagnostic; nothing of the refused expression is evaluated.
+What an expansion may compute is bounded too (backends/xacro_limits.py, E0673): each
+operation that could run without end in one step, and the whole expansion's time and memory.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from mpc.backends.xacro_limits import ExpansionTooLong, TooLarge, bound_symbols, bounded_code, builtins_of
 from mpc.core.packages import PackageResolver
 from mpc.core.reads import note_volatile
 
@@ -84,6 +87,20 @@ def check_expression(expression: str) -> None:
                       "(a xacro model computes values; it does not reach into Python)", expression)
 
 
+def evaluate(expression: str, globals: Any, locals: Any) -> Any:
+    """`expression` evaluated as xacro evaluates it, once it is allowed (`check_expression`) and
+    with its operations bounded (backends/xacro_limits.py); past a bound, `Refused` (E0673)."""
+    check_expression(expression)
+    code = bounded_code(expression)
+    try:
+        if isinstance(code, str):
+            raise TooLarge(code)
+        return builtins.eval(code, globals, locals)
+    except TooLarge as e:
+        raise Refused("E0673", f"the expression '{_short(expression)}' is not evaluated: {e} (a xacro "
+                      "model computes values of the size a robot needs)", expression) from None
+
+
 def _short(text: str) -> str:
     text = " ".join(text.split())
     return text if len(text) <= 80 else text[:77] + "..."
@@ -98,12 +115,12 @@ def guarded(resolver: PackageResolver, near: Path, environment: tuple[str, ...])
     from xacro import substitution_args as subst
 
     def safe_eval(expression: str, globals: Any, locals: Any = None) -> Any:
-        check_expression(expression)
-        return original_safe_eval(expression, globals, locals)
+        # xacro's own safe_eval, less its builtins and with the operations bounded
+        globals.update(__builtins__=builtins_of({}))
+        return evaluate(expression, globals, locals)
 
     def restricted_eval(expression: str, _globals: Any = None, locals: Any = None) -> Any:
-        check_expression(expression)
-        return builtins.eval(expression, {"__builtins__": dict(EVAL_BUILTINS)}, locals)
+        return evaluate(expression, {"__builtins__": builtins_of(EVAL_BUILTINS)}, locals)
 
     def allowed(name: str) -> None:
         if name not in environment:
@@ -142,7 +159,8 @@ def guarded(resolver: PackageResolver, near: Path, environment: tuple[str, ...])
     symbols = xacro.create_global_symbols()  # a fresh table: no expansion sees another's edits
     for name in DENIED_SYMBOLS:
         symbols["python"].pop(name, None)
-    original_safe_eval, original_env, original_parse = xacro.safe_eval, subst._eval_env, xacro.parse
+    bound_symbols(symbols)
+    original_env, original_parse = subst._eval_env, xacro.parse
     saved = (xacro._global_symbols, xacro.safe_eval, xacro.parse, xacro.abs_filename_spec,
              subst._eval_env, subst._eval_optenv, dict(subst._eval_dict), subst.__dict__.get("eval"))
     xacro._global_symbols, xacro.safe_eval, xacro.parse = symbols, safe_eval, parse
@@ -169,5 +187,8 @@ def refusal_of(error: BaseException) -> Refused | None:
     while seen is not None:
         if isinstance(seen, Refused):
             return seen
+        if isinstance(seen, ExpansionTooLong):
+            return Refused("E0673", f"the expansion was stopped: {ExpansionTooLong.reason} (a xacro model "
+                           "computes values of the size a robot needs)", "")
         seen = getattr(seen, "exc", None) or seen.__cause__ or seen.__context__
     return None

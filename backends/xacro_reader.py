@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import io
 import threading
+import xml.sax.saxutils
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -56,6 +57,7 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
     import xacro
 
     from mpc.backends.xacro_guard import guarded, refusal_of
+    from mpc.backends.xacro_limits import watched
 
     if not path.is_file():
         sink.error(origin or Span.of_file(str(path)), "E0601", f"xacro file '{path}' does not exist")
@@ -64,7 +66,8 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
     with _LOCK, _resolving(resolver, path.parent), guarded(resolver, path.parent.resolve(), environment), \
             contextlib.redirect_stderr(said), contextlib.redirect_stdout(said):
         try:
-            doc = xacro.process_file(str(path.resolve()), mappings=dict(args))
+            with watched():
+                doc = xacro.process_file(str(path.resolve()), mappings=dict(args))
             _drop_banner(doc)
             text = doc.toprettyxml(indent="  ")
         except xml.parsers.expat.ExpatError as e:
@@ -110,6 +113,9 @@ def _locate(file: str, needle: str) -> Span | None:
     except (OSError, UnicodeDecodeError):
         return None
     at = text.find(needle)
+    if at < 0:  # as the file writes it: `<` and `&` escaped
+        needle = xml.sax.saxutils.escape(needle)
+        at = text.find(needle)
     if at < 0 or not needle:
         return None
     line = text.count("\n", 0, at) + 1

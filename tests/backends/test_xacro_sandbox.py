@@ -62,6 +62,8 @@ HOSTILE = {
     "include-outside-by-dotdot": ('<xacro:include filename="../secret/secret.xacro"/>', "E0650"),
     "load-yaml-proc": ('<link name="${xacro.load_yaml(\'/proc/self/environ\')}"/>', "E0650"),
     "load-yaml-outside": ('<link name="${xacro.load_yaml(\'{secret}\')}"/>', "E0650"),
+    "power-tower": ('<link name="${9**9**9}"/>', "E0673"),  # hours of one multiplication
+    "terabyte-string": ('<link name="${\'a\' * 10**12}"/>', "E0673"),
 }
 
 
