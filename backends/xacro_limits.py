@@ -58,7 +58,8 @@ def _bits(value: int) -> int:
 
 
 def _repeat(seq: Any, times: Any) -> None:
-    if isinstance(times, int) and isinstance(seq, str | bytes | list | tuple) and len(seq) * times > MAX_ITEMS:
+    sequence = isinstance(seq, str | bytes | list | tuple)
+    if sequence and isinstance(times, int) and len(seq) * times > MAX_ITEMS:
         raise TooLarge(f"it makes a sequence of {len(seq) * times:,} items (more than {MAX_ITEMS:,})")
 
 
