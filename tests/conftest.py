@@ -8,6 +8,7 @@ so no diagnostic goes unnoticed.
 from __future__ import annotations
 
 import os
+import tempfile
 import textwrap
 from pathlib import Path
 
@@ -28,6 +29,11 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "bounded"))
 # this process (tests/backends/test_mesh_pool.py checks the pool of processes that a build
 # uses alone; every build in a pytest worker would fork that big process to make one).
 os.environ.setdefault("MPC_MESH_WORKERS", "1")
+# mpc's cache is the suite's own (one per pytest process, shared by its tests), never the
+# user's ~/.cache/mpc: what earlier versions of mpc kept there would show in the tests'
+# diagnostics. A test that needs a cache of its own sets MPC_CACHE_DIR itself.
+_CACHE = tempfile.TemporaryDirectory(prefix="mpc-test-cache-")
+os.environ["MPC_CACHE_DIR"] = _CACHE.name
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
