@@ -88,6 +88,10 @@ def _parser() -> argparse.ArgumentParser:
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
                       "--built: where the protocol goes (default: the --built folder)")
+    from mpc.cli.diff import add_arguments as diff_arguments
+
+    diff_arguments(sub.add_parser("diff", help="the semantic changes between two models (exit 1 when "
+                                  "something changed, as diff)"))
     # -- pipeline runs and CI generation (pipeline/) --
     run = sub.add_parser("run", parents=inputs,
                          help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
@@ -179,6 +183,12 @@ def _test(args: argparse.Namespace) -> int:
     return test.run(args)
 
 
+def _diff(args: argparse.Namespace) -> int:
+    from mpc.cli import diff
+
+    return diff.run(args)
+
+
 def _deploy(args: argparse.Namespace) -> int:
     from mpc.cli import deploy
 
@@ -210,7 +220,7 @@ def _lsp(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "compile": _compile, "check": _check, "schema": _schema, "test": _test, "deploy": _deploy,
+    "compile": _compile, "check": _check, "schema": _schema, "test": _test, "diff": _diff, "deploy": _deploy,
     "run": _run, "ci": _ci, "view": _view, "lsp": _lsp,
 }
 
@@ -233,6 +243,7 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
     """`--format json` makes stdout one JSON document of diagnostics, unless stdout carries
     something else already: the IR of `--emit ir`, the JSON lines of `--log-format json`."""
     return (getattr(args, "format", None) == "json" and getattr(args, "emit", None) != "ir"
+            and args.command != "diff"  # its stdout is the diff
             and getattr(args, "log_format", None) != "json")
 
 
