@@ -1,9 +1,10 @@
 """Two robots → which link and which joint of the old one is which of the new one.
 
 Names match first. A link only in the old model and one only in the new are the same link
-renamed when they hang from the same (matched) parent link and lie at the same place in the
-root at the zero pose (within `distance` and `rad`); a joint is renamed when it carries the
-same (matched) child link. Matching runs down from the root until nothing more pairs, so a
+renamed when the joints that carry them have the same name and the same (matched) parent
+link, or when they hang from the same parent and lie at the same place in the root at the
+zero pose (within `distance` and `rad`); a joint is renamed when it carries the same
+(matched) child link. Matching runs down from the root until nothing more pairs, so a
 renamed chain is found link by link; what stays unpaired was removed or added.
 """
 
@@ -45,6 +46,13 @@ def match(old: Robot, new: Robot, tol: Tolerances) -> Matching:
     up_old, up_new = parent_joint(old), parent_joint(new)
     while True:
         taken = set(out.links.values())
+        paired = False
+        for j in sorted(out.joints):  # a joint kept its name: its child is the same link
+            a, b = old.joints[j], new.joints[out.joints[j]]
+            if a.child not in out.links and b.child not in taken and out.links.get(a.parent) == b.parent:
+                out.links[a.child] = b.child
+                taken.add(b.child)
+                paired = True
         candidates = []
         for a in sorted(set(old.links) - set(out.links)):
             ja = up_old.get(a)
@@ -58,7 +66,6 @@ def match(old: Robot, new: Robot, tol: Tolerances) -> Matching:
                 turn = _angle(X_old[a][:3, :3].T @ X_new[b][:3, :3])
                 if d <= tol.distance and turn <= tol.rad:
                     candidates.append((d, turn, a, b))
-        paired = False
         for _, _, a, b in sorted(candidates):
             if a not in out.links and b not in set(out.links.values()):
                 out.links[a] = b

@@ -21,11 +21,13 @@ ARM = """\
   <link name="base">
     <inertial><origin xyz="0 0 0.05"/><mass value="4"/>
       <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
+    <visual><origin xyz="0 0 0.05"/><geometry><box size="0.2 0.2 0.1"/></geometry></visual>
+    <collision><origin xyz="0 0 0.05"/><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
   </link>
   <link name="upper">
     <inertial><origin xyz="0 0 0.15"/><mass value="MASS"/>
       <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.002"/></inertial>
+    <visual><origin xyz="0 0 0.15"/><geometry><cylinder radius="0.04" length="0.3"/></geometry></visual>
     <collision><origin xyz="0 0 0.15"/><geometry><cylinder radius="0.04" length="0.3"/></geometry></collision>
   </link>
   <link name="LOWER">
@@ -50,12 +52,18 @@ ARM = """\
 """
 
 
+@pytest.fixture(autouse=True)
+def _cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+
+
 def arm(folder: Path, mass: str = "2", limit: str = "2.5", elbow: str = "0.3", lower: str = "lower",
-        subdivisions: int = 3) -> Path:
+        subdivisions: int = 3, elbow_name: str = "elbow") -> Path:
     """The arm URDF (and its mesh) in `folder`, with what the arguments change."""
     folder.mkdir(parents=True, exist_ok=True)
     trimesh.creation.icosphere(subdivisions=subdivisions, radius=0.05).export(folder / "ball.stl")
     text = ARM.replace("MASS", mass).replace("LIMIT", limit).replace("ELBOW", elbow)
+    text = text.replace('joint name="elbow"', f'joint name="{elbow_name}"')
     return write(folder / "arm.urdf", text.replace("LOWER", lower))
 
 
@@ -70,6 +78,12 @@ def changes(old: Path | str, new: Path | str, *args: str, cwd: Path | None = Non
     ({"mass": "2.5"}, ["link 'upper': mass 2 → 2.5 kg (+0.5)", "total mass 7 → 7.5 kg (+0.5)",
                        "centre of mass moved by 0.005238 m at the zero pose"]),
     ({"lower": "forearm"}, ["link 'lower' renamed to 'forearm'"]),
+    ({"lower": "forearm", "elbow": "0.35"}, ["link 'lower' renamed to 'forearm'",
+                                            "joint 'elbow': origin moved by 0.05 m, turned by 0 rad",
+                                            "centre of mass moved by 0.007143 m at the zero pose",
+                                            "reach at the zero pose 0.6 → 0.65 m"]),
+    ({"lower": "forearm", "elbow_name": "knee"}, ["link 'lower' renamed to 'forearm'",
+                                                 "joint 'elbow' renamed to 'knee'"]),
     ({"elbow": "0.35"}, ["joint 'elbow': origin moved by 0.05 m, turned by 0 rad",
                          "centre of mass moved by 0.007143 m at the zero pose",
                          "reach at the zero pose 0.6 → 0.65 m"]),
@@ -158,8 +172,7 @@ def test_markdown_and_json_are_exact(tmp_path: Path) -> None:
         "pictures": []}
 
 
-def test_a_definition_at_the_last_commit(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+def test_a_definition_at_the_last_commit(tmp_path: Path) -> None:
     repo = git.Repo.init(tmp_path / "repo", initial_branch="main")
     arm(tmp_path / "repo/model")
     write(tmp_path / "repo/model.yml", """
