@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from mpc.checks.diff_models import Diff
 from mpc.ir.program import Tolerances
@@ -36,10 +36,10 @@ def human(d: Diff, old: str, new: str, tol: Tolerances) -> str:
     return "\n".join(lines) + "\n"
 
 
-def markdown(d: Diff, old: str, new: str, tol: Tolerances, pictures: Sequence[str] = (),
-             title: str = "Model diff") -> str:
-    """The diff as Markdown; pictures: paths of the `<view>_<side>.png` files to show, three
-    (release, new, overlay) a view, relative to where the Markdown is read."""
+def markdown(d: Diff, old: str, new: str, tol: Tolerances,
+             pictures: Mapping[str, Sequence[str]] | None = None, title: str = "Model diff") -> str:
+    """The diff as Markdown; pictures: {view: the paths of its old, new and overlay pictures},
+    relative to where the Markdown is read."""
     lines = [f"## {title}: `{old}` → `{new}`", "",
              f"**{summary(d)}** beyond the tolerances ({tolerances_text(tol)}).", ""]
     lines += [f"- {_code(c.text)}" for c in d.changes]
@@ -47,10 +47,9 @@ def markdown(d: Diff, old: str, new: str, tol: Tolerances, pictures: Sequence[st
         lines.append("")
     if pictures:
         lines += ["| view | old | new | overlay |", "|---|---|---|---|"]
-        for i in range(0, len(pictures) - 2, 3):
-            view = pictures[i].rsplit("/", 1)[-1].rsplit("_", 1)[0]
+        for view, paths in pictures.items():
             cells = " | ".join(f"![{view} {side}]({p})" for side, p in zip(
-                ("old", "new", "overlay"), pictures[i:i + 3], strict=True))
+                ("old", "new", "overlay"), paths, strict=True))
             lines.append(f"| {view} | {cells} |")
         lines.append("")
     return "\n".join(lines)

@@ -10,8 +10,6 @@ poses and submechanisms the URDF cannot hold), or any of these at a git revision
 
 from __future__ import annotations
 
-import os
-import shutil
 import tarfile
 import tempfile
 from dataclasses import dataclass
@@ -108,6 +106,7 @@ def at_revision(path: Path, rev: str, sink: Sink) -> Path | None:
     """`path` (in a git work tree) as it was at revision `rev`: its place in that commit's tree,
     written once into the cache. None, with E0741, when there is no such revision or file."""
     from mpc.core.cache import cache_dir
+    from mpc.core.git_tree import write_tree
     from mpc.core.gitrun import GitFailed, git
 
     where = Span.of_file(str(path))
@@ -126,38 +125,15 @@ def at_revision(path: Path, rev: str, sink: Sink) -> Path | None:
         return None
     inside = path.resolve().relative_to(top.resolve())
     tree = cache_dir("diff") / commit
-    if not (tree / ".mpc-complete").is_file():
-        try:
-            _write_tree(top, commit, tree)
-        except (GitFailed, OSError, tarfile.TarError) as e:
-            sink.error(where, "E0741", f"cannot write revision '{rev}' of '{top}': "
-                       f"{e.message if isinstance(e, GitFailed) else e}")
-            return None
+    try:
+        write_tree(top, commit, tree)
+    except (GitFailed, OSError, tarfile.TarError) as e:
+        sink.error(where, "E0741", f"cannot write revision '{rev}' of '{top}': "
+                   f"{e.message if isinstance(e, GitFailed) else e}")
+        return None
     found = tree / inside
     if not found.exists():
         sink.error(where, "E0741", f"'{inside.as_posix()}' does not exist at revision '{rev}' "
                    f"(commit {commit[:12]})")
         return None
     return found
-
-
-def _write_tree(top: Path, commit: str, tree: Path) -> None:
-    """The files of `commit` into `tree`, whole or not at all (written beside, then renamed)."""
-    from mpc.core.gitrun import git
-
-    tree.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{commit[:12]}-", dir=tree.parent))
-    try:
-        archive = staging / "tree.tar"
-        git("archive", "--format=tar", "-o", str(archive), commit, cwd=top)
-        files = staging / "files"
-        with tarfile.open(archive) as tar:
-            tar.extractall(files, filter="data")  # no links out, no devices
-        (files / ".mpc-complete").write_text(commit + "\n")
-        try:
-            os.rename(files, tree)
-        except OSError:
-            if not (tree / ".mpc-complete").is_file():  # not another run's whole tree
-                raise
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)

@@ -63,10 +63,11 @@ def run(args: argparse.Namespace) -> int:
             print_diagnostics(sink, "human")
             return 2
         d = diff(old.robot, new.robot, tol)
-        pictures = _pictures(args.pictures, old.robot, new.robot, d, tol, sink) if args.pictures else []
+        pictures = _pictures(args.pictures, old.robot, new.robot, d, tol, sink) if args.pictures else {}
+    paths = [p for view in pictures.values() for p in view]
     print_diagnostics(sink, "human")
     if args.format == "json":
-        print(diff_report.as_json(d, old.label, new.label, tol, pictures), end="")
+        print(diff_report.as_json(d, old.label, new.label, tol, paths), end="")
     elif args.format == "markdown":
         print(diff_report.markdown(d, old.label, new.label, tol, pictures), end="")
     else:
@@ -74,19 +75,20 @@ def run(args: argparse.Namespace) -> int:
     return 1 if d.changed else 0
 
 
-def _pictures(folder: Path, old: object, new: object, d: object, tol: object, sink: object) -> list[str]:
-    """The renders written into `folder`; their paths as the Markdown links them."""
+def _pictures(folder: Path, old: object, new: object, d: object, tol: object,
+              sink: object) -> dict[str, list[str]]:
+    """The renders written into `folder`: {view: the paths of its old, new and overlay pictures}."""
     from mpc.checks.diff_models import changed_links
     from mpc.checks.pictures import SIDES, draw
 
     drawn = draw(old, new, tol, None, sink, changed=changed_links(d, old, new))  # type: ignore[arg-type]
     if not drawn.drawn:
-        return []
+        return {}
     folder.mkdir(parents=True, exist_ok=True)
-    out = []
+    out: dict[str, list[str]] = {}
     for view in drawn.views:
         for side in SIDES:
             name = f"{view}_{side}.png"
             (folder / name).write_bytes(drawn.files[name])
-            out.append((folder / name).as_posix())
+            out.setdefault(view, []).append((folder / name).as_posix())
     return out
