@@ -113,7 +113,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--log-format", choices=("text", "json"), default="text",
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
     ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
-    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary")
+    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary|review")
     gens = []
     for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
         gen = systems.add_parser(system, help=f"write {what}")
@@ -139,6 +139,11 @@ def _parser() -> argparse.ArgumentParser:
     summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
     summary.add_argument("--markdown", type=Path, metavar="FILE",
                          help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
+    review = systems.add_parser("review", help="in a merge request's pipeline: every model's changes "
+                                "against the request's base, posted as a comment (GitLab, GitHub)")
+    review.add_argument("pipeline", type=Path, help="the pipeline file")
+    review.add_argument("--base", metavar="REV", help="compare with the definitions at this git revision "
+                        "(default: the merge request's base)")
     from mpc.cli.lsp import add_arguments as lsp_arguments
 
     lsp_arguments(sub.add_parser("lsp", parents=[packages],
@@ -149,7 +154,7 @@ def _parser() -> argparse.ArgumentParser:
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
-    for p in (run, *gens, job, summary):
+    for p in (run, *gens, job, summary, review):
         p.add_argument("--allow-root-outside", action="store_true",
                        help="accept a pipeline `root` outside the pipeline file's folder and its parent "
                             "(the build folder is <root>/build)")
