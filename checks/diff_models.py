@@ -124,11 +124,11 @@ def _joint_changes(a: Joint, b: Joint, m: Matching, tol: Tolerances) -> Iterator
     limits = _limit_changes(a, b, tol)
     if limits:
         yield Change("joint", n, "limit", _limit(a), _limit(b), f"joint '{n}': limit " + ", ".join(limits))
-    da, db = a.dynamics, b.dynamics
-    dyn = [f"{k} {_num(getattr(da, k, None))} → {_num(getattr(db, k, None))}" for k in ("damping", "friction")
-           if abs((getattr(da, k, None) or 0.0) - (getattr(db, k, None) or 0.0)) > tol.default]
+    da, db = ({k: getattr(j.dynamics, k, None) for k in ("damping", "friction")} for j in (a, b))
+    dyn = [f"{k} {_num(da[k])} → {_num(db[k])}" for k in da
+           if abs((da[k] or 0.0) - (db[k] or 0.0)) > tol.default]
     if dyn:
-        yield Change("joint", n, "dynamics", None, None, f"joint '{n}': dynamics " + ", ".join(dyn))
+        yield Change("joint", n, "dynamics", da, db, f"joint '{n}': dynamics " + ", ".join(dyn))
     mimic = [_mimic(a.mimic, m), _mimic(b.mimic, None)]
     if mimic[0] != mimic[1] and (mimic[0] is None or mimic[1] is None or mimic[0][0] != mimic[1][0] or any(
             abs(x - y) > tol.default for x, y in zip(mimic[0][1:], mimic[1][1:], strict=True))):

@@ -63,7 +63,14 @@ def run(args: argparse.Namespace) -> int:
             print_diagnostics(sink, "human")
             return 2
         d = diff(old.robot, new.robot, tol)
-        pictures = _pictures(args.pictures, old.robot, new.robot, d, tol, sink) if args.pictures else {}
+        try:
+            pictures = _pictures(args.pictures, old.robot, new.robot, d, tol, sink) if args.pictures else {}
+        except OSError as e:
+            from mpc.core.files import describe
+
+            print(f"mpc diff: error: cannot write the pictures into '{args.pictures}' ({describe(e)})",
+                  file=sys.stderr)
+            return 2
     paths = [p for view in pictures.values() for p in view]
     print_diagnostics(sink, "human")
     if args.format == "json":

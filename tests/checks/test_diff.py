@@ -98,6 +98,31 @@ def test_a_known_change_is_listed_and_nothing_else(tmp_path: Path, edit: dict, e
     assert code == 1
 
 
+@pytest.mark.parametrize(("before", "after", "expected"), [
+    ('<axis xyz="0 1 0"/>\n    <limit lower="-LIMIT"', '<axis xyz="1 0 0"/>\n    <limit lower="-LIMIT"',
+     ["joint 'shoulder': axis (0 1 0) → (1 0 0)"]),
+    ('<parent link="upper"/>', '<parent link="upper"/><dynamics damping="0.5"/>',
+     ["joint 'elbow': dynamics damping none → 0.5"]),
+    ('<box size="0.05 0.05 0.2"/>', '<box size="0.05 0.05 0.3"/>',
+     ["collision 0: box 0.05×0.05×0.2 → box 0.05×0.05×0.3 (0.0005 → 0.00075 m³)"]),
+    ('<color rgba="0.5 0.5 0.5 1"/>', '<color rgba="0.9 0.1 0.1 1"/>',
+     ["visual 0: material rgba 0.5 0.5 0.5 1 → rgba 0.9 0.1 0.1 1"]),
+    ('ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.002"', 'ixx="0.01" ixy="0" ixz="0" iyy="0.01" '
+     'iyz="0" izz="0.01"', ["link 'upper': principal moments of inertia 0.002, 0.01, 0.01 → 0.01, 0.01, "
+                            "0.01 kg·m²"]),
+    ('ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.002"', 'ixx="0.002" ixy="0" ixz="0" iyy="0.01" '
+     'iyz="0" izz="0.01"', ["link 'upper': principal axes of inertia turned by 1.571 rad"]),
+])
+def test_a_changed_property_is_listed(tmp_path: Path, before: str, after: str, expected: list[str]) -> None:
+    old = arm(tmp_path / "old")
+    new = arm(tmp_path / "new")
+    text = ARM.replace("LIMIT", "2.5").replace(before.replace("LIMIT", "2.5"), after.replace("LIMIT", "2.5"))
+    assert text != ARM.replace("LIMIT", "2.5")
+    write(new, text.replace("MASS", "2").replace("ELBOW", "0.3").replace("LOWER", "lower"))
+    code, lines = changes(old, new)
+    assert ([ln.strip() for ln in lines], code) == (expected, 1)
+
+
 def test_the_unchanged_model_exits_0_in_any_format_it_is_written_in(tmp_path: Path) -> None:
     source = arm(tmp_path / "in")
     write(tmp_path / "m.yml", f"""
