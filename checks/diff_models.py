@@ -140,7 +140,7 @@ def _mimic(mimic: Any, m: Matching | None) -> tuple[str, float, float] | None:
     if mimic is None:
         return None
     joint = m.joints.get(mimic.joint, mimic.joint) if m is not None else mimic.joint
-    return (joint, 1.0 if mimic.multiplier is None else mimic.multiplier, mimic.offset or 0.0)
+    return (str(joint), 1.0 if mimic.multiplier is None else mimic.multiplier, mimic.offset or 0.0)
 
 
 def _said(mimic: tuple[str, float, float] | None) -> str:

@@ -44,9 +44,10 @@ def markdown_against(program: Program, built: Path, release: Path, pictures: Pat
         return f"## {TITLE}\n\nThe build has no URDF or SDF of the whole robot to compare.\n"
     old_path = release / new_path.relative_to(built)
     if not old_path.is_file():
-        old_path = model_in_folder(release)  # type: ignore[assignment]
-    if old_path is None:
-        return f"## {TITLE}\n\nThe release holds no model file: this is the first.\n"
+        found = model_in_folder(release)
+        if found is None:
+            return f"## {TITLE}\n\nThe release holds no model file: this is the first.\n"
+        old_path = found
     sink = Sink()
     old, new = read_model(old_path, sink), read_model(new_path, sink)
     if old is None or new is None:

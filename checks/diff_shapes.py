@@ -34,7 +34,7 @@ def describe(g: Geometry) -> str:
             return f"sphere r {g.radius:.4g}"
         case Mesh():
             scale = "" if g.scale in (None, (1.0, 1.0, 1.0)) else " scaled " + "×".join(
-                f"{x:.4g}" for x in g.scale)  # type: ignore[union-attr]
+                f"{x:.4g}" for x in g.scale or ())
             return f"mesh {Path(g.source.uri).name}{scale}"
     return type(g).__name__.lower()
 
