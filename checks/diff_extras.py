@@ -60,6 +60,17 @@ def _short(v: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "…"
 
 
+def _where(value: Any) -> str:
+    """` (IMU on link 'base')`: a sensor's or motor's type and place, when it has them."""
+    if not isinstance(value, dict):
+        return ""
+    kind = value.get("type") if isinstance(value.get("type"), str) else ""
+    place = next((f"{key} '{value[key]}'" for key in ("link", "joint")
+                  if isinstance(value.get(key), str)), "")
+    said = " on ".join(p for p in (kind, place) if p)
+    return f" ({said})" if said else ""
+
+
 def _keyed(element: str, old: Mapping[str, Any], new: Mapping[str, Any], names: Mapping[str, str],
            eps: float) -> Iterator[Change]:
     """Changes of elements keyed by name (motors, sensors, poses, cut joints)."""
@@ -67,9 +78,10 @@ def _keyed(element: str, old: Mapping[str, Any], new: Mapping[str, Any], names: 
     b = {str(k): plain(v) for k, v in new.items()}
     for name in sorted(a.keys() | b.keys()):
         if name not in a:
-            yield Change(element, name, "added", None, b[name], f"{element} '{name}' added")
+            yield Change(element, name, "added", None, b[name], f"{element} '{name}' added{_where(b[name])}")
         elif name not in b:
-            yield Change(element, name, "removed", a[name], None, f"{element} '{name}' removed")
+            yield Change(element, name, "removed", a[name], None,
+                         f"{element} '{name}' removed{_where(a[name])}")
         else:
             said = differences(a[name], b[name], eps)
             if said:
