@@ -177,6 +177,37 @@ def test_an_added_sensor_between_definitions(tmp_path: Path) -> None:
     assert (code, lines) == (1, ["  sensor 'imu' added (IMU on link 'upper')"])
 
 
+def test_poses_and_renamed_links_in_annotations(tmp_path: Path) -> None:
+    """A pose's value changed beyond `rad` is listed; a sensor on a renamed link is not."""
+    base = f"""
+        model:
+          robotname: arm
+          modelname: arm
+          input_models:
+            base:
+              basefile: "{arm(tmp_path / "old")}"
+          assemble:
+            model: base
+          export_config:
+            - type: urdf
+            - type: smurf
+          sensors:
+            - {{type: IMU, name: imu, link: LINK}}
+          poses:
+            init:
+              shoulder: SHOULDER
+        """
+    write(tmp_path / "a.yml", base.replace("LINK", "lower").replace("SHOULDER", "0.5"))
+    arm(tmp_path / "new", lower="forearm")
+    write(tmp_path / "b.yml", base.replace("LINK", "forearm").replace("SHOULDER", "0.52").replace(
+        "old/arm.urdf", "new/arm.urdf"))
+    assert changes(tmp_path / "a.yml", tmp_path / "b.yml") == (1, ["  link 'lower' renamed to 'forearm'"])
+    write(tmp_path / "c.yml", base.replace("LINK", "forearm").replace("SHOULDER", "0.6").replace(
+        "old/arm.urdf", "new/arm.urdf"))
+    assert changes(tmp_path / "a.yml", tmp_path / "c.yml") == (1, [
+        "  link 'lower' renamed to 'forearm'", "  pose 'init': shoulder: 0.5 → 0.6"])
+
+
 def test_markdown_and_json_are_exact(tmp_path: Path) -> None:
     arm(tmp_path / "old"), arm(tmp_path / "new", limit="1.0")
     run = mpc("diff", "old/arm.urdf", "new/arm.urdf", "--format", "markdown", cwd=tmp_path)
