@@ -328,7 +328,8 @@ def test_a_urdf_against_its_own_exports_shows_only_documented_losses(tmp_path: P
 
 
 @pytest.mark.parametrize("args", [("a.urdf",), ("a.urdf", "a.urdf", "--mass", "-1"),
-                                  ("a.urdf", "a.urdf", "--format", "gcc"), ("a.urdf", "a.urdf", "--rad", "x")])
+                                  ("a.urdf", "a.urdf", "--format", "gcc"),
+                                  ("a.urdf", "a.urdf", "--rad", "x")])
 def test_a_bad_command_line_exits_2(tmp_path: Path, args: tuple[str, ...]) -> None:
     arm(tmp_path).rename(tmp_path / "a.urdf")
     run = mpc("diff", *args, cwd=tmp_path)
