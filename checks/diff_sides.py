@@ -124,7 +124,11 @@ def at_revision(path: Path, rev: str, sink: Sink) -> Path | None:
     except GitFailed:
         sink.error(where, "E0741", f"the repository of '{path}' has no revision '{rev}'")
         return None
-    inside = path.resolve().relative_to(top.resolve())
+    try:
+        inside = path.resolve().relative_to(top.resolve())
+    except ValueError:  # a link out of the work tree
+        sink.error(where, "E0741", f"'{path}' lies outside the git work tree '{top}'")
+        return None
     tree = cache_dir("diff") / commit
     try:
         write_tree(top, commit, tree)
