@@ -44,21 +44,25 @@ class Model:
 
 
 def read_model(path: Path, sink: Sink) -> Robot | None:
-    """A URDF, SDF or SMURF file (by its suffix) → a robot; diagnostics go to `sink`.
+    """A model file → a robot, read by the format its suffix names (backends/formats.py; a file
+    of no known suffix as URDF); diagnostics go to `sink`.
 
     A SMURF (Phobos names one as compare model) is read with its annotations: cut joints,
     motors and submechanisms take part in the dynamics tests."""
-    if path.suffix.lower() == ".sdf":
-        from mpc.backends.sdf_reader import read as read_sdf
+    from mpc.backends.formats import reader_of
 
-        return read_sdf(path, sink)
-    if path.suffix.lower() == ".smurf":
-        from mpc.backends.smurf_reader import read as read_smurf
+    read = reader_of(path).read
+    assert read is not None  # reader_of answers only formats that read
+    return read(path, sink, None)
 
-        return read_smurf(path, sink)
-    from mpc.backends.urdf_reader import read as read_urdf
 
-    return read_urdf(path, sink)
+MODEL_PATTERNS = ("urdf/*.urdf", "*.urdf", "sdf/*.sdf")  # a folder's model file, in this order
+
+
+def model_in_folder(folder: Path) -> Path | None:
+    """The model file of a folder that holds a model: its first URDF (in `urdf/`, then at the
+    top), else its first SDF in `sdf/`."""
+    return next((sorted(folder.glob(p))[0] for p in MODEL_PATTERNS if any(folder.glob(p))), None)
 
 
 def read_submechanisms(path: Path) -> tuple[Submechanism, ...] | None:
@@ -128,13 +132,12 @@ def load_compare(target: CompareTarget, workdir: Path, shown: str | None = None)
     path = folder / target.model_in_repo if target.model_in_repo else folder
     if path.is_dir():
         folder = path
-        patterns = ("urdf/*.urdf", "*.urdf", "sdf/*.sdf")
-        found = next((sorted(path.glob(p)) for p in patterns if any(path.glob(p))), [])
-        if not found:
+        found = model_in_folder(path)
+        if found is None:
             inside = shown and (f"{shown}/{target.model_in_repo}" if target.model_in_repo else shown)
-            return None, (f"no model file ({', '.join(patterns)}) in '{inside or path}'; "
+            return None, (f"no model file ({', '.join(MODEL_PATTERNS)}) in '{inside or path}'; "
                           "name it with model_in_repo")
-        path = found[0]
+        path = found
     elif not path.is_file():
         return None, f"'{target.model_in_repo}' does not exist in the compare model" + (
             f" at commit {commit[:12]}" if commit else "")

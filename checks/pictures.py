@@ -63,7 +63,7 @@ class VisualDiff:
         return any(name.endswith(".png") for name in self.files)
 
 
-def _turned(a: Pose | None, b: Pose | None) -> tuple[float, float]:
+def turned(a: Pose | None, b: Pose | None) -> tuple[float, float]:
     """How far (m) and by what angle (rad) pose b lies from pose a."""
     pa, pb = a or Pose(), b or Pose()
     distance = float(np.linalg.norm(np.subtract(pa.xyz, pb.xyz)))
@@ -71,7 +71,7 @@ def _turned(a: Pose | None, b: Pose | None) -> tuple[float, float]:
     return distance, math.acos(max(-1.0, min(1.0, (float(np.trace(R)) - 1) / 2)))
 
 
-def _mesh_digest(mesh: Mesh) -> str:
+def mesh_digest(mesh: Mesh) -> str:
     path = mesh.source.path
     if is_generated(mesh.source):  # made from shapes: its ops are all of it
         return mesh.source.uri + repr(mesh.ops)
@@ -84,7 +84,7 @@ def _shape_changed(a: object, b: object, tol: Tolerances) -> bool:
     ga, gb = a.geometry, b.geometry  # type: ignore[attr-defined]
     if type(ga) is not type(gb):
         return True
-    d, angle = _turned(a.origin, b.origin)  # type: ignore[attr-defined]
+    d, angle = turned(a.origin, b.origin)  # type: ignore[attr-defined]
     if d > tol.distance or angle > tol.rad:
         return True
     match ga:
@@ -96,7 +96,7 @@ def _shape_changed(a: object, b: object, tol: Tolerances) -> bool:
             sizes = ((ga.radius,), (gb.radius,))
         case Mesh():
             scale = (tuple(ga.scale or (1.0, 1.0, 1.0)), tuple(gb.scale or (1.0, 1.0, 1.0)))
-            return scale[0] != scale[1] or _mesh_digest(ga) != _mesh_digest(gb)
+            return scale[0] != scale[1] or mesh_digest(ga) != mesh_digest(gb)
         case _:
             return ga != gb
     return bool(np.max(np.abs(np.subtract(*sizes))) > tol.distance)
@@ -118,7 +118,7 @@ def _joint_change(old: Joint | None, new: Joint | None, tol: Tolerances) -> str:
         return "" if old is new else "its joint changed"
     if (old.parent, old.type) != (new.parent, new.type):
         return f"its joint changed ({old.parent}, {old.type} → {new.parent}, {new.type})"
-    d, angle = _turned(old.origin, new.origin)
+    d, angle = turned(old.origin, new.origin)
     if d > tol.distance or angle > tol.rad:
         return f"moved by {d:.4g} m, turned by {angle:.4g} rad"
     axes = (np.asarray(old.axis or (1.0, 0.0, 0.0)), np.asarray(new.axis or (1.0, 0.0, 0.0)))
@@ -143,18 +143,19 @@ def changed_links(old: Robot, new: Robot, tol: Tolerances) -> dict[str, str]:
 
 
 def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, sink: Sink,
-         tree: bool = False) -> VisualDiff:
+         tree: bool = False, changed: dict[str, str] | None = None) -> VisualDiff:
     """The visual diff of `new` against its release `old`, drawn with the views and size of
     the model's render export (default: iso, front and side at 480×360); a reason instead of
     pictures when they cannot be drawn (no EGL, a model MuJoCo cannot load). tree: also the
-    kinematic tree as a PDF with the changed links coloured (the model has a pdf export)."""
+    kinematic tree as a PDF with the changed links coloured (the model has a pdf export).
+    changed: the links to colour, {name in either model: why} (default: changed_links)."""
     from mpc.backends.render import ZERO, clamped_note, pose_values
     from mpc.backends.scene import GLMissing, Scene, frame, png
 
     views = render.views if render is not None else ("iso", "front", "side")
     size = render.size if render is not None else DEFAULT_SIZE
     background = render.background if render is not None else (1.0, 1.0, 1.0)
-    out = VisualDiff(views=tuple(views), changed=changed_links(old, new, tol))
+    out = VisualDiff(views=tuple(views), changed=changed_links(old, new, tol) if changed is None else changed)
     quiet = Sink()  # what the build reported already (W0500 …) is not the diff's business
     span = Span.of_file(new.name)
     with tempfile.TemporaryDirectory(prefix="mpc-diff-") as work:

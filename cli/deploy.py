@@ -58,8 +58,11 @@ def run(args: argparse.Namespace) -> int:
     result = None
     if program is not None and settings is not None and not sink.has_errors():
         pictures = None if args.protocol is None else args.protocol.parent / "test_pictures"
+        from mpc.checks.diff_review import review_of
+
         result = deploy_model(program, args.built, settings, sink, protocol_markdown=protocol,
-                              tests_failed=args.tests_failed, pictures=pictures)
+                              tests_failed=args.tests_failed, pictures=pictures,
+                              review=review_of(program, args.built.resolve()))
     print_diagnostics(sink.diagnostics, args.format)
     if result is None or not result.ok:
         print(f"error: could not deploy '{args.definition}'", file=sys.stderr)

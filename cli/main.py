@@ -88,6 +88,10 @@ def _parser() -> argparse.ArgumentParser:
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
                       "--built: where the protocol goes (default: the --built folder)")
+    from mpc.cli.diff import add_arguments as diff_arguments
+
+    diff_arguments(sub.add_parser("diff", help="the semantic changes between two models (exit 1 when "
+                                  "something changed, as diff)"))
     # -- pipeline runs and CI generation (pipeline/) --
     run = sub.add_parser("run", parents=inputs,
                          help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
@@ -109,7 +113,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--log-format", choices=("text", "json"), default="text",
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
     ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
-    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary")
+    systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary|review")
     gens = []
     for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
         gen = systems.add_parser(system, help=f"write {what}")
@@ -135,6 +139,11 @@ def _parser() -> argparse.ArgumentParser:
     summary.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
     summary.add_argument("--markdown", type=Path, metavar="FILE",
                          help="also append the table as Markdown to FILE (GitHub: $GITHUB_STEP_SUMMARY)")
+    review = systems.add_parser("review", help="in a merge request's pipeline: every model's changes "
+                                "against the request's base, posted as a comment (GitLab, GitHub)")
+    review.add_argument("pipeline", type=Path, help="the pipeline file")
+    review.add_argument("--base", metavar="REV", help="compare with the definitions at this git revision "
+                        "(default: the merge request's base)")
     from mpc.cli.lsp import add_arguments as lsp_arguments
 
     lsp_arguments(sub.add_parser("lsp", parents=[packages],
@@ -145,7 +154,7 @@ def _parser() -> argparse.ArgumentParser:
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
-    for p in (run, *gens, job, summary):
+    for p in (run, *gens, job, summary, review):
         p.add_argument("--allow-root-outside", action="store_true",
                        help="accept a pipeline `root` outside the pipeline file's folder and its parent "
                             "(the build folder is <root>/build)")
@@ -179,6 +188,12 @@ def _test(args: argparse.Namespace) -> int:
     return test.run(args)
 
 
+def _diff(args: argparse.Namespace) -> int:
+    from mpc.cli import diff
+
+    return diff.run(args)
+
+
 def _deploy(args: argparse.Namespace) -> int:
     from mpc.cli import deploy
 
@@ -210,7 +225,7 @@ def _lsp(args: argparse.Namespace) -> int:
 
 
 COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "compile": _compile, "check": _check, "schema": _schema, "test": _test, "deploy": _deploy,
+    "compile": _compile, "check": _check, "schema": _schema, "test": _test, "diff": _diff, "deploy": _deploy,
     "run": _run, "ci": _ci, "view": _view, "lsp": _lsp,
 }
 
@@ -233,6 +248,7 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
     """`--format json` makes stdout one JSON document of diagnostics, unless stdout carries
     something else already: the IR of `--emit ir`, the JSON lines of `--log-format json`."""
     return (getattr(args, "format", None) == "json" and getattr(args, "emit", None) != "ir"
+            and args.command != "diff"  # its stdout is the diff
             and getattr(args, "log_format", None) != "json")
 
 

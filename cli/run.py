@@ -150,7 +150,7 @@ def ci(args: argparse.Namespace) -> int:
     from mpc.pipeline import ci as generate
     from mpc.pipeline import ci_install
 
-    if args.system in ("job", "summary"):
+    if args.system in ("job", "summary", "review"):
         return _ci_step(args)
     sink = Sink()
     plan = _load(args, sink)
@@ -204,12 +204,17 @@ def ci(args: argparse.Namespace) -> int:
 
 
 def _ci_step(args: argparse.Namespace) -> int:
-    """`mpc ci job PIPELINE MODEL` and `mpc ci summary PIPELINE` (pipeline/ci_job.py)."""
+    """`mpc ci job PIPELINE MODEL`, `mpc ci summary PIPELINE` (pipeline/ci_job.py) and `mpc ci
+    review PIPELINE` (pipeline/ci_review.py)."""
     from mpc.pipeline import ci_job
 
     plan = _load(args, Sink())
     if plan is None:
         return 1
+    if args.system == "review":
+        from mpc.pipeline.ci_review import review
+
+        return review(plan, args.base)
     build = args.out.resolve() if args.out else plan.root / "build"
     if args.system == "summary":
         return ci_job.summary(plan, build, args.markdown)

@@ -73,6 +73,12 @@ class GitHub:
         url = pull.get("html_url")
         return url if isinstance(url, str) and url else None
 
+    def comment(self, slug: str, number: int, body: str) -> str | None:
+        """Post `body` as a comment on pull request `number` of `owner/name`; its address."""
+        answer = self._call("POST", f"/repos/{slug}/issues/{number}/comments", {"body": body})
+        url = answer.get("html_url") if isinstance(answer, dict) else None
+        return url if isinstance(url, str) and url else None
+
     def _find_open(self, request: MergeRequest) -> int | None:
         """The number of the open pull request from the branch into the target, if any."""
         slug = self._slug(request)

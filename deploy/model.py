@@ -23,6 +23,7 @@ from mpc.deploy.plan import Plan, check_plan_branches, do_not_deploy, make_plan
 from mpc.deploy.provenance import Provenance, commit_message, footer, provenance
 from mpc.deploy.repository import Clone, locked, open_clone, publish
 from mpc.deploy.result import DeployResult, record_push
+from mpc.deploy.review import Review, release_review
 from mpc.deploy.settings import DeploySettings
 from mpc.deploy.test_outcome import TestOutcome, test_outcome
 from mpc.ir.program import Program
@@ -30,7 +31,7 @@ from mpc.ir.program import Program
 
 def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: Sink, *,
                  protocol_markdown: str | None = None, tests_failed: bool = False,
-                 pictures: Path | None = None) -> DeployResult:
+                 pictures: Path | None = None, review: Review | None = None) -> DeployResult:
     """Deploy the build of `program` in `built` (what `mpc compile` wrote).
 
     protocol_markdown, tests_failed: the caller's test protocol and verdict; without a
@@ -38,6 +39,8 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
     protocol that says its tests failed sends the model to the failure branch.
     pictures: the folder of the protocol's pictures (`test_pictures/` beside it), committed
     with the model when it is not the build's own; the merge request links them.
+    review: makes the changes against the release (deploy/review.py) that the merge
+    request's description starts with; their pictures are committed and linked too.
 
     Models deployed at the same time (a pipeline's workers, or two CI jobs) may share the
     workdir: each holds the lock of its own clone, and the shared caches have locks of their own.
@@ -56,7 +59,7 @@ def deploy_model(program: Program, built: Path, settings: DeploySettings, sink: 
         tests = test_outcome(built, protocol_markdown, tests_failed)
         workdir = _workdir(settings.workdir)
         with locked(workdir / program.modelname):
-            _deploy(program, built.resolve(), remote, workdir, settings, result, tests, pictures)
+            _deploy(program, built.resolve(), remote, workdir, settings, result, tests, pictures, review)
     except DeployError as e:
         sink.error(span, e.code, e.message)
         result.ok = False
@@ -101,7 +104,8 @@ def _workdir(folder: Path) -> Path:
 
 
 def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings: DeploySettings,
-            result: DeployResult, tests: TestOutcome, pictures: Path | None = None) -> None:
+            result: DeployResult, tests: TestOutcome, pictures: Path | None = None,
+            review: Review | None = None) -> None:
     clone = open_clone(remote, workdir / program.modelname, settings.remote_name)
     plan = make_plan(program, settings, clone.url, clone.default_branch, tests.failed)
     check_plan_branches(plan)
@@ -119,15 +123,22 @@ def _deploy(program: Program, built: Path, remote: str, workdir: Path, settings:
         pinned += mesh_pins
 
     forge = adapter(settings.forge, settings.github_api)
-    request = None
+    request, reviewed = None, None
     if plan.mr_target is not None and forge.name != "none":
+        changes = ""
+        if review is not None:
+            changes, reviewed = release_review(review, clone, plan.mr_target, workdir, program.modelname)
+        described = "\n\n".join(part.strip() for part in (changes, protocol or "") if part.strip())
         request = merge_request(clone.url, plan.branch, plan.mr_target, plan.mr_title, plan.mr_description,
-                                plan.mr_mention, protocol, footer(prov))
+                                plan.mr_mention, described, footer(prov))
 
     def fill(c: Clone) -> None:
         fill_model(c, built, program, plan, prov, pinned)
         if pictures is not None and pictures.is_dir() and pictures.resolve() != built / FOLDER:
             copy_pictures(pictures, c.folder)
+            c.git("add", "-A")
+        if reviewed is not None and reviewed.is_dir():  # the review's, beside the protocol's
+            copy_pictures(reviewed, c.folder, replace=False)
             c.git("add", "-A")
 
     published = publish(clone, plan.branch, plan.base, fill, message, settings.dry_run, forge, request)

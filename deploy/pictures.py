@@ -54,16 +54,16 @@ def link_pictures(request: MergeRequest, forge: str, sha: str) -> MergeRequest:
     return replace(request, description=_LINK.sub(lambda m: f"]({base}{m.group(1)})", request.description))
 
 
-def copy_pictures(source: Path, clone: Path) -> None:
+def copy_pictures(source: Path, clone: Path, replace: bool = True) -> None:
     """The PNG and PDF files of `source` (the folder beside the protocol) into `clone/test_pictures/`,
-    replacing what was there. Only regular files named like mpc's pictures are taken; a
-    symbolic link is E0850 (it could publish any file of the machine)."""
+    replacing what was there (with `replace`: else beside it). Only regular files named like
+    mpc's pictures are taken; a symbolic link is E0850 (it could publish any file of the machine)."""
     target = clone / FOLDER
     if target.is_symlink() or target.is_file():
         target.unlink()
-    elif target.exists():
+    elif target.exists() and replace:
         shutil.rmtree(target)
-    target.mkdir()
+    target.mkdir(exist_ok=True)
     for path in sorted(source.iterdir()):
         if path.is_symlink():
             raise DeployError("E0850", f"the test picture '{path}' is a symbolic link; mpc deploys "

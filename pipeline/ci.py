@@ -74,6 +74,11 @@ def _command(s: Setup, model: str, stages: tuple[str, ...]) -> str:
                        *_flags(s)])
 
 
+def _review(s: Setup) -> str:
+    """The review of a merge request (pipeline/ci_review.py; nothing outside one)."""
+    return shlex.join(["mpc", "ci", "review", s.pipeline, *_flags(s)])
+
+
 def _flags(s: Setup) -> list[str]:
     return ["--allow-root-outside"] if s.allow_root_outside else []
 
@@ -204,7 +209,9 @@ def gitlab(plan: Plan, s: Setup) -> str:
             doc[ids[stage][name]] = job
     doc["summary"] = {
         "stage": "summary", "when": "always",
-        "script": [shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build, *_flags(s)])],
+        "variables": {"GIT_DEPTH": "0"},  # the merge request's base commit, for the review
+        "script": [shlex.join(["mpc", "ci", "summary", s.pipeline, "-o", s.build, *_flags(s)]),
+                   _review(s)],
         "cache": [{**uv, "policy": "pull-push", "when": "always"},
                   {"key": key, "paths": [f"{CACHE}/mpc/"], "policy": "push", "when": "always"},
                   {"key": f"mpc-meshes-{s.version}", "paths": [f"{CACHE}/mpc/"], "policy": "push",
@@ -280,11 +287,14 @@ def github(plan: Plan, s: Setup) -> str:
     jobs["summary"] = {
         "name": "summary", "runs-on": "ubuntu-latest", **({"container": s.image} if s.image else {}),
         "needs": everything, "if": "${{ !cancelled() }}",
-        "steps": [{"uses": "actions/checkout@v4"},
+        "permissions": {"contents": "read", "pull-requests": "write"},  # the review's comment
+        "steps": [{"uses": "actions/checkout@v4", "with": {"fetch-depth": 0}},  # the request's base too
                   {"name": "the artifacts of every job", "uses": "actions/download-artifact@v4",
                    "with": {"pattern": "model-*", "merge-multiple": True, "path": s.build}},
                   restore[0], *setup,
                   {"name": "the status table", "run": summary + ' --markdown "$GITHUB_STEP_SUMMARY"'},
+                  {"name": "review the pull request", "if": "${{ github.event_name == 'pull_request' }}",
+                   "run": _review(s), "env": {"GITHUB_TOKEN": "${{ github.token }}"}},
                   {"name": "save the mesh cache", "uses": "actions/cache/save@v4",
                    "with": {"path": f"{CACHE}/mpc",
                             "key": mesh_key_gh + "-${{ github.run_id }}"}},

@@ -183,9 +183,12 @@ def deploy_stage(job: StageJob) -> StageOutcome:
                                             job.sink)
     tested = job.results.get("test")
     tests = tested.details if tested is not None else {}
+    from mpc.checks.diff_review import review_of
+
     result = deploy_model(job.program, job.built, settings, job.sink,
                           protocol_markdown=tests.get("markdown"), tests_failed=bool(tests.get("failed")),
-                          pictures=job.workdir / "test_pictures" if tested is not None else None)
+                          pictures=job.workdir / "test_pictures" if tested is not None else None,
+                          review=review_of(job.program, job.built.resolve()))
     if not result.ok:
         return StageOutcome("failed", first_error(job.sink.diagnostics))
     if result.skipped:

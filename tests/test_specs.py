@@ -39,7 +39,8 @@ EXAMPLES = SPECS / "examples"
 UPDATE = os.environ.get("MPC_UPDATE_GOLDEN") == "1"
 MARKS = {"compile": {"later"}, "kind": {"model", "pipeline"}}
 # Pages that describe mpc rather than a section of the language need no example.
-NO_EXAMPLE = {"README.md", "diagnostics.md", "files.md", "layers.md", "lsp.md", "passes.md", "urdf.md"}
+NO_EXAMPLE = {"README.md", "diagnostics.md", "diff.md", "files.md", "layers.md", "lsp.md", "passes.md",
+              "urdf.md"}
 
 
 @dataclass(frozen=True)

@@ -55,6 +55,7 @@ def test_compile_test_deploy_in_one_run(model: Model, server: Server, tmp_path: 
     assert code == 0 and {state for state, _ in stages.values()} == {"cached"}
     assert server.log() == ["[mpc] Update arm-model"]
 
+    git(server.path, "branch", "develop", "master")  # the release the merge request goes into
     model.compile(heavier())  # a heavier first link: total_mass fails
     code, stages = _run(pipeline)
     assert code == 1
@@ -66,3 +67,6 @@ def test_compile_test_deploy_in_one_run(model: Model, server: Server, tmp_path: 
     description = next(o for o in options if o.startswith("merge_request.description="))
     assert "Model tests of `arm-model`: **failed**" in description
     assert "total mass 13.5 kg, expected 3.5 kg" in description
+    # the changes against the release come first (deploy/review.py)
+    assert description.index("## Changes against the release") < description.index("Model tests of")
+    assert "<br/>- link `base`: mass 2 → 12 kg (+10)<br/>" in description

@@ -94,7 +94,8 @@ def test_gitlab_child_pipeline(fleet: Path) -> None:
     assert re.fullmatch(rf"mpc-meshes-{re.escape(VERSION)}-[0-9a-f]{{16}}", meshes["key"])
     summary = doc["summary"]
     assert (summary["stage"], summary["when"], summary["script"]) == (
-        "summary", "always", ["mpc ci summary pipeline.yml -o build"])
+        "summary", "always", ["mpc ci summary pipeline.yml -o build", "mpc ci review pipeline.yml"])
+    assert summary["variables"] == {"GIT_DEPTH": "0"}  # the merge request's base, for the review
     assert [(c["key"], c["policy"]) for c in summary["cache"]] == [
         (uv["key"], "pull-push"), (meshes["key"], "push"), (f"mpc-meshes-{VERSION}", "push")]
     assert doc["stages"] == ["compile", "summary"]
@@ -175,6 +176,11 @@ def test_github_workflow(fleet: Path, tmp_path: Path) -> None:
     summary = jobs["summary"]
     assert sorted(summary["needs"]) == sorted(k for k in jobs if k != "summary")
     assert any('--markdown "$GITHUB_STEP_SUMMARY"' in s.get("run", "") for s in summary["steps"])
+    assert summary["steps"][0] == {"uses": "actions/checkout@v4", "with": {"fetch-depth": 0}}
+    assert summary["permissions"] == {"contents": "read", "pull-requests": "write"}
+    [review] = [s for s in summary["steps"] if s.get("name") == "review the pull request"]
+    assert review == {"name": "review the pull request", "if": "${{ github.event_name == 'pull_request' }}",
+                      "run": "mpc ci review pipeline.yml", "env": {"GITHUB_TOKEN": "${{ github.token }}"}}
     assert doc["env"]["MPC_VERSION"] == VERSION
     assert doc["env"]["UV_SYSTEM_CERTS"] == "1"
 
