@@ -27,6 +27,7 @@ from mpc.ir.extras import Motor
 from mpc.ir.geometry import Sphere
 from mpc.ir.robot import Material, Robot, Visual
 from tests.backends.test_mjcf import _toy
+from tests.backends.test_render_materials import share, two_material_dae
 from tests.conftest import ERD, Diags, write
 
 UR5 = "ur_description/urdf/ur5_robot.urdf"
@@ -97,7 +98,8 @@ def test_menagerie_policy(model: str, tmp_path: Path, capfd: pytest.CaptureFixtu
                           monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     xml, codes = _compile(tmp_path, model)
-    assert set(codes) <= {"W0500"}
+    # W0304: 16 bits cannot let every allowed pair of TALOS's collide (the pairs left over never do)
+    assert set(codes) <= {"W0500", "W0304"}
     compiled = _load_quietly(xml, capfd)
     assert compiled.nkey == len(POSES[model]) and compiled.nu > 0
     for k, (name, pose) in enumerate(POSES[model].items()):
@@ -120,9 +122,11 @@ def test_menagerie_policy(model: str, tmp_path: Path, capfd: pytest.CaptureFixtu
 
 @pytest.mark.parametrize("model", [UR5, PANDA])
 def test_position_actuators_track_a_target(model: str, tmp_path: Path) -> None:
-    """Each actuated joint moved 0.3 rad (the finger 1 cm) from the keyframe reaches it within 1 %."""
+    """Each actuated joint moved 0.3 rad (the finger 1 cm) from the keyframe reaches it within 1 %
+    in 4 s, without gravity (a PD servo holds a load with an offset: load / kp)."""
     xml, _ = _compile(tmp_path, model)
     compiled = mujoco.MjModel.from_xml_path(str(xml))
+    compiled.opt.gravity[:] = 0
     data = mujoco.MjData(compiled)
     mujoco.mj_resetDataKeyframe(compiled, data, 0)
     start = data.qpos.copy()
@@ -131,13 +135,13 @@ def test_position_actuators_track_a_target(model: str, tmp_path: Path) -> None:
         step = 0.01 if compiled.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE else 0.3
         lo, hi = compiled.actuator_ctrlrange[a]
         data.ctrl[a] = np.clip(start[compiled.jnt_qposadr[j]] + step, lo, hi)
-    for _ in range(round(2.0 / compiled.opt.timestep)):
+    for _ in range(round(4.0 / compiled.opt.timestep)):
         mujoco.mj_step(compiled, data)
     for a in range(compiled.nu):
         j = compiled.actuator_trnid[a, 0]
         moved = data.qpos[compiled.jnt_qposadr[j]] - start[compiled.jnt_qposadr[j]]
         wanted = data.ctrl[a] - start[compiled.jnt_qposadr[j]]
-        assert abs(moved - wanted) <= 0.01 * abs(wanted) + 1e-3, compiled.actuator(a).name
+        assert abs(moved - wanted) <= 0.01 * abs(wanted), compiled.actuator(a).name
 
 
 def test_dae_materials_are_split_meshes_with_their_colours(tmp_path: Path) -> None:
@@ -159,34 +163,46 @@ def test_dae_materials_are_split_meshes_with_their_colours(tmp_path: Path) -> No
                 assert compiled.geom_matid[g] >= 0
                 np.testing.assert_allclose(compiled.mat_rgba[compiled.geom_matid[g]], colour, atol=1e-6)
                 checked += 1
-    assert checked == 19
+    assert checked == 20
     stems = sorted(p.name for p in (tmp_path / "out" / "meshes" / "stl").glob("upperarm_material*.stl"))
     assert stems == [f"upperarm_material{i}.stl" for i in range(4)]
 
 
 def test_dae_colours_are_drawn(tmp_path: Path) -> None:
-    """The exported UR5 file drawn by MuJoCo (the render export's renderer): its blue and grey
-    DAE materials appear among the pixels."""
-    from mpc.backends.scene import GLMissing, Scene, frame
+    """A DAE file of a red and a blue box (the file the render tests write) through an mjcf
+    export: the exported file, drawn by MuJoCo (the render export's renderer), shows both."""
+    from mpc.backends.scene import Scene, frame
 
-    xml, _ = _compile(tmp_path, UR5)
-    compiled = mujoco.MjModel.from_xml_path(str(xml))
+    two_material_dae(tmp_path / "meshes/boxes.dae")
+    write(tmp_path / "boxes.urdf", """<robot name="boxes">
+  <link name="base"><visual><geometry><mesh filename="meshes/boxes.dae"/></geometry></visual></link>
+</robot>
+""")
+    definition = write(tmp_path / "boxes.yml", """\
+        model:
+          robotname: boxes
+          modelname: boxes
+          input_models: {base: {basefile: boxes.urdf}}
+          assemble: {model: base}
+          export_config:
+            - type: mjcf
+        """)
+    sink = Sink()
+    compile_model(definition, sink, Options(out=tmp_path / "out"))
+    assert not sink.diagnostics, [d.message for d in sink.diagnostics]
+    compiled = mujoco.MjModel.from_xml_path(str(tmp_path / "out/mjcf/boxes.xml"))
+    np.testing.assert_array_equal(compiled.mat_rgba[compiled.geom_matid], [[1, 0, 0, 1], [0, 0, 1, 1]])
+    assert sorted(p.name for p in (tmp_path / "out/meshes/obj").iterdir()) == [
+        "boxes_material0.obj", "boxes_material1.obj"]
     scene = Scene(compiled, "visual")
     scene.pose({})
     try:
-        rgb = scene.draw(frame(scene.points(), "iso", (320, 240)), (320, 240))
-    except GLMissing as e:
-        pytest.fail(f"no EGL: {e}")
+        rgb = scene.draw(frame(scene.points(), "front", (160, 120)), (160, 120)).astype(int)
     finally:
         scene.close()
-    pixels = rgb.reshape(-1, 3).astype(float)
-    colours = {tuple(np.round(c[:3], 3)) for c in compiled.mat_rgba}
-    blueish = [c for c in colours if c[2] > c[0] + 0.2]
-    assert blueish, colours
-    for colour in blueish[:1]:  # a pixel whose hue is the material's (lit, so scaled)
-        c = np.asarray(colour)
-        hue = pixels / np.maximum(pixels.sum(axis=1, keepdims=True), 1)
-        assert (np.abs(hue - c / c.sum()).max(axis=1) < 0.03).sum() > 200
+    left, right = rgb[:, :80], rgb[:, 80:]  # seen from the front (from +x), -y is on the left
+    assert share(left, 0) > 0.1 and share(left, 2) == 0
+    assert share(right, 2) > 0.1 and share(right, 0) == 0
 
 
 def _colliding_pairs(robot: Robot) -> set[frozenset[str]]:
@@ -252,7 +268,7 @@ def test_motors_become_the_actuators_their_types_name(diags: Diags) -> None:
     robot = replace(_toy(), motors=motors)
     text = mjcf.to_string(robot, str, diags)
     assert diags.take("W0500", Severity.WARNING).message == (
-        "the MJCF leaves out what it cannot hold: 1 joint velocity limit, 2 motor settings, motor 'd_odd' of "
+        "the MJCF leaves out what it cannot hold: 2 joint velocity limits, 2 motor settings, motor 'd_odd' of "
         "type 'hydraulic' (MuJoCo has no actuator for it; position, velocity and force/effort/torque it has), "
         "1 rotational cut joint's axis (without one, a connect is a ball joint)".replace(
             ", 1 rotational cut joint's axis (without one, a connect is a ball joint)", ""))
