@@ -374,7 +374,8 @@ class _Writer:
 
     def material(self, name: str, rgba: tuple[float, float, float, float]) -> str:
         """The asset name of a material colour: its own name, made unique when two colours share it."""
-        key = (name, fmt_floats(rgba))
+        key = (name or "material", fmt_floats(rgba))  # MuJoCo refuses an empty name
+        name = key[0]
         if key not in self.materials:
             asset, n, taken = name, 1, set(self.materials.values())
             while asset in taken:
