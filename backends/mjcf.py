@@ -636,6 +636,13 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
     text = to_string(robot, meshes.namer(files, "../"), formats=formats, enforce_zero=export.enforce_zero,
                      actuators=export.actuators)
     name = export.filename or robot.name
-    write_path(confined(out, "mjcf", f"{name}.xml"), text)
+    path = confined(out, "mjcf", f"{name}.xml")
+    write_path(path, text)
     if export.scene:
-        write_path(confined(out, "mjcf", f"{name}_scene.xml"), mjcf_scene.scene(robot, f"{name}.xml"))
+        try:
+            floor = mjcf_scene.floor_height(path, COLLISION_GROUP)
+        except ValueError as e:
+            sink.error(export.span, "E0696", f"MuJoCo refuses the MJCF of robot '{robot.name}', so its "
+                       f"scene cannot place the floor: {e}")
+            return
+        write_path(confined(out, "mjcf", f"{name}_scene.xml"), mjcf_scene.scene(robot, f"{name}.xml", floor))

@@ -116,8 +116,49 @@ def test_menagerie_policy(model: str, tmp_path: Path, capfd: pytest.CaptureFixtu
     scene = _load_quietly(xml.with_name("robot_scene.xml"), capfd)
     assert (scene.nbody, scene.ngeom - compiled.ngeom, scene.nlight, scene.ntex) == (
         compiled.nbody, 1, 1, 2)
-    assert scene.geom("floor").type == mujoco.mjtGeom.mjGEOM_PLANE
+    floor = scene.geom("floor")
+    assert floor.type == mujoco.mjtGeom.mjGEOM_PLANE
+    # The floor under the lowest collision shape at q0: UR5's wrist (stretched out, it hangs
+    # 4.85 cm below the base's origin), TALOS's feet about 1.1 m below its pelvis (its root,
+    # fixed), Panda's base link just below its origin.
+    low, high = {UR5: (-0.049, -0.048), TALOS: (-1.2, -1.0), PANDA: (-1e-3, 0.0)}[model]
+    assert low <= floor.pos[2] <= high
+    data = mujoco.MjData(scene)
+    mujoco.mj_kinematics(scene, data)
+    lowest = min((data.geom_xpos[g] - scene.geom_rbound[g])[2] for g in range(scene.ngeom)
+                 if scene.geom_group[g] == 3)
+    assert lowest <= floor.pos[2]  # (a bounding sphere reaches lower than the shape)
     _step_one_second(scene, 0)
+
+
+def test_a_scene_of_a_robot_mujoco_refuses_is_e0696(tmp_path: Path) -> None:
+    """A visual mesh of one triangle: mpc copies it, MuJoCo wants 4 vertices at least."""
+    import struct
+
+    (tmp_path / "flat.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 1)
+                                        + struct.pack("<12fH", 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 0))
+    write(tmp_path / "flat.urdf", """<robot name="flat">
+  <link name="base"><visual><geometry><mesh filename="flat.stl"/></geometry></visual></link>
+</robot>
+""")
+    definition = write(tmp_path / "flat.yml", """\
+        model:
+          robotname: flat
+          modelname: flat
+          input_models: {base: {basefile: flat.urdf}}
+          assemble: {model: base}
+          export_config:
+            - type: mjcf
+              mesh_format: stl
+              scene: true
+        """)
+    sink = Diags()
+    compile_model(definition, sink, Options(out=tmp_path / "out"))
+    error = sink.take_error("E0696")
+    assert error.message.startswith("MuJoCo refuses the MJCF of robot 'flat', so its scene cannot place "
+                                    "the floor: Error: at least 4 vertices required")
+    assert (error.span.line, error.span.col) == (7, 7)  # the entry
+    assert not (tmp_path / "out").exists()  # the build failed: nothing is written
 
 
 @pytest.mark.parametrize("model", [UR5, PANDA])
