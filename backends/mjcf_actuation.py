@@ -136,12 +136,13 @@ def _unknown_types(robot: Robot, options: holds.Options) -> Iterator[tuple[holds
 
 
 def _unused_settings(robot: Robot, options: holds.Options) -> int:
+    """The settings of the written motors that their actuators do not use (a motor left out
+    as a whole is named or counted as one, not by its settings)."""
     n = 0
     for m in robot.motors.values():
         tag = kind_of(m.settings.get("type"))
         if options.get("actuators", "motors") == "none" or tag is None \
                 or not _driven(robot, robot.joints.get(m.joint)):
-            n += len(m.settings)
             continue
         n += sum(k not in USED[tag] and not (k in ("i", "d") and _number(v) == 0)
                  for k, v in m.settings.items())

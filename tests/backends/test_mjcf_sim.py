@@ -311,9 +311,9 @@ def test_motors_become_the_actuators_their_types_name(diags: Diags) -> None:
     robot = replace(_toy(), motors=motors)
     text = mjcf.to_string(robot, str, diags)
     assert diags.take("W0500", Severity.WARNING).message == (
-        "the MJCF leaves out what it cannot hold: 2 joint velocity limits, 2 motor settings, motor "
+        "the MJCF leaves out what it cannot hold: 2 joint velocity limits, 1 motor setting, motor "
         "'d_odd' of type 'hydraulic' (MuJoCo has no actuator for it; position, velocity and "
-        "force/effort/torque it has)")  # the settings: c_torque's i (a_pos's i is 0) and d_odd's type
+        "force/effort/torque it has)")  # the setting: c_torque's i (a_pos's i is 0)
     root = etree.fromstring(text.encode())
     assert [(e.tag, dict(e.attrib)) for e in root.find("actuator")] == [
         ("velocity", {"name": "b_vel", "joint": "slide", "kv": "3", "ctrlrange": "-2 2",
@@ -412,3 +412,32 @@ def test_output_is_byte_stable(tmp_path: Path) -> None:
 
     a, b = files(first.parent.parent), files(second.parent.parent)
     assert a == b and "mjcf/robot_scene.xml" in a
+
+
+def test_motors_mjcf_cannot_drive_are_named_in_w0500(diags: Diags) -> None:
+    robot = replace(_toy(), motors={"m": Motor(name="m", joint="fly", settings={"p": 1.0}),
+                                    "n": Motor(name="n", joint="shoulder")})
+    mjcf.to_string(robot, str, diags)
+    assert "1 motor of a joint without one degree of freedom" in diags.take("W0500", Severity.WARNING).message
+    text = mjcf.to_string(robot, str, diags, actuators="none")
+    assert "2 motors (actuators: none)" in diags.take("W0500", Severity.WARNING).message
+    assert "<actuator>" not in text
+
+
+def test_an_unknown_actuators_value_is_refused(tmp_path: Path) -> None:
+    definition = write(tmp_path / "robot.yml", f"""\
+        model:
+          robotname: robot
+          modelname: robot
+          input_models: {{base: {{basefile: "{ERD / UR5}"}}}}
+          assemble: {{model: base}}
+          export_config:
+            - type: mjcf
+              actuators: positoin
+        """)
+    sink = Diags()
+    compile_model(definition, sink, Options(out=tmp_path / "out"))
+    error = sink.take_error("E0203")
+    assert error.message == ("'actuators' must be one of 'motors', 'position', 'velocity', 'motor' or 'none', "
+                             "got 'positoin'; did you mean 'position'?")
+    assert (error.span.line, error.span.col) == (8, 18)
