@@ -438,6 +438,6 @@ def test_an_unknown_actuators_value_is_refused(tmp_path: Path) -> None:
     sink = Diags()
     compile_model(definition, sink, Options(out=tmp_path / "out"))
     error = sink.take_error("E0203")
-    assert error.message == ("'actuators' must be one of 'motors', 'position', 'velocity', 'motor' or 'none', "
-                             "got 'positoin'; did you mean 'position'?")
+    assert error.message == ("'actuators' must be one of 'motors', 'position', 'velocity', 'motor' or "
+                             "'none', got 'positoin'; did you mean 'position'?")
     assert (error.span.line, error.span.col) == (8, 18)
