@@ -13,7 +13,8 @@ motors → the actuators their types name, and the export's `actuators` option f
 without one (backends/mjcf_actuation.py); named poses → `<keyframe>`; which links collide →
 contype/conaffinity from the bitmasks, or `<contact><exclude>` (backends/mjcf_contacts.py);
 visuals group 2 with their material colours (DAE files split per material, backends/dae_colours.py),
-collisions group 3; `scene: true` → a scene file (backends/mjcf_scene.py). Cut joints (loop closures) → equalities between two sites, one on each side
+collisions group 3; `scene: true` → a scene file (backends/mjcf_scene.py). Cut joints (loop
+closures) → equalities between two sites, one on each side
 (see `cut_sites`): `<weld>` for fixed ones, `<connect>` for ball ones, two `<connect>`s along
 the axis for a revolute or continuous one whose axis is known, one `<connect>` (a ball joint)
 for other rotational ones; translational ones are left out (W0500). Sites, not `anchor`: with
