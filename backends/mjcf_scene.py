@@ -14,7 +14,9 @@ every bit MuJoCo has, so a bitmask without MuJoCo's default bit still meets it).
 
 from __future__ import annotations
 
+from importlib import import_module
 from pathlib import Path
+from typing import Any
 
 from mpc.backends import xml_escape
 from mpc.backends.xml import fmt_float
@@ -36,8 +38,9 @@ def floor_height(robot_xml: Path, collision_group: int) -> float:
     """The lowest z of the robot's collision geoms (group `collision_group`; all geoms when it
     has none) at q0, from MuJoCo's compiled model; 0 without geoms. ValueError (MuJoCo's
     message) when MuJoCo refuses the file."""
-    import mujoco
     import numpy as np
+
+    mujoco: Any = import_module("mujoco")  # its stubs lack the compiled API's names
 
     model = mujoco.MjModel.from_xml_path(str(robot_xml))
     data = mujoco.MjData(model)
