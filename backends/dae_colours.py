@@ -50,13 +50,15 @@ def _parts(robot: Robot, visual: Visual) -> list[Visual]:
         return [visual]
     if all(c is None for c in colours):
         return [visual]
+    stem = visual.name or path.name.split(".", 1)[0]
     if len(colours) == 1:
-        return [replace(visual, inline_material=_material(visual, 0, colours[0]))]
+        return [replace(visual, inline_material=_material(stem, 0, colours[0]))]
     return [replace(visual, name=f"{visual.name}_material{i}" if visual.name else None,
                     geometry=replace(mesh, ops=(MaterialPart(i), *mesh.ops)),
-                    inline_material=_material(visual, i, colour) if colour is not None else None)
+                    inline_material=_material(stem, i, colour) if colour is not None else None)
             for i, colour in enumerate(colours)]
 
 
-def _material(visual: Visual, index: int, rgba: tuple[float, float, float, float] | None) -> Material:
-    return Material(name=f"{visual.name or 'visual'}_material{index}", rgba=rgba)
+def _material(stem: str, index: int, rgba: tuple[float, float, float, float] | None) -> Material:
+    """The material of part `index`: named after the visual, else its file (the MJCF's asset name)."""
+    return Material(name=f"{stem}_material{index}", rgba=rgba)

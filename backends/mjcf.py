@@ -9,7 +9,12 @@ its joint's origin, the joint at the body's origin, the axis as in URDF. revolut
 range, continuous → hinge, prismatic → slide, fixed → no joint (a welded body), floating →
 freejoint (its body hoisted to the world; deeper down: three slides and a ball), planar → two
 slides and a hinge. Mimic → `<equality><joint>` with joint1 = offset + multiplier·joint2 (polycoef);
-motors → `<motor>`. Cut joints (loop closures) → equalities between two sites, one on each side
+motors → the actuators their types name, and the export's `actuators` option for the joints
+without one (backends/mjcf_actuation.py); named poses → `<keyframe>`; which links collide →
+contype/conaffinity from the bitmasks, or `<contact><exclude>` (backends/mjcf_contacts.py);
+visuals group 2 with their material colours (DAE files split per material, backends/dae_colours.py),
+collisions group 3; `scene: true` → a scene file (backends/mjcf_scene.py). Cut joints (loop
+closures) → equalities between two sites, one on each side
 (see `cut_sites`): `<weld>` for fixed ones, `<connect>` for ball ones, two `<connect>`s along
 the axis for a revolute or continuous one whose axis is known, one `<connect>` (a ball joint)
 for other rotational ones; translational ones are left out (W0500). Sites, not `anchor`: with
@@ -38,7 +43,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mpc.backends import holds, meshes, xml_escape
+from mpc.backends import holds, meshes, mjcf_actuation, mjcf_contacts, mjcf_scene, xml_escape
+from mpc.backends.dae_colours import coloured
 from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.core.diagnostics import Sink
@@ -63,6 +69,7 @@ MAX_BODY_DEPTH = 496
 Pairs = list[tuple[str, str | None]]
 MJMINVAL = 1e-15  # MuJoCo's mjMINVAL: the least mass and inertia of a moving body
 IND = "  "
+VISUAL_GROUP, COLLISION_GROUP = 2, 3  # Menagerie's geom groups: visuals drawn by default, collisions hidden
 COMPILER: Pairs = [("angle", "radian"), ("autolimits", "true"), ("inertiafromgeom", "false"),
             ("balanceinertia", "false"), ("boundmass", "0"), ("boundinertia", "0"),
             ("fusestatic", "false"), ("discardvisual", "false")]
@@ -228,10 +235,10 @@ def _one_dof(joint: Joint | None) -> bool:
     return joint is not None and joint.type in ("revolute", "continuous", "prismatic")
 
 
-def left_out(robot: Robot) -> list[str]:
+def left_out(robot: Robot, actuators: str = "motors") -> list[str]:
     """What the robot holds that this MJCF does not: fragments, sensors, velocity limits, …
-    (the table `CANNOT_HOLD`, read by backends/holds.py)."""
-    return holds.left_out(robot, CANNOT_HOLD)
+    (the table `CANNOT_HOLD`, read by backends/holds.py); `actuators`: the export's option."""
+    return holds.left_out(robot, CANNOT_HOLD, actuators=actuators)
 
 
 def _shapes(robot: Robot) -> list[Visual | Collision]:
@@ -279,7 +286,9 @@ _C = holds.Counted
 # What MJCF cannot hold, in the order W0500 names it.
 CANNOT_HOLD: tuple[holds.Tally, ...] = (
     holds.count(_C("sensor", "sensors"), lambda r, o: len(r.sensors)),
-    holds.count(_C("pose", "poses"), lambda r, o: len(r.poses)),
+    holds.count(_C("pose value of a joint without one degree of freedom", "pose values of joints without one "
+                   "degree of freedom"), lambda r, o: sum(not _one_dof(r.joints.get(j))
+                                                          for p in r.poses.values() for j in p)),
     holds.count(_C("submechanism", "submechanisms"), lambda r, o: len(r.submechanisms)),
     holds.count(_C("annotation category", "annotation categories"), lambda r, o: len(r.annotations)),
     holds.count(_C("annotated link or joint", "annotated links and joints"), lambda r, o: sum(
@@ -304,8 +313,7 @@ CANNOT_HOLD: tuple[holds.Tally, ...] = (
     holds.count(_C("mimic of or by a joint without one degree of freedom", "mimics of or by joints without "
                    "one degree of freedom"), lambda r, o: sum(_mimic_without_one_dof(r, j)
                                                                for j in r.joints.values())),
-    holds.count(_C("motor setting", "motor settings"), lambda r, o: sum(len(m.settings)
-                                                                         for m in r.motors.values())),
+    *mjcf_actuation.CANNOT_HOLD,
     holds.count(_C("cut joint constraint axis", "cut joint constraint axes"), lambda r, o: sum(
         len(c.constraint_axes) for c in r.cut_joints.values())),
     holds.count(_C("rotational cut joint's axis (without one, a connect is a ball joint)",
@@ -320,12 +328,16 @@ CANNOT_HOLD: tuple[holds.Tally, ...] = (
 
 class _Writer:
     def __init__(self, robot: Robot, mesh_name: Callable[[Mesh], str], formats: Formats | None = None,
-                 enforce_zero: bool = False) -> None:
+                 enforce_zero: bool = False, actuators: str = "motors") -> None:
         self.robot, self.mesh_name, self.formats = robot, mesh_name, formats
-        self.enforce_zero = enforce_zero
+        self.enforce_zero, self.actuator_mode = enforce_zero, actuators
         self.out: list[str] = []
         self.children = child_joints(robot)
         self.assets: dict[tuple[str, str | None], str] = {}  # (file, scale) → asset name
+        self.materials: dict[tuple[str, str], str] = {}  # (material name, rgba) → asset name
+        # The qpos vector as the joints are written (MuJoCo's order): (joint name or None, value at q0).
+        self.qpos: list[tuple[str | None, float]] = []
+        self.bitmasks = mjcf_contacts.uses_bitmasks(robot)
         shapes = [s for lk in robot.links.values() for s in (*lk.visuals, *lk.collisions)]
         counts = Counter(s.name for s in shapes)
         self.unique_names = {n for n, c in counts.items() if c == 1 and n is not None}
@@ -365,6 +377,17 @@ class _Writer:
             self.assets[key] = name
         return self.assets[key]
 
+    def material(self, name: str, rgba: tuple[float, float, float, float]) -> str:
+        """The asset name of a material colour: its own name, made unique when two colours share it."""
+        key = (name or "material", fmt_floats(rgba))  # MuJoCo refuses an empty name
+        name = key[0]
+        if key not in self.materials:
+            asset, n, taken = name, 1, set(self.materials.values())
+            while asset in taken:
+                asset, n = f"{name}_{n}", n + 1
+            self.materials[key] = asset
+        return self.materials[key]
+
     def _emit_geom(self, depth: int, shape: Visual | Collision) -> None:
         g = shape.geometry
         pairs: Pairs = [("name", shape.name if shape.name in self.unique_names else None)]
@@ -380,11 +403,12 @@ class _Writer:
         pairs += _pose_pairs(shape.origin)
         if isinstance(shape, Visual):
             m = shape.inline_material or self.robot.materials.get(shape.material or "")
-            rgba = fmt_floats(m.rgba) if m is not None and m.rgba is not None else None
-            pairs += [("contype", "0"), ("conaffinity", "0"), ("group", "1"), ("rgba", rgba)]
+            material = self.material(m.name, m.rgba) if m is not None and m.rgba is not None else None
+            pairs += [("contype", "0"), ("conaffinity", "0"), ("group", str(VISUAL_GROUP)),
+                      ("material", material)]
         else:
             bits = str(shape.bitmask) if shape.bitmask is not None else None
-            pairs += [("contype", bits), ("conaffinity", bits), ("group", "3")]
+            pairs += [("contype", bits), ("conaffinity", bits), ("group", str(COLLISION_GROUP))]
         self.leaf(depth, "geom", pairs)
 
     def _emit_inertial(self, depth: int, inertial: Inertial) -> None:
@@ -409,8 +433,11 @@ class _Writer:
             kind = "slide" if joint.type == "prismatic" else "hinge"
             self.leaf(depth, "joint", [("name", joint.name), ("type", kind), ("axis", fmt_floats(axis)),
                                        *rng, *common])
+            self.qpos.append((joint.name, 0.0))
         elif joint.type == "floating" and top:
             self.leaf(depth, "freejoint", [("name", joint.name)])
+            origin = joint.origin or Pose()
+            self.qpos += [(None, x) for x in (*origin.xyz, *_quat_rpy(origin.rpy))]
         elif joint.type in ("floating", "planar"):
             n = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
             e1 = np.eye(3)[int(np.argmin(np.abs(n)))]
@@ -423,6 +450,8 @@ class _Writer:
             last = ("ball", None) if joint.type == "floating" else ("hinge", fmt_floats(axis))
             self.leaf(depth, "joint", [("name", f"{joint.name}_rot"), ("type", last[0]),
                                        ("axis", last[1]), *common])
+            rot = (1.0, 0.0, 0.0, 0.0) if joint.type == "floating" else (0.0,)
+            self.qpos += [(None, 0.0)] * len(dirs) + [(None, x) for x in rot]
 
     def _emit_body(self, depth: int, joint: Joint | None, link: Link, top: bool) -> None:
         """The link's body at `joint`'s origin (inertial, joint, geoms), then the bodies below it,
@@ -487,29 +516,53 @@ class _Writer:
                     ("site2", f"{c.name}_child{suffix}")])
 
     def _emit_actuators(self, depth: int = 2) -> None:
-        for name in sorted(self.robot.motors):
-            motor = self.robot.motors[name]
-            joint = self.robot.joints.get(motor.joint)
-            effort = joint.limit.effort if joint is not None and joint.limit is not None else None
-            rng = fmt_floats([-abs(effort), abs(effort)]) if effort else None
-            self.leaf(depth, "motor", [("name", name), ("joint", motor.joint), ("ctrlrange", rng)])
+        for a in mjcf_actuation.actuators(self.robot, self.actuator_mode):
+            pairs: Pairs = [(k, v if v is None or isinstance(v, str) else
+                             fmt_floats(v) if isinstance(v, tuple) else fmt_float(v)) for k, v in a.attrs]
+            self.leaf(depth, a.tag, [("name", a.name), ("joint", a.joint), *pairs])
+
+    def _emit_contacts(self, depth: int = 2) -> None:
+        for a, b in mjcf_contacts.excluded_pairs(self.robot):
+            self.leaf(depth, "exclude", [("body1", a), ("body2", b)])
+
+    def _emit_keyframes(self, depth: int = 2) -> None:
+        """A key per named pose: the pose's joint values, q0 elsewhere (a mimic follower where its
+        leader puts it); ctrl holds a position actuator at its joint's value, the others at 0."""
+        acts = mjcf_actuation.actuators(self.robot, self.actuator_mode)
+        for name, values in self.robot.poses.items():
+            q = {j: float(v) for j, v in values.items() if _one_dof(self.robot.joints.get(j))}
+            for j in [n for n in self.robot.joints if n not in q]:
+                m = self.robot.joints[j].mimic
+                if m is not None and _one_dof(self.robot.joints[j]) and m.joint in q:
+                    q[j] = (m.offset or 0.0) + (1.0 if m.multiplier is None else m.multiplier) * q[m.joint]
+            qpos = [q.get(j, x) if j is not None else x for j, x in self.qpos]
+            ctrl = [q.get(a.joint, 0.0) if a.tag == "position" else 0.0 for a in acts]
+            self.leaf(depth, "key", [("name", name), ("qpos", fmt_floats(qpos) if qpos else None),
+                                     ("ctrl", fmt_floats(ctrl) if ctrl else None)])
 
     def document(self) -> str:
         """Worldbody first: it names the mesh assets, which come before it in the file."""
         parts = []
-        for emit_part in (self._emit_worldbody, self._emit_equality, self._emit_actuators):
+        for emit_part in (self._emit_worldbody, self._emit_contacts, self._emit_equality,
+                          self._emit_actuators, self._emit_keyframes):
             self.out = []
             emit_part()
             parts.append(self.out)
-        body, equality, actuator = parts
+        body, contact, equality, actuator, keyframe = parts
         self.out = [f'<mujoco{_attrs([("model", self.robot.name)])}>']
         self.leaf(1, "compiler", COMPILER)
+        self.out.append(f'{IND}<option integrator="implicitfast">')
+        self.leaf(2, "flag", [("filterparent", "disable")])
+        self.out.append(f"{IND}</option>")
         assets = [(name, file, scale) for (file, scale), name in self.assets.items()]
-        self.out += [f"{IND}<asset>"] * bool(assets)
+        self.out += [f"{IND}<asset>"] * bool(assets or self.materials)
+        for (_, rgba), name in self.materials.items():
+            self.leaf(2, "material", [("name", name), ("rgba", rgba)])
         for name, file, scale in assets:
             self.leaf(2, "mesh", [("name", name), ("file", file), ("scale", scale), ("inertia", "shell")])
-        self.out += [f"{IND}</asset>"] * bool(assets) + body
-        for tag, lines in (("equality", equality), ("actuator", actuator)):
+        self.out += [f"{IND}</asset>"] * bool(assets or self.materials) + body
+        for tag, lines in (("contact", contact), ("equality", equality), ("actuator", actuator),
+                           ("keyframe", keyframe)):
             self.out += [f"{IND}<{tag}>", *lines, f"{IND}</{tag}>"] if lines else []
         return "\n".join([*self.out, "</mujoco>"]) + "\n"
 
@@ -522,13 +575,14 @@ def _zeroed(text: str | None) -> str | None:
 
 
 def to_string(robot: Robot, mesh_name: Callable[[Mesh], str], sink: Sink | None = None,
-              formats: Formats | None = None, enforce_zero: bool = False) -> str:
+              formats: Formats | None = None, enforce_zero: bool = False, actuators: str = "motors") -> str:
     """The canonical MJCF text of `robot`; `mesh_name` gives each mesh's file relative to it;
-    `formats`: the number formats of `float_fmt_dict`, when given. With a sink, also reports
-    what MuJoCo would refuse (E0504) and what is left out (W0500)."""
+    `formats`: the number formats of `float_fmt_dict`, when given; `actuators`: the export's
+    option (backends/mjcf_actuation.py). With a sink, also reports what MuJoCo would refuse
+    (E0504) and what is left out (W0500)."""
     if sink is not None:
-        _diagnose(robot, sink, robot.span or Span.of_file(robot.name))
-    return _Writer(robot, mesh_name, formats, enforce_zero).document()
+        _diagnose(robot, sink, robot.span or Span.of_file(robot.name), actuators)
+    return _Writer(robot, mesh_name, formats, enforce_zero, actuators).document()
 
 
 def body_depth(robot: Robot) -> tuple[int, str]:
@@ -547,7 +601,7 @@ def body_depth(robot: Robot) -> tuple[int, str]:
     return depth[deepest], deepest
 
 
-def _diagnose(robot: Robot, sink: Sink, span: Span) -> bool:
+def _diagnose(robot: Robot, sink: Sink, span: Span, actuators: str = "motors") -> bool:
     """Report what MuJoCo refuses (E0504, E0695) and what is left out (W0500); whether the
     MJCF can be written (E0695: MuJoCo could not even parse it)."""
     depth, deepest = body_depth(robot)
@@ -565,7 +619,7 @@ def _diagnose(robot: Robot, sink: Sink, span: Span) -> bool:
     if unusable:
         return False
     check(robot, sink, span)
-    missing = left_out(robot)
+    missing = left_out(robot, actuators)
     if missing:
         sink.warning(span, "W0500", "the MJCF leaves out what it cannot hold: " + ", ".join(missing))
     return True
@@ -577,12 +631,23 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
         sink.error(export.span, "E0501", f"MuJoCo reads no '{export.mesh_format}' meshes",
                    hint="use mesh_format stl or obj for an mjcf export")
         return
-    if not _diagnose(robot, sink, export.span):
+    if not _diagnose(robot, sink, export.span, export.actuators):
         return
-    prepared = meshes.for_export(robot, export, out, sink)
+    prepared = meshes.for_export(coloured(robot), export, out, sink)
     if prepared is None:
         return
     robot, files = prepared
     formats = Formats(export.float_formats, MJCF_KEYS) if export.float_formats else None
-    text = to_string(robot, meshes.namer(files, "../"), formats=formats, enforce_zero=export.enforce_zero)
-    write_path(confined(out, "mjcf", f"{export.filename or robot.name}.xml"), text)
+    text = to_string(robot, meshes.namer(files, "../"), formats=formats, enforce_zero=export.enforce_zero,
+                     actuators=export.actuators)
+    name = export.filename or robot.name
+    path = confined(out, "mjcf", f"{name}.xml")
+    write_path(path, text)
+    if export.scene:
+        try:
+            floor = mjcf_scene.floor_height(path, COLLISION_GROUP)
+        except ValueError as e:
+            sink.error(export.span, "E0696", f"MuJoCo refuses the MJCF of robot '{robot.name}', so its "
+                       f"scene cannot place the floor: {e}")
+            return
+        write_path(confined(out, "mjcf", f"{name}_scene.xml"), mjcf_scene.scene(robot, f"{name}.xml", floor))

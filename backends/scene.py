@@ -25,6 +25,7 @@ import numpy as np
 
 from mpc.backends import meshes
 from mpc.backends.dae_colours import coloured
+from mpc.backends.mjcf import COLLISION_GROUP, VISUAL_GROUP
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir.program import RENDER_VIEWS
@@ -33,7 +34,6 @@ from mpc.ir.robot import Inertia, Inertial, Robot
 Geometry = Literal["visual", "collision", "both"]
 RGBA = tuple[float, float, float, float]
 VIEWS = RENDER_VIEWS
-VISUAL_GROUP, COLLISION_GROUP = 1, 3  # the MJCF backend's geom groups
 COLLISION_COLOUR = (0.95, 0.55, 0.1)  # collisions: orange, translucent over visuals
 COLLISION_ALPHA = 0.4
 MARGIN = 1.06  # the frame around the robot, as a factor of the tightest distance

@@ -170,6 +170,8 @@ class _Exports:
         elif entry.include_cut_joints:
             self.ctx.sink.error(entry.key_span("include_cut_joints"), "E0313", "'include_cut_joints' has "
                                 f"no meaning in a {entry.type} export: {fmt.cut_joints}")
+        if entry.type == "mjcf":
+            export = replace(export, actuators=entry.actuators, scene=entry.scene)
         extra = entry.additional_meshes
         return replace(export, enforce_zero=entry.enforce_zero,
                        additional_meshes=tuple([extra] if isinstance(extra, str) else extra or ()))

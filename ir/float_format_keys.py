@@ -20,7 +20,8 @@ SDF_KEYS = frozenset({
     "velocity", "damping", "friction"})
 MJCF_KEYS = frozenset({
     "pos", "quat", "mass", "diaginertia", "size", "axis", "range", "rgba", "scale", "polycoef",
-    "damping", "frictionloss", "actuatorfrcrange", "ctrlrange"})
+    "damping", "frictionloss", "actuatorfrcrange", "ctrlrange", "forcerange", "kp", "kv", "dampratio",
+    "qpos", "ctrl"})
 DEFAULT = "default"
 _FORMAT = re.compile(r"%[-+ 0#]*[0-9]{0,2}(\.[0-9]{1,2})?[eEfFgG]")
 

@@ -133,7 +133,9 @@ class MjcfExport(ExportEntry):
     """A `type: mjcf` entry: MuJoCo's format; meshes in `mesh_format` (stl or obj: MuJoCo
     reads no DAE); `additional_meshes`, `enforce_zero`, `correct_inertials` as for URDF, and
     `float_formats` keyed by MJCF attribute (`pos`, `quat`, `mass`, …). No package paths:
-    MuJoCo cannot resolve them."""
+    MuJoCo cannot resolve them. actuators: what the joints without a motor get (motors,
+    position, velocity, motor, none: backends/mjcf_actuation.py); scene: also write
+    `<file>_scene.xml` (floor, light, sky) that includes the robot's file."""
 
     mesh_format: str
     span: Span
@@ -144,6 +146,8 @@ class MjcfExport(ExportEntry):
     additional_meshes: tuple[str, ...] = ()
     enforce_zero: bool = False
     float_formats: tuple[tuple[str, str], ...] = ()
+    actuators: Literal["motors", "position", "velocity", "motor", "none"] = "motors"
+    scene: bool = False
     type: Literal["mjcf"] = "mjcf"
 
 

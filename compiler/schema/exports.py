@@ -57,6 +57,8 @@ class SdfExport(_Kinematic):
 class MjcfExport(_Kinematic):
     SECTION: ClassVar[str] = "an mjcf export"
     type: Literal["mjcf"]
+    actuators: Literal["motors", "position", "velocity", "motor", "none"] = "motors"
+    scene: bool = False
 
 
 class SmurfExport(_Export):

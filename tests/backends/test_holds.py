@@ -106,7 +106,6 @@ SDF_RICH = [
 ]
 MJCF_ENRICHED = [
     '3 sensors',
-    '1 pose',
     '1 submechanism',
     '2 annotation categories',
     '1 annotated link or joint',
@@ -118,7 +117,7 @@ MJCF_ENRICHED = [
     '3 names of visuals or collisions used twice',
     '2 attributes URDF does not define',
     '1 mimic of or by a joint without one degree of freedom',
-    '2 motor settings',
+    '1 motor setting',  # m1's i (p is its actuator's kp; poses are keyframes)
     '1 cut joint constraint axis',
     "1 rotational cut joint's axis (without one, a connect is a ball joint)",
     "prismatic cut joint 'cp' (MJCF has no equality for it)",

@@ -17,6 +17,7 @@ import pytest
 from lxml import etree
 
 from mpc.backends import meshes, mjcf, urdf
+from mpc.backends.dae_colours import coloured
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.span import Span
@@ -111,7 +112,7 @@ def emitted(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, str], Em
             sink = Sink()
             out = root / fmt / model.replace("/", "_")
             mjcf.emit(robot, MjcfExport(mesh_format=fmt, span=SPAN), out, sink)
-            files = meshes.plan(robot, fmt, Sink(), SPAN) or {}
+            files = meshes.plan(coloured(robot), fmt, Sink(), SPAN) or {}
             cache[model, fmt] = Emitted(robot, out / "mjcf" / f"{robot.name}.xml",
                                         lambda m: "../" + files[meshes.key(m)], sink.diagnostics)
         return cache[model, fmt]
@@ -192,8 +193,9 @@ def test_model_loads_in_mujoco_as_the_same_robot(model: str, emitted: Callable[[
         [d.message for d in e.diagnostics]
     assert ("W0605" in codes) == bool(broken_dae)
     # Canonical: the same robot gives the same text, and to_string is what emit wrote (of the
-    # robot as emit prepares it: its unnamed shapes named as the SMURF names them).
-    assert mjcf.to_string(named_shapes(e.robot), e.namer) == e.xml.read_text()
+    # robot as emit prepares it: DAE visuals split by material, its unnamed shapes named as the
+    # SMURF names them).
+    assert mjcf.to_string(named_shapes(coloured(e.robot)), e.namer) == e.xml.read_text()
     flagged = _flagged(e.diagnostics)
     assert sorted(flagged) == sorted(BAD_INERTIA.get(model, ("", ()))[1])
     try:
@@ -234,7 +236,7 @@ def test_emitting_twice_gives_identical_bytes(tmp_path: Path, emitted: Callable[
         return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
 
     a, b = files(first), files(tmp_path)
-    assert len(a) == 20 and a == b  # the MJCF and 19 meshes
+    assert len(a) == 35 and a == b  # the MJCF and 34 meshes (DAE visuals split by material)
 
 
 def test_mimic_is_a_joint_equality_with_mujocos_convention(tmp_path: Path) -> None:
@@ -280,7 +282,7 @@ def test_collision_bitmasks_become_contype_and_conaffinity(emitted: Callable[[st
             assert model.geom_contype[g] == model.geom_conaffinity[g] == masks[name]
             checked += 1
         else:
-            assert (model.geom_group[g], model.geom_contype[g], model.geom_conaffinity[g]) == (1, 0, 0)
+            assert (model.geom_group[g], model.geom_contype[g], model.geom_conaffinity[g]) == (2, 0, 0)
     assert checked == sum(len(lk.collisions) for lk in robot.links.values())
 
 
@@ -358,7 +360,8 @@ def test_joint_types_cut_joints_and_motors() -> None:
     np.testing.assert_allclose(model.site("loop_parent").pos, [0.3, 0, 0])
     np.testing.assert_allclose(model.site("loop_child").pos, [0, 0, 0])
     np.testing.assert_allclose(model.site("weld_parent").quat, _quat(0.5), atol=1e-15)
-    np.testing.assert_allclose(model.actuator_ctrlrange[0], [-5, 5])
+    np.testing.assert_allclose(model.actuator_ctrlrange[0], [-1, 1])  # a position servo (Phobos's default)
+    np.testing.assert_allclose(model.actuator_forcerange[0], [-5, 5])
     arm = model.body("arm").id
     sizes = [model.geom_size[g] for g in range(model.ngeom) if model.geom_bodyid[g] == arm]
     np.testing.assert_allclose(sizes, [[0.1, 0.2, 0.3], [0.1, 0.25, 0], [0.05, 0, 0]])
