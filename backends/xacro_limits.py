@@ -220,7 +220,7 @@ def watched() -> Iterator[None]:
         while not done.wait(_POLL):
             elapsed, grown = time.monotonic() - start, _resident_bytes() - base
             why = (f"it ran for more than {MAX_SECONDS:g} s" if elapsed > MAX_SECONDS else
-                   f"it took more than {MAX_MEMORY / 2**20:,.0f} MiB of memory" if grown > MAX_MEMORY else "")
+                   f"it took more than {MAX_MEMORY >> 20:,} MiB of memory" if grown > MAX_MEMORY else "")
             if why:
                 with lock:
                     if not done.is_set():
