@@ -23,7 +23,9 @@ from mpc.ir.tree import parent_joint
 BITS = 16
 
 
-def _coal_object(geometry: Geometry) -> object:
+def coal_object(geometry: Geometry, mesh: object = None) -> object:
+    """The shape as a coal collision object in its own frame (a mesh: a BVH of its triangles;
+    `mesh`: its trimesh, when the caller read it already)."""
     import coal
 
     from mpc.ir.geometry import Box, Cylinder, Sphere
@@ -35,11 +37,12 @@ def _coal_object(geometry: Geometry) -> object:
         return coal.Cylinder(geometry.radius, geometry.length)
     if isinstance(geometry, Sphere):
         return coal.Sphere(geometry.radius)
-    mesh = as_trimesh(geometry)
+    if mesh is None:
+        mesh = as_trimesh(geometry)
     model = coal.BVHModelOBBRSS()
-    model.beginModel(len(mesh.faces), len(mesh.vertices))
-    model.addVertices(np.asarray(mesh.vertices, dtype=float))
-    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+    model.beginModel(len(mesh.faces), len(mesh.vertices))  # type: ignore[attr-defined]
+    model.addVertices(np.asarray(mesh.vertices, dtype=float))  # type: ignore[attr-defined]
+    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))  # type: ignore[attr-defined]
     model.endModel()
     return model
 
@@ -53,7 +56,7 @@ def touching(robot: Robot) -> set[frozenset[str]]:
     for name, link in robot.links.items():
         for c in link.collisions:
             X = X_R[name] @ pose_matrix(c.origin)
-            shapes.append((name, _coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
+            shapes.append((name, coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
     out: set[frozenset[str]] = set()
     request = coal.CollisionRequest()
     for (a, sa, ta), (b, sb, tb) in combinations(shapes, 2):
