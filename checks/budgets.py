@@ -10,8 +10,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.backends.empty_meshes import binary_stl_triangles
-from mpc.backends.meshes import mesh_uses
 from mpc.checks.protocol import Result, failed, first_of, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.geometry import Mesh
@@ -21,6 +19,8 @@ from mpc.ir.robot import Robot
 
 def _mesh_files(robot: Robot) -> tuple[dict[Path, Mesh], list[str]]:
     """The mesh files the robot uses (each once), and a problem for each it names but lacks."""
+    from mpc.backends.meshes import mesh_uses
+
     files: dict[Path, Mesh] = {}
     problems: list[str] = []
     for use in mesh_uses(robot):
@@ -36,6 +36,8 @@ def _mesh_files(robot: Robot) -> tuple[dict[Path, Mesh], list[str]]:
 
 def faces(path: Path, mesh: Mesh) -> int:
     """The faces (triangles) of a mesh file: a binary STL's from its header, others read."""
+    from mpc.backends.empty_meshes import binary_stl_triangles
+
     if path.suffix.lower() == ".stl" and (count := binary_stl_triangles(path)) is not None:
         return count
     from mpc.ir.mesh_props import as_trimesh
