@@ -198,3 +198,11 @@ def test_bad_budget_and_joint_limits_arguments(tmp_path: Path) -> None:
         found = [(d.code, d.message) for d in sink.diagnostics if d.severity.name == "ERROR"]
         assert found == [("E0703", message)], tests
         assert [(d.span.line, d.span.col) for d in sink.diagnostics if d.code == "E0703"] == [(line, 9)]
+
+
+def test_the_editor_completes_the_new_tests() -> None:
+    """The LSP offers what the registry implements (lsp/completion.py test_names)."""
+    from mpc.lsp.completion import test_names
+
+    assert {"joint_limits", "max_mesh_faces", "max_mesh_bytes", "max_collisions_per_link",
+            "effort_covers_gravity", "self_collision"} <= set(test_names())
