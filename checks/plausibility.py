@@ -28,7 +28,7 @@ import numpy as np
 from mpc.checks.dynamics_model import DynamicsError
 from mpc.checks.protocol import Result, failed, first_of, passed, verdict
 from mpc.checks.registry import Context, register
-from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere
+from mpc.ir.geometry import Box, Geometry, Mesh, Sphere
 from mpc.ir.program import ModelTest
 from mpc.ir.robot import Collision, Robot
 
@@ -168,15 +168,15 @@ class _Shapes:
 
     def corners(self, geometry: Geometry) -> np.ndarray:
         """The 8 corners of the shape's bounding box in its frame (4×8, homogeneous)."""
-        if isinstance(geometry, Box):
-            half = np.asarray(geometry.size, dtype=float) / 2
-        elif isinstance(geometry, Sphere):
-            half = np.full(3, geometry.radius)
-        elif isinstance(geometry, Cylinder):
-            half = np.array([geometry.radius, geometry.radius, geometry.length / 2])
         if isinstance(geometry, Mesh):
             lo, hi = self._mesh(geometry).bounds
         else:
+            if isinstance(geometry, Box):
+                half = np.asarray(geometry.size, dtype=float) / 2
+            elif isinstance(geometry, Sphere):
+                half = np.full(3, geometry.radius)
+            else:
+                half = np.array([geometry.radius, geometry.radius, geometry.length / 2])
             lo, hi = -half, half
         grid = np.meshgrid(*zip(lo, hi, strict=True), indexing="ij")
         return np.vstack([np.array(grid).reshape(3, 8), np.ones(8)])
@@ -199,8 +199,7 @@ def _label(collision: Collision, index: int) -> str:
 def self_collision(ctx: Context, test: ModelTest) -> Result:
     """No two collision shapes that may collide overlap at q = 0 or at a named pose. The
     figure is the number of colliding pairs of links."""
-    import coal
-
+    from mpc.ir.bitmask import overlap
     from mpc.ir.kinematics import pose_matrix
 
     robot = ctx.built.robot
@@ -218,7 +217,6 @@ def self_collision(ctx: Context, test: ModelTest) -> Result:
         corners = {k: shapes.corners(geometry[k]) for k in keys}
     except Exception as e:  # a mesh that cannot be read: no verdict
         return failed(test.name, f"a collision mesh cannot be read: {e}")
-    request = coal.CollisionRequest()
     found: dict[frozenset[str], str] = {}
     configs = configurations(robot)
     for label, values in configs:
@@ -237,13 +235,11 @@ def self_collision(ctx: Context, test: ModelTest) -> Result:
             links = frozenset((a[0], b[0]))
             if links in found or np.any(boxes[a][0] > boxes[b][1]) or np.any(boxes[b][0] > boxes[a][1]):
                 continue
-            Xa, Xb = where[a], where[b]
             try:
                 oa, ob = shapes.get(geometry[a]), shapes.get(geometry[b])
             except Exception as e:
                 return failed(test.name, f"a collision mesh cannot be read: {e}")
-            if coal.collide(oa, coal.Transform3s(Xa[:3, :3], Xa[:3, 3]), ob,
-                            coal.Transform3s(Xb[:3, :3], Xb[:3, 3]), request, coal.CollisionResult()):
+            if overlap(oa, where[a], ob, where[b]):
                 ca, cb = robot.links[a[0]].collisions[a[1]], robot.links[b[0]].collisions[b[1]]
                 found[links] = (f"links '{a[0]}' and '{b[0]}' collide at {label} (collisions "
                                 f"{_label(ca, a[1])} and {_label(cb, b[1])})")

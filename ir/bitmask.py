@@ -47,22 +47,27 @@ def coal_object(geometry: Geometry, mesh: object = None) -> object:
     return model
 
 
-def touching(robot: Robot) -> set[frozenset[str]]:
-    """Pairs of links whose collision shapes touch or overlap at q = 0."""
+def overlap(a: object, X_a: np.ndarray, b: object, X_b: np.ndarray) -> bool:
+    """Whether two coal objects (coal_object) at the poses X_a, X_b (4×4) touch or overlap."""
     import coal
 
+    return bool(coal.collide(a, coal.Transform3s(X_a[:3, :3], X_a[:3, 3]), b,
+                             coal.Transform3s(X_b[:3, :3], X_b[:3, 3]), coal.CollisionRequest(),
+                             coal.CollisionResult()))
+
+
+def touching(robot: Robot) -> set[frozenset[str]]:
+    """Pairs of links whose collision shapes touch or overlap at q = 0."""
     shapes = []
     X_R = links_in_root(robot)
     for name, link in robot.links.items():
         for c in link.collisions:
-            X = X_R[name] @ pose_matrix(c.origin)
-            shapes.append((name, coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
+            shapes.append((name, coal_object(c.geometry), X_R[name] @ pose_matrix(c.origin)))
     out: set[frozenset[str]] = set()
-    request = coal.CollisionRequest()
     for (a, sa, ta), (b, sb, tb) in combinations(shapes, 2):
         if a == b or frozenset((a, b)) in out:
             continue
-        if coal.collide(sa, ta, sb, tb, request, coal.CollisionResult()):
+        if overlap(sa, ta, sb, tb):
             out.add(frozenset((a, b)))
     return out
 
