@@ -92,8 +92,9 @@ class Dynamics:
                     q[m.idx_qs[j]:m.idx_qs[j] + 2] = np.cos(value), np.sin(value)
                 else:
                     q[m.idx_qs[j]] = value
-        if not self.constraints:  # mimic joints alone: each set from the joint it follows
-            for c in _leaders_first(self.mimics):
+        order = _leaders_first(self.mimics)
+        if not self.constraints and order is not None:  # mimic joints alone: set from their joints
+            for c in order:
                 q[m.idx_qs[c.follower]] = c.multiplier * q[m.idx_qs[c.leader]] + c.offset
             return q
         fixed = {m.idx_vs[m.getJointId(n)] for n in (self.actuated if actuated is None else actuated)
@@ -188,7 +189,8 @@ class Dynamics:
         if not self.coupled:
             return {n: float(g[i]) for n, i in index.items()}
         driven = {m.getJointId(n) for n in (*index, *self.actuated) if m.existJointName(n)}
-        if not self.constraints and {c.leader for c in self.mimics} <= driven:
+        if not self.constraints and {c.leader for c in self.mimics} <= driven \
+                and _leaders_first(self.mimics) is not None:
             return {n: float(self._mimic_load(g, m.getJointId(n))) for n in index}
         _, J = self.residual(q)
         S = np.zeros((m.nv, len(index)))
@@ -212,7 +214,6 @@ class Dynamics:
                                 f"(the mechanism is overactuated{hint})")
         return {n: float(x[k]) for k, n in enumerate(index)}
 
-
     def _mimic_load(self, g: np.ndarray, joint: int) -> float:
         """The gravity load on a joint with the loads of the joints that follow it (mimic):
         g_j + Σ multiplier · load_follower, the principle of virtual work, recursively (a
@@ -225,15 +226,16 @@ class Dynamics:
         return load
 
 
-def _leaders_first(mimics: tuple[MimicCoupling, ...]) -> list[MimicCoupling]:
-    """The couplings ordered so that a follower that is itself followed is set first."""
+def _leaders_first(mimics: tuple[MimicCoupling, ...]) -> list[MimicCoupling] | None:
+    """The couplings ordered so that a follower that is itself followed is set first; None
+    when they make a cycle (then the general solution, Gauss-Newton, is left to judge them)."""
     out: list[MimicCoupling] = []
     rest = list(mimics)
     followers = {c.follower for c in mimics}
     while rest:
         ready = [c for c in rest if c.leader not in followers or c.leader in {d.follower for d in out}]
-        if not ready:  # a cycle of mimic joints: left as the order gives them
-            return out + rest
+        if not ready:
+            return None
         out += ready
         rest = [c for c in rest if c not in ready]
     return out
