@@ -152,7 +152,7 @@ def test_max_mesh_faces_reads_other_formats(tmp_path: Path) -> None:
 
 def test_max_mesh_bytes(tmp_path: Path) -> None:
     """A binary STL of 4 triangles: 84 + 4 · 50 = 284 bytes."""
-    protocol = _tested(tmp_path, ARM, "      - max_mesh_bytes: 284\n")
+    protocol = _tested(tmp_path, ARM, '      - max_mesh_bytes: "2 * 142"\n')  # an expression
     size = result(protocol, "max_mesh_bytes")
     assert (size.status, size.figure, size.reason) == ("passed", 284.0, "1 mesh files, 284 bytes ≤ 284")
     protocol = _tested(tmp_path, ARM, "      - max_mesh_bytes: 283\n")
