@@ -133,3 +133,18 @@ def test_bitmasks_say_which_links_may_collide(tmp_path: Path) -> None:
     shared = FOLDED + "  collisions:\n    base:\n      bitmask: 3\n    lower:\n      bitmask: 2\n"
     collision = result(_tested(tmp_path, FOLDING, COLLISION, extra=shared), "self_collision")
     assert (collision.status, collision.reason) == ("failed", AT_FOLDED)
+
+
+def test_mesh_collisions_are_tested_by_their_triangles(tmp_path: Path) -> None:
+    """The base's collision is the tetrahedron of tests/fixtures scaled to 0.4 m and moved 0.1 m
+    along x. With the elbow at 2 the forearm is inside the tetrahedron's bounding box and 2 cm
+    above its slanted face: apart (coal decides, not the boxes); folded it reaches into it."""
+    tetra = FOLDING.replace('<collision><origin xyz="0 0 0.05"/><geometry><box size="0.8 0.8 0.1"/>',
+                            '<collision><origin xyz="0.1 0 0"/><geometry><mesh filename="meshes/tetra.stl" '
+                            'scale="4 4 4"/>')
+    reach = "  poses:\n    reach:\n      elbow: 2.0\n"
+    collision = result(_tested(tmp_path, tetra, COLLISION, extra=reach), "self_collision")
+    assert (collision.status, collision.reason) == (
+        "passed", "1 pairs of collisions (by the kinematic rules) apart in 2 configurations")
+    collision = result(_tested(tmp_path, tetra, COLLISION, extra=FOLDED), "self_collision")
+    assert (collision.status, collision.reason) == ("failed", AT_FOLDED)
