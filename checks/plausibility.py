@@ -81,7 +81,7 @@ def effort_covers_gravity(ctx: Context, test: ModelTest) -> Result:
         if not effort or effort <= 0:
             unlimited.append(joint)
             continue
-        worst, at = 0.0, ""
+        worst, at = -1.0, ""  # the first sample sets both
         for label, values in configs:
             for value in samples(robot, joint):
                 try:
@@ -96,13 +96,13 @@ def effort_covers_gravity(ctx: Context, test: ModelTest) -> Result:
                                      f"effort limit {effort:g} {unit}"))
     rows.sort(key=lambda r: -r[0])
     over = [f"{text} (×{ratio:.3g})" for ratio, text in rows if ratio > 1.0]
-    note = (f"; no effort limit: {', '.join(repr(n) for n in unlimited)}",) if unlimited else ()
+    note = (f"no effort limit: {', '.join(repr(n) for n in unlimited)}",) if unlimited else ()
     if not rows:
-        return passed(test.name, "no actuated joint has an effort limit" + (note[0] if note else ""))
+        return passed(test.name, "no actuated joint has an effort limit", details=note)
     worst_ratio = rows[0][0]
     reason = first_of(over) if over else (f"{len(rows)} joints hold themselves over their ranges in "
                                           f"{len(configs)} configurations; the most loaded: {rows[0][1]}")
-    details = tuple(over or [text for _, text in rows[:5]]) + tuple(n.lstrip("; ") for n in note)
+    details = tuple(over or [text for _, text in rows[:5]]) + note
     return verdict(test.name, not over, reason, figure=float(worst_ratio), unit="of the effort limit",
                    details=details)
 
