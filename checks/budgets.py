@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.checks.protocol import Result, failed, first_of, verdict
+from mpc.checks.protocol import Result, counted, failed, first_of, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.geometry import Mesh
 from mpc.ir.program import ModelTest
@@ -45,15 +45,16 @@ def faces(path: Path, mesh: Mesh) -> int:
     return len(as_trimesh(Mesh(source=mesh.source), scaled=False).faces)
 
 
-def _over(name: str, figures: dict[str, float], limit: float, unit: str, problems: list[str]) -> Result:
+def _over(name: str, figures: dict[str, float], limit: float, unit: str, noun: str,
+          problems: list[str]) -> Result:
     """The verdict of a budget: the largest figure against the limit; details worst first."""
     if problems:
         return failed(name, first_of(problems), details=tuple(problems))
     rows = sorted(figures.items(), key=lambda kv: (-kv[1], kv[0]))
-    over = [f"{key}: {value:g} {unit} > {limit:g}" for key, value in rows if value > limit]
+    over = [f"{key}: {counted(value, noun)} > {limit:g}" for key, value in rows if value > limit]
     worst = rows[0][1] if rows else 0.0
-    reason = first_of(over) if over else (f"the largest, {rows[0][0]}: {worst:g} {unit} ≤ {limit:g}" if rows
-                                          else f"nothing to count: 0 {unit} ≤ {limit:g}")
+    reason = first_of(over) if over else (f"the largest, {rows[0][0]}: {counted(worst, noun)} ≤ {limit:g}"
+                                          if rows else f"nothing to count: 0 {unit} ≤ {limit:g}")
     return verdict(name, not over, reason, figure=float(worst), unit=unit, details=tuple(over))
 
 
@@ -68,7 +69,7 @@ def max_mesh_faces(ctx: Context, test: ModelTest) -> Result:
             counts[f"'{_shown(path, ctx.built.folder)}'"] = float(faces(path, mesh))
         except Exception as e:  # a mesh trimesh cannot read: the budget cannot be judged
             problems.append(f"mesh '{_shown(path, ctx.built.folder)}' cannot be read: {e}")
-    return _over(test.name, counts, test.value, "faces", problems)
+    return _over(test.name, counts, test.value, "faces", "face", problems)
 
 
 @register("max_mesh_bytes")
@@ -83,7 +84,7 @@ def max_mesh_bytes(ctx: Context, test: ModelTest) -> Result:
     largest = sorted(sizes.items(), key=lambda kv: (-kv[1], kv[0]))[:10]
     details = tuple(f"{key}: {size:g} bytes" for key, size in largest)
     ok = total <= test.value
-    return verdict(test.name, ok, f"{len(files)} mesh files, {total:g} bytes {'≤' if ok else '>'} "
+    return verdict(test.name, ok, f"{counted(len(files), 'mesh file')}, {total:g} bytes {'≤' if ok else '>'} "
                    f"{test.value:g}", figure=total, unit="bytes", details=() if ok else details)
 
 
@@ -92,7 +93,7 @@ def max_collisions_per_link(ctx: Context, test: ModelTest) -> Result:
     """The collision shapes of each link ≤ the limit."""
     assert test.value is not None
     counts = {f"link '{n}'": float(len(link.collisions)) for n, link in ctx.built.robot.links.items()}
-    return _over(test.name, counts, test.value, "collisions", [])
+    return _over(test.name, counts, test.value, "collisions", "collision", [])
 
 
 def _shown(path: Path, folder: Path) -> str:

@@ -10,7 +10,7 @@ it is or negated (mirroring a joint may turn its axis: [-1, 2] and [-2, 1] are t
 
 from __future__ import annotations
 
-from mpc.checks.protocol import Result, Tolerance, failed, first_of, passed
+from mpc.checks.protocol import Result, Tolerance, counted, failed, first_of, passed
 from mpc.checks.registry import Context, register
 from mpc.ir.program import ModelTest
 from mpc.ir.robot import Joint, Robot
@@ -129,9 +129,9 @@ def joint_limits(ctx: Context, test: ModelTest) -> Result:
                             f"joint of the name with '{test.mirrored[1]}' for it")
         problems += mirrored
     joints = len(_movable(ctx.built.robot))
-    what = f"{joints} movable joints"
+    what = counted(joints, "movable joint")
     what += "" if missing is None else " (no compare_model: mirrored joints only)"
-    what += f", {pairs} mirrored pairs" if test.mirrored is not None else ""
+    what += f", {counted(pairs, 'mirrored pair')}" if test.mirrored is not None else ""
     if problems:
         return failed(test.name, first_of(problems), figure=float(len(problems)), unit="joints",
                       tolerances=tolerances, details=tuple(problems))

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from mpc.checks.dynamics_model import DynamicsError
-from mpc.checks.protocol import Result, failed, first_of, passed, verdict
+from mpc.checks.protocol import Result, counted, failed, first_of, passed, verdict
 from mpc.checks.registry import Context, register
 from mpc.ir.geometry import Box, Geometry, Mesh, Sphere
 from mpc.ir.program import ModelTest
@@ -100,8 +100,10 @@ def effort_covers_gravity(ctx: Context, test: ModelTest) -> Result:
     if not rows:
         return passed(test.name, "no actuated joint has an effort limit", details=note)
     worst_ratio = rows[0][0]
-    reason = first_of(over) if over else (f"{len(rows)} joints hold themselves over their ranges in "
-                                          f"{len(configs)} configurations; the most loaded: {rows[0][1]}")
+    holds = "holds itself over its range" if len(rows) == 1 else "hold themselves over their ranges"
+    reason = first_of(over) if over else (f"{counted(len(rows), 'joint')} {holds} in "
+                                          f"{counted(len(configs), 'configuration')}; the most loaded: "
+                                          f"{rows[0][1]}")
     details = tuple(over or [text for _, text in rows[:5]]) + note
     return verdict(test.name, not over, reason, figure=float(worst_ratio), unit="of the effort limit",
                    details=details)
@@ -246,5 +248,6 @@ def self_collision(ctx: Context, test: ModelTest) -> Result:
     problems = list(found.values())
     rule = "bitmasks" if bitmasks else "kinematic rules"
     return verdict(test.name, not problems, first_of(problems) if problems else
-                   f"{len(pairs)} pairs of collisions (by the {rule}) apart in {len(configs)} configurations",
+                   f"{counted(len(pairs), 'pair')} of collisions (by the {rule}) apart in "
+                   f"{counted(len(configs), 'configuration')}",
                    figure=float(len(problems)), unit="pairs", details=tuple(problems))

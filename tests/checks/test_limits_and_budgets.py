@@ -105,7 +105,7 @@ def test_mirrored_joints_with_the_same_or_the_negated_range_pass(tmp_path: Path)
         limits = result(protocol, "joint_limits")
         assert (limits.status, limits.reason) == (
             "passed", "the limits of 2 movable joints (no compare_model: mirrored joints only), 1 mirrored "
-                      "pairs agree")
+                      "pair agree")
 
 
 def test_mirrored_joints_that_differ_from_the_release_fail(tmp_path: Path) -> None:
@@ -154,18 +154,18 @@ def test_max_mesh_bytes(tmp_path: Path) -> None:
     """A binary STL of 4 triangles: 84 + 4 · 50 = 284 bytes."""
     protocol = _tested(tmp_path, ARM, '      - max_mesh_bytes: "2 * 142"\n')  # an expression
     size = result(protocol, "max_mesh_bytes")
-    assert (size.status, size.figure, size.reason) == ("passed", 284.0, "1 mesh files, 284 bytes ≤ 284")
+    assert (size.status, size.figure, size.reason) == ("passed", 284.0, "1 mesh file, 284 bytes ≤ 284")
     protocol = _tested(tmp_path, ARM, "      - max_mesh_bytes: 283\n")
     size = result(protocol, "max_mesh_bytes")
     assert (size.status, size.reason, size.details) == (
-        "failed", "1 mesh files, 284 bytes > 283", ("'meshes/stl/tetra.stl': 284 bytes",))
+        "failed", "1 mesh file, 284 bytes > 283", ("'meshes/stl/tetra.stl': 284 bytes",))
 
 
 def test_max_collisions_per_link(tmp_path: Path) -> None:
     box = ARM[ARM.index("<collision>"):ARM.index("</collision>") + len("</collision>")]
     three = ARM.replace(box, box * 3)
     protocol = _tested(tmp_path, ARM, "      - max_collisions_per_link: 2\n")
-    assert result(protocol, "max_collisions_per_link").reason == "the largest, link 'upper': 1 collisions ≤ 2"
+    assert result(protocol, "max_collisions_per_link").reason == "the largest, link 'upper': 1 collision ≤ 2"
     protocol = _tested(tmp_path, three, "      - max_collisions_per_link: 2\n")
     count = result(protocol, "max_collisions_per_link")
     assert (count.status, count.figure, count.reason) == ("failed", 3.0, "link 'upper': 3 collisions > 2")

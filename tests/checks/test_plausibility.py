@@ -42,7 +42,7 @@ def test_the_unchanged_arm_holds_itself(tmp_path: Path) -> None:
     protocol = _tested(tmp_path, LOADED, GRAVITY)
     effort = result(protocol, "effort_covers_gravity")
     assert (effort.status, effort.reason) == (
-        "passed", "2 joints hold themselves over their ranges in 1 configurations; the most loaded: joint "
+        "passed", "2 joints hold themselves over their ranges in 1 configuration; the most loaded: joint "
                   "'shoulder': gravity 5.382 N·m at shoulder = -1.5, q = 0, effort limit 10 N·m")
     assert effort.details[1] == "joint 'elbow': gravity 1.468 N·m at elbow = -1.5, q = 0, effort limit 5 N·m"
 
@@ -107,7 +107,7 @@ def test_the_arm_apart_passes_self_collision(tmp_path: Path) -> None:
     protocol = _tested(tmp_path, FOLDING, COLLISION, extra="  poses:\n    bent:\n      elbow: 1.0\n")
     collision = result(protocol, "self_collision")
     assert (collision.status, collision.figure, collision.reason) == (
-        "passed", 0.0, "1 pairs of collisions (by the kinematic rules) apart in 2 configurations")
+        "passed", 0.0, "1 pair of collisions (by the kinematic rules) apart in 2 configurations")
 
 
 def test_links_colliding_at_a_named_pose_fail(tmp_path: Path) -> None:
@@ -145,6 +145,6 @@ def test_mesh_collisions_are_tested_by_their_triangles(tmp_path: Path) -> None:
     reach = "  poses:\n    reach:\n      elbow: 2.0\n"
     collision = result(_tested(tmp_path, tetra, COLLISION, extra=reach), "self_collision")
     assert (collision.status, collision.reason) == (
-        "passed", "1 pairs of collisions (by the kinematic rules) apart in 2 configurations")
+        "passed", "1 pair of collisions (by the kinematic rules) apart in 2 configurations")
     collision = result(_tested(tmp_path, tetra, COLLISION, extra=FOLDED), "self_collision")
     assert (collision.status, collision.reason) == ("failed", AT_FOLDED)
