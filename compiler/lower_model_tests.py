@@ -217,7 +217,7 @@ class _TestLowering:
         value = self.number(arg, span, f"test '{name}' limit")
         if value is None:
             return None
-        if value < 0 or value != int(value):
+        if value < 0 or not float(value).is_integer():  # inf and nan too
             self.sink.error(span, "E0703", f"test '{name}': the limit is a whole number of "
                             f"{BUDGETS[name]}, at least 0, got {value:g}")
             return None
