@@ -23,15 +23,22 @@ _DAE_INDICES = re.compile(rb"<p[\s>]")  # an index list of <triangles>, <polylis
 _OBJ_FACE = re.compile(rb"^\s*f\s", re.MULTILINE)
 
 
+def binary_stl_triangles(path: Path) -> int | None:
+    """The triangle count of a binary STL, read from its header (the rest is not read); None
+    when the file is not a binary STL whose count fits its size. Raises OSError."""
+    with open(path, "rb") as f:
+        head, size = f.read(84), os.fstat(f.fileno()).st_size
+    if len(head) == 84 and size == 84 + 50 * struct.unpack_from("<I", head, 80)[0]:
+        return int(struct.unpack_from("<I", head, 80)[0])
+    return None
+
+
 def has_no_triangles(path: Path) -> bool:
     """Whether the mesh file at `path` surely holds no triangle; False when unsure."""
     suffix = path.suffix.lower()
     try:
-        if suffix == ".stl":  # a binary STL says it in its header: the rest is not read
-            with open(path, "rb") as f:
-                head, size = f.read(84), os.fstat(f.fileno()).st_size
-            if len(head) == 84 and size == 84 + 50 * struct.unpack_from("<I", head, 80)[0]:
-                return struct.unpack_from("<I", head, 80)[0] == 0  # binary: the count fits the size
+        if suffix == ".stl" and (count := binary_stl_triangles(path)) is not None:
+            return count == 0
         data = path.read_bytes()
     except OSError:
         return False

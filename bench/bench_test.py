@@ -1,5 +1,8 @@
 """Wall time of the model tests on talos (60 links) compared with itself: every test of
-`mpc test`, the model compiled beforehand (compiling is bench_meshes.py's business).
+`mpc test`, the model compiled beforehand (compiling is bench_meshes.py's business); then
+the same with the tests of issue 33 added (joint_limits, the budgets, effort_covers_gravity,
+self_collision; the definition has auto_bitmask and a named pose), run in turns with the
+first, and the ratio of the two medians (the goal: at most 1.2).
 
 Run: python bench/bench_test.py [runs]
 """
@@ -34,28 +37,64 @@ TESTS = """\
 """
 
 
+ADDED = """\
+      - joint_limits: {mirrored: [left, right]}
+      - max_mesh_faces: 50000
+      - max_mesh_bytes: 20000000
+      - max_collisions_per_link: 2
+      - effort_covers_gravity
+      - self_collision
+"""
+# A named pose (elbows and knees bent) for effort_covers_gravity and self_collision; the bitmasks make
+# self_collision test the pairs that may collide (TALOS's hands touch its thighs at q = 0).
+EXTRA = """\
+  collisions:
+    auto_bitmask: true
+  poses:
+    bent: {arm_left_4_joint: -1.0, arm_right_4_joint: -1.0, leg_left_4_joint: 0.6,
+           leg_right_4_joint: 0.6}
+"""
+
+
+def _compiled(folder: Path, name: str, erd: Path, tests: str, extra: str) -> object:
+    (folder / f"{name}.yml").write_text(
+        "model:\n  robotname: talos\n  modelname: talos-model\n  input_models:\n    base:\n"
+        f"      basefile: \"{erd / 'robots/talos_data/robots/talos_full_v2.urdf'}\"\n"
+        f"  assemble:\n    model: base\n{extra}  test:\n    compare_model:\n      path: {name}\n"
+        "    tests:\n" + tests)
+    result = compile_model(folder / f"{name}.yml", Sink(), Options(out=folder / name))
+    assert result.out is not None and result.program is not None
+    return result
+
+
 def main(runs: int = 5) -> None:
     erd = PackageResolver().find("example-robot-data")
     assert erd is not None, "example-robot-data is not installed"
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        (folder / "talos.yml").write_text(
-            "model:\n  robotname: talos\n  modelname: talos-model\n  input_models:\n    base:\n"
-            f"      basefile: \"{erd / 'robots/talos_data/robots/talos_full_v2.urdf'}\"\n"
-            "  assemble:\n    model: base\n  test:\n    compare_model:\n      path: out\n"
-            "    tests:\n" + TESTS)
-        result = compile_model(folder / "talos.yml", Sink(), Options(out=folder / "out"))
-        assert result.out is not None and result.program is not None
-        times = []
+        before = _compiled(folder, "before", erd, TESTS, EXTRA)
+        after = _compiled(folder, "after", erd, TESTS + ADDED, EXTRA)
+        times: dict[str, list[float]] = {"before": [], "after": []}
+        cpu: dict[str, list[float]] = {"before": [], "after": []}
+        counts = {}
         for i in range(runs + 1):
-            start = time.perf_counter()
-            protocol = run_model_tests(result.program, result.out, Sink(), workdir=folder / "work",
-                                       robot=result.robot)
-            if i:  # the first run imports Pinocchio and PyBullet
-                times.append(time.perf_counter() - start)
-            assert not protocol.failed, protocol.markdown()
-    print(f"mpc test talos against itself ({len(protocol.results)} tests), median of {runs}: "
-          f"{statistics.median(times) * 1000:.0f} ms (min {min(times) * 1000:.0f} ms)")
+            for name, result in (("before", before), ("after", after)):
+                start, start_cpu = time.perf_counter(), time.process_time()
+                protocol = run_model_tests(result.program, result.out, Sink(),  # type: ignore[attr-defined]
+                                           workdir=folder / "work", robot=result.robot)  # type: ignore[attr-defined]
+                if i:  # the first run imports Pinocchio, PyBullet and coal
+                    times[name].append(time.perf_counter() - start)
+                    cpu[name].append(time.process_time() - start_cpu)
+                assert not protocol.failed, protocol.markdown()
+                counts[name] = len(protocol.results)
+    for name in times:
+        print(f"mpc test talos against itself, {name} issue 33 ({counts[name]} tests), median of {runs}: "
+              f"{statistics.median(times[name]) * 1000:.0f} ms (min {min(times[name]) * 1000:.0f} ms), "
+              f"CPU {statistics.median(cpu[name]) * 1000:.0f} ms")
+    ratio = statistics.median(times["after"]) / statistics.median(times["before"])
+    ratio_cpu = statistics.median(cpu["after"]) / statistics.median(cpu["before"])
+    print(f"ratio after / before: {ratio:.3f} (min / min {min(times['after']) / min(times['before']):.3f}; "
+          f"CPU {ratio_cpu:.3f}; goal ≤ 1.2)")
 
 
 if __name__ == "__main__":

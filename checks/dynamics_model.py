@@ -92,7 +92,10 @@ class Dynamics:
                     q[m.idx_qs[j]:m.idx_qs[j] + 2] = np.cos(value), np.sin(value)
                 else:
                     q[m.idx_qs[j]] = value
-        if not self.coupled:
+        order = _leaders_first(self.mimics)
+        if not self.constraints and order is not None:  # mimic joints alone: set from their joints
+            for c in order:
+                q[m.idx_qs[c.follower]] = c.multiplier * q[m.idx_qs[c.leader]] + c.offset
             return q
         fixed = {m.idx_vs[m.getJointId(n)] for n in (self.actuated if actuated is None else actuated)
                  if m.existJointName(n) and n not in self.followers}
@@ -185,6 +188,10 @@ class Dynamics:
                  if m.existJointName(n) and m.nvs[m.getJointId(n)] == 1 and n not in self.followers}
         if not self.coupled:
             return {n: float(g[i]) for n, i in index.items()}
+        driven = {m.getJointId(n) for n in (*index, *self.actuated) if m.existJointName(n)}
+        if not self.constraints and {c.leader for c in self.mimics} <= driven \
+                and _leaders_first(self.mimics) is not None:
+            return {n: float(self._mimic_load(g, m.getJointId(n))) for n in index}
         _, J = self.residual(q)
         S = np.zeros((m.nv, len(index)))
         for k, i in enumerate(index.values()):
@@ -206,6 +213,32 @@ class Dynamics:
             raise DynamicsError(f"the actuated joints ({', '.join(index)}) do not determine their torques "
                                 f"(the mechanism is overactuated{hint})")
         return {n: float(x[k]) for k, n in enumerate(index)}
+
+    def _mimic_load(self, g: np.ndarray, joint: int) -> float:
+        """The gravity load on a joint with the loads of the joints that follow it (mimic):
+        g_j + Σ multiplier · load_follower, the principle of virtual work, recursively (a
+        follower may be followed). The closed form of the least squares below when there
+        is no loop and every followed joint is actuated (or asked for)."""
+        load = float(g[self.model.idx_vs[joint]])
+        for c in self.mimics:
+            if c.leader == joint:
+                load += c.multiplier * self._mimic_load(g, c.follower)
+        return load
+
+
+def _leaders_first(mimics: tuple[MimicCoupling, ...]) -> list[MimicCoupling] | None:
+    """The couplings ordered so that a follower that is itself followed is set first; None
+    when they make a cycle (then the general solution, Gauss-Newton, is left to judge them)."""
+    out: list[MimicCoupling] = []
+    rest = list(mimics)
+    followers = {c.follower for c in mimics}
+    while rest:
+        ready = [c for c in rest if c.leader not in followers or c.leader in {d.follower for d in out}]
+        if not ready:
+            return None
+        out += ready
+        rest = [c for c in rest if c not in ready]
+    return out
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

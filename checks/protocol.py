@@ -246,6 +246,11 @@ def first_of(problems: list[str]) -> str:
     return problems[0] + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else "")
 
 
+def counted(n: float, noun: str, plural: str = "") -> str:
+    """`1 joint`, `2 joints`: a count with its noun (plural: when it is not noun + s)."""
+    return f"{n:g} {noun if n == 1 else plural or noun + 's'}"
+
+
 def vector_text(v: object) -> str:
     """A 3-vector for a reason: (0.1, -0.2, 0.3), four significant digits."""
     return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"  # type: ignore[attr-defined]

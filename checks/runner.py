@@ -11,7 +11,18 @@ import traceback
 from collections.abc import Callable
 from pathlib import Path
 
-from mpc.checks import bullet, dynamics, masses, pictures, process, topology, validity  # noqa: F401  (registration)
+from mpc.checks import (  # noqa: F401  (registration)
+    budgets,
+    bullet,
+    dynamics,
+    limits,
+    masses,
+    pictures,
+    plausibility,
+    process,
+    topology,
+    validity,
+)
 from mpc.checks.compare_name import compare_name
 from mpc.checks.models import Model, load_built, load_compare
 from mpc.checks.pictures import VisualDiff

@@ -19,9 +19,13 @@ from mpc.ir.program import DENSITY, FACTOR, CompareTarget, ModelTest, TestPlan, 
 
 # Tests that take a pair of links [left, right] (and optionally a mirror plane).
 PAIR_TESTS = frozenset({"symmetry_check_masses", "symmetry_check", "symmetry_check_torques"})
+# Budgets: a test that fails when a figure of the model exceeds its limit (the argument, in these units).
+BUDGETS = {"max_mesh_faces": "faces", "max_mesh_bytes": "bytes",
+           "max_collisions_per_link": "collision shapes"}
 # Tests whose argument is optional: the others take none.
-_WITH_ARGUMENT = PAIR_TESTS | {"total_mass", "compare_link_positions", "move_hyrodyn_model",
-                               "physical_validity", "compare_torques"}
+_WITH_ARGUMENT = PAIR_TESTS | set(BUDGETS) | {"total_mass", "compare_link_positions", "move_hyrodyn_model",
+                                         "physical_validity", "compare_torques", "joint_limits"}
+_LIMIT_FIGURES = ("position", "velocity", "effort")
 _UNITS = ("deg", "rad")
 
 
@@ -142,7 +146,7 @@ class _TestLowering:
         what = f"test '{name}'"
         test = ModelTest(name=name, span=span, dynamics=dynamics)
         if arg is None:
-            if name in PAIR_TESTS or name == "move_hyrodyn_model":
+            if name in PAIR_TESTS or name in BUDGETS or name == "move_hyrodyn_model":
                 self.sink.error(span, "E0703", f"{what} needs an argument: {_NEEDS[name]}")
                 return None
             return test
@@ -158,6 +162,10 @@ class _TestLowering:
             return None if value is None else ModelTest(name=name, span=span, dynamics=dynamics, value=value)
         if name == "physical_validity":
             return self.validity(span, arg)
+        if name in BUDGETS:
+            return self.budget(name, span, arg)
+        if name == "joint_limits":
+            return self.joint_limits(span, arg)
         if name in ("compare_link_positions", "compare_torques"):
             links = [arg] if isinstance(arg, str) else arg
             if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
@@ -203,6 +211,50 @@ class _TestLowering:
             factor = value
         return ModelTest(name="physical_validity", span=span, as_error=severity == "error", density=density,
                          inertia_factor=factor)
+
+    def budget(self, name: str, span: Span, arg: Any) -> ModelTest | None:
+        """A budget's limit: a whole number ≥ 0 (faces, bytes, collisions), an expression allowed."""
+        value = self.number(arg, span, f"test '{name}' limit")
+        if value is None:
+            return None
+        if value < 0 or not float(value).is_integer():  # inf and nan too
+            self.sink.error(span, "E0703", f"test '{name}': the limit is a whole number of "
+                            f"{BUDGETS[name]}, at least 0, got {value:g}")
+            return None
+        return ModelTest(name=name, span=span, value=float(value))
+
+    def joint_limits(self, span: Span, arg: Any) -> ModelTest | None:
+        """joint_limits: {position, velocity, effort} (absolute bounds; each replaces the tolerance
+        it defaults to) and mirrored: [left, right] (the name parts of mirrored joints)."""
+        what = "test 'joint_limits'"
+        if not isinstance(arg, dict):
+            self.sink.error(span, "E0703", f"{what} takes a mapping {{position, velocity, effort, "
+                            f"mirrored}}, got {arg!r}")
+            return None
+        unknown = set(arg) - {*_LIMIT_FIGURES, "mirrored"}
+        if unknown:
+            self.sink.error(span, "E0703", f"{what}: unknown key '{sorted(unknown, key=str)[0]}' (it takes "
+                            "'position', 'velocity', 'effort' and 'mirrored')")
+            return None
+        bounds: dict[str, float] = {}
+        for key in _LIMIT_FIGURES:
+            if key in arg:
+                value = self.number(arg[key], span, f"{what} {key}")
+                if value is None:
+                    return None
+                if value < 0:
+                    self.sink.error(span, "E0703", f"{what}: '{key}' must not be negative, got {value:g}")
+                    return None
+                bounds[key] = value
+        mirrored = arg.get("mirrored")
+        if mirrored is not None:
+            if not (isinstance(mirrored, list) and len(mirrored) == 2 and all(
+                    isinstance(x, str) and x for x in mirrored) and mirrored[0] != mirrored[1]):
+                self.sink.error(span, "E0703", f"{what}: 'mirrored' is the two parts of the names that "
+                                f"tell mirrored joints apart, e.g. [left, right], got {mirrored!r}")
+                return None
+            mirrored = (mirrored[0], mirrored[1])
+        return ModelTest(name="joint_limits", span=span, limit_tolerances=bounds or None, mirrored=mirrored)
 
     def pair(self, test: ModelTest, arg: Any) -> ModelTest | None:
         what = f"test '{test.name}'"
@@ -253,6 +305,9 @@ _NEEDS = {
     "symmetry_check": "two link names [left, right]",
     "symmetry_check_torques": "two link names [left, right]",
     "move_hyrodyn_model": "a joint value, a list of values or a mapping {joint: value}",
+    "max_mesh_faces": "the largest number of faces of a mesh",
+    "max_mesh_bytes": "the largest total size of the mesh files in bytes",
+    "max_collisions_per_link": "the largest number of collision shapes of a link",
 }
 
 

@@ -23,7 +23,9 @@ from mpc.ir.tree import parent_joint
 BITS = 16
 
 
-def _coal_object(geometry: Geometry) -> object:
+def coal_object(geometry: Geometry, mesh: object = None) -> object:
+    """The shape as a coal collision object in its own frame (a mesh: a BVH of its triangles;
+    `mesh`: its trimesh, when the caller read it already)."""
     import coal
 
     from mpc.ir.geometry import Box, Cylinder, Sphere
@@ -35,31 +37,37 @@ def _coal_object(geometry: Geometry) -> object:
         return coal.Cylinder(geometry.radius, geometry.length)
     if isinstance(geometry, Sphere):
         return coal.Sphere(geometry.radius)
-    mesh = as_trimesh(geometry)
+    if mesh is None:
+        mesh = as_trimesh(geometry)
     model = coal.BVHModelOBBRSS()
-    model.beginModel(len(mesh.faces), len(mesh.vertices))
-    model.addVertices(np.asarray(mesh.vertices, dtype=float))
-    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))
+    model.beginModel(len(mesh.faces), len(mesh.vertices))  # type: ignore[attr-defined]
+    model.addVertices(np.asarray(mesh.vertices, dtype=float))  # type: ignore[attr-defined]
+    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))  # type: ignore[attr-defined]
     model.endModel()
     return model
 
 
-def touching(robot: Robot) -> set[frozenset[str]]:
-    """Pairs of links whose collision shapes touch or overlap at q = 0."""
+def overlap(a: object, X_a: np.ndarray, b: object, X_b: np.ndarray) -> bool:
+    """Whether two coal objects (coal_object) at the poses X_a, X_b (4×4) touch or overlap."""
     import coal
 
+    return bool(coal.collide(a, coal.Transform3s(X_a[:3, :3], X_a[:3, 3]), b,
+                             coal.Transform3s(X_b[:3, :3], X_b[:3, 3]), coal.CollisionRequest(),
+                             coal.CollisionResult()))
+
+
+def touching(robot: Robot) -> set[frozenset[str]]:
+    """Pairs of links whose collision shapes touch or overlap at q = 0."""
     shapes = []
     X_R = links_in_root(robot)
     for name, link in robot.links.items():
         for c in link.collisions:
-            X = X_R[name] @ pose_matrix(c.origin)
-            shapes.append((name, _coal_object(c.geometry), coal.Transform3s(X[:3, :3], X[:3, 3])))
+            shapes.append((name, coal_object(c.geometry), X_R[name] @ pose_matrix(c.origin)))
     out: set[frozenset[str]] = set()
-    request = coal.CollisionRequest()
     for (a, sa, ta), (b, sb, tb) in combinations(shapes, 2):
         if a == b or frozenset((a, b)) in out:
             continue
-        if coal.collide(sa, ta, sb, tb, request, coal.CollisionResult()):
+        if overlap(sa, ta, sb, tb):
             out.add(frozenset((a, b)))
     return out
 

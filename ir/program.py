@@ -398,7 +398,10 @@ class ModelTest:
     move_hyrodyn_model sets (one value for every joint, one per joint, or by joint name).
     as_error: physical_validity findings fail instead of warning. density: the range of
     plausible densities (kg/m³) and inertia_factor: how far principal moments may be from
-    the collision solid's, for physical_validity.
+    the collision solid's, for physical_validity. limit_tolerances: joint_limits's own
+    bounds by figure (`position`, `velocity`, `effort`), where given. mirrored: the two name
+    parts ("left", "right") whose swap names a joint's mirror image, for joint_limits.
+    value is also a budget's limit (max_mesh_faces, max_mesh_bytes, max_collisions_per_link).
     """
 
     name: str
@@ -413,6 +416,8 @@ class ModelTest:
     as_error: bool = False
     density: tuple[float, float] = DENSITY
     inertia_factor: float = FACTOR
+    limit_tolerances: Mapping[str, float] | None = None
+    mirrored: tuple[str, str] | None = None
 
 
 @record(slots=True, kw_only=True)

@@ -8,7 +8,8 @@ from mpc.core.diagnostics import did_you_mean
 TESTS = frozenset({
     "topological_self_consistency", "process_double_check", "file_consistency", "load_in_pybullet",
     "compare_link_masses", "compare_link_transformations", "compare_amount_joints", "total_mass",
-    "symmetry_check_masses", "hyrodynChecks", "physical_validity",
+    "symmetry_check_masses", "hyrodynChecks", "physical_validity", "joint_limits", "max_mesh_faces",
+    "max_mesh_bytes", "max_collisions_per_link", "effort_covers_gravity", "self_collision",
 })
 DYNAMICS_CHECKS = frozenset({
     "load_in_hyrodyn", "compare_masses", "compare_com", "compare_torques", "compare_link_positions",

@@ -83,3 +83,29 @@ def test_a_mimic_joint_follows_and_its_load_is_on_the_joint_it_follows(tmp_path)
     assert list(tau) == ["j"]
     assert tau["j"] == pytest.approx(expected, abs=1e-6)
     assert abs(tau["j"] - pin.computeGeneralizedGravity(dyn.model, dyn.data, q)[0]) > 1.0  # k's load counts
+
+
+def test_a_mimic_joint_that_is_followed_passes_its_load_on(tmp_path) -> None:
+    """A chain of mimics: k follows j (q_k = 2 q_j + 0.1), l follows k (q_l = -q_k); the load
+    of both is on j (a finite difference of the potential energy along the coupled motion)."""
+    chained = MIMIC_URDF.replace("</robot>", """\
+  <joint name="l" type="revolute"><origin xyz="0 0 1"/><parent link="c"/><child link="d"/>
+    <axis xyz="1 0 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+    <mimic joint="k" multiplier="-1" offset="0"/></joint>
+  <link name="d"><inertial><origin xyz="0 0.3 0.2"/><mass value="1.5"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+</robot>""")
+    (tmp_path / "g.urdf").write_text(chained)
+    robot = read(tmp_path / "g.urdf", Sink())
+    assert robot is not None
+    dyn = build(robot)
+    theta = 0.4
+    q = dyn.configuration({"j": theta})
+    np.testing.assert_allclose(q, [theta, 2 * theta + 0.1, -(2 * theta + 0.1)], atol=1e-12)
+
+    def potential(t: float) -> float:
+        return pin.computePotentialEnergy(dyn.model, dyn.data, np.array([t, 2 * t + 0.1, -(2 * t + 0.1)]))
+
+    h = 1e-6
+    expected = (potential(theta + h) - potential(theta - h)) / (2 * h)
+    assert dyn.gravity_torques(q)["j"] == pytest.approx(expected, abs=1e-6)
