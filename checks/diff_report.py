@@ -14,7 +14,7 @@ from mpc.ir.program import Tolerances
 _QUOTED = re.compile(r"'([^'\n]*)'")
 
 
-def _code(text: str) -> str:
+def code_spans(text: str) -> str:
     """Names quoted 'so' in the text → `so` (Markdown code)."""
     return _QUOTED.sub(r"`\1`", text)
 
@@ -42,7 +42,7 @@ def markdown(d: Diff, old: str, new: str, tol: Tolerances,
     relative to where the Markdown is read."""
     lines = [f"## {title}: `{old}` → `{new}`", "",
              f"**{summary(d)}** beyond the tolerances ({tolerances_text(tol)}).", ""]
-    lines += [f"- {_code(c.text)}" for c in d.changes]
+    lines += [f"- {code_spans(c.text)}" for c in d.changes]
     if d.changes:
         lines.append("")
     if pictures:

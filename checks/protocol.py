@@ -91,6 +91,9 @@ class Protocol:
     compare: str = ""  # what the model was compared with (repository @ commit, or folder)
     waiver: str = ""  # why failures are waived, when they are
     pictures: VisualDiff | None = None  # the visual diff against the compare model
+    # the model diff against the compare model (checks/diff_models.py): each change beyond the
+    # tolerances, in the diff's words; None when there was nothing to compare with
+    changes: tuple[str, ...] | None = None
 
     def add(self, result: Result) -> None:
         """Record `result`; a repeated name gets a suffix; a failure becomes a waiver when
@@ -124,6 +127,14 @@ class Protocol:
         lines = [f"## Model tests of `{self.model}`: {verdict_line} ({self.summary()})", ""]
         if self.compare:
             lines += [f"Compared with {self.compare}.", ""]
+        if self.changes is not None:
+            n = len(self.changes)
+            lines += [f"**{n} change{'s' * (n != 1)}** beyond the tolerances (`mpc diff`)"
+                      + (":" if n else "."), ""]
+            if n:
+                from mpc.checks.diff_report import code_spans
+
+                lines += [*(f"- {code_spans(c)}" for c in self.changes), ""]
         if self.waiver:
             lines += [f"Failures are waived: {self.waiver}.", ""]
         lines += ["| test | result | figure | tolerance | reason |", "|---|---|---|---|---|"]
@@ -176,6 +187,7 @@ class Protocol:
         return {
             "model": self.model, "failed": self.failed, "counts": self.counts(),
             "compare": self.compare, "waiver": self.waiver, "pictures": pictures,
+            "changes": None if self.changes is None else list(self.changes),
             "tests": [{"name": r.name, "status": r.status, "reason": r.reason, "figure": r.figure,
                        "unit": r.unit, "tolerances": [{"name": t.name, "value": t.value, "unit": t.unit,
                                                        "kind": "absolute"} for t in r.tolerances],

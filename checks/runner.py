@@ -81,8 +81,19 @@ def run_model_tests(program: Program, built: Path, sink: Sink, *, workdir: Path,
     for test in tests:
         protocol.add(_run(ctx, test))
     if ctx.old is not None and ctx.new is not None:
+        protocol.changes = _changes(ctx)
         protocol.pictures = _pictures(ctx)
     return protocol
+
+
+def _changes(ctx: Context) -> tuple[str, ...]:
+    """What `mpc diff` says changed since the compare model; a bug in it is one change."""
+    try:
+        from mpc.checks.diff_models import diff
+
+        return tuple(c.text for c in diff(ctx.compare.robot, ctx.built.robot, ctx.tol).changes)
+    except Exception as e:
+        return (f"the diff could not be made: {_bug(e)}",)
 
 
 def _pictures(ctx: Context) -> VisualDiff:

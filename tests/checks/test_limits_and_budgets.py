@@ -43,6 +43,15 @@ def test_the_unchanged_model_passes_joint_limits(tmp_path: Path) -> None:
     protocol = _tested(tmp_path, ARM, "      - joint_limits\n", release=ARM)
     limits = result(protocol, "joint_limits")
     assert (limits.status, limits.reason) == ("passed", "the limits of 2 movable joints agree")
+    assert protocol.changes == () and "**0 changes** beyond the tolerances (`mpc diff`).\n" in protocol.markdown()
+
+
+def test_the_protocol_starts_with_the_diff_against_the_release(tmp_path: Path) -> None:
+    narrowed = ARM.replace('lower="-2.5" upper="2.5"', 'lower="-1.0" upper="1.0"')
+    markdown = _tested(tmp_path, narrowed, "      - joint_limits\n", release=ARM).markdown()
+    head = markdown.split("| test |")[0]
+    assert head.endswith("**1 change** beyond the tolerances (`mpc diff`):\n\n"
+                         "- joint `shoulder`: limit lower -2.5 → -1, upper 2.5 → 1\n\n"), head
 
 
 def test_velocity_and_effort_are_compared_with_their_tolerances(tmp_path: Path) -> None:
