@@ -44,7 +44,7 @@ class Model:
 
 
 def read_model(path: Path, sink: Sink) -> Robot | None:
-    """A URDF, SDF or SMURF file (by its suffix) → a robot; diagnostics go to `sink`.
+    """A URDF, SDF, SMURF or MJCF file (by its suffix) → a robot; diagnostics go to `sink`.
 
     A SMURF (Phobos names one as compare model) is read with its annotations: cut joints,
     motors and submechanisms take part in the dynamics tests."""
@@ -56,6 +56,10 @@ def read_model(path: Path, sink: Sink) -> Robot | None:
         from mpc.backends.smurf_reader import read as read_smurf
 
         return read_smurf(path, sink)
+    if path.suffix.lower() in (".xml", ".mjcf"):
+        from mpc.backends.mjcf_reader import read as read_mjcf
+
+        return read_mjcf(path, sink)
     from mpc.backends.urdf_reader import read as read_urdf
 
     return read_urdf(path, sink)
