@@ -237,9 +237,9 @@ class _Builder:
         floating = len(top) == 1 and [m.jnt_type[j] for j in joints_of[top[0]]] == [_FREE]
         root = self.body_names[top[0]] if floating else "world"
         self.shift[0] = np.eye(4)
-        if floating:
-            self.unheld["worldbody element"] += m.body_geomnum[0] + sum(
-                1 for s in range(m.nsite) if m.site_bodyid[s] == 0)
+        if floating:  # the world body holds the scene (a floor), not the robot
+            self.unheld["worldbody geom"] += int(m.body_geomnum[0])
+            self.unheld["worldbody site"] += sum(1 for s in range(m.nsite) if m.site_bodyid[s] == 0)
         for b in range(0 if not floating else 1, m.nbody):
             self.body(b, joints_of[b], root_body=floating and b == top[0])
         self.sites(skip_world=floating)
@@ -344,6 +344,7 @@ class _Builder:
                                for n, (s, Xs) in zip(names, shapes, strict=True)]
             if not collides or m.geom_group[g] != COLLISION_GROUP:
                 material = self.material(g)
+                names = [f"{n}_visual" for n in names] if collides else names  # MJCF names are unique
                 visuals += [Visual(geometry=s, origin=_pose(Xs), name=n, material=material)
                             for n, (s, Xs) in zip(names, shapes, strict=True)]
         self.links[link.name] = Link(name=link.name, inertial=link.inertial, visuals=tuple(visuals),
@@ -368,11 +369,22 @@ class _Builder:
             return None
         uri, path = self.files.mesh_paths[name]
         source = mesh_source(self.files.resolver, uri, self.files.base_dir)
-        # MuJoCo moves a mesh's vertices to its centre of mass and principal axes (mesh_pos,
-        # mesh_quat); the file's frame is that much away from the geom's.
-        X_file = X @ tf.inverse(_X(m.mesh_pos[mesh], m.mesh_quat[mesh]))
-        scale = _vec(m.mesh_scale[mesh])
-        return [(Mesh(source=source, scale=None if scale == (1.0, 1.0, 1.0) else scale), X_file)]
+        # MuJoCo takes a file's vertex v to s ⊙ (Rᵀ (v − refpos)) (R: refquat), then moves it to
+        # the mesh's centre of mass and principal axes (mesh_pos, mesh_quat). In the IR the scale
+        # acts in the file's frame: s is permuted to it when R permutes the axes (else unheld).
+        spec_mesh = self.spec.mesh(name)
+        R = _quat_matrix(np.asarray(spec_mesh.refquat, dtype=float))
+        scale = np.asarray(m.mesh_scale[mesh], dtype=float)
+        in_file = R @ np.diag(scale) @ R.T
+        if not np.allclose(in_file, np.diag(np.diag(in_file)), rtol=0, atol=1e-12):
+            self.unheld["mesh scaled along axes its refquat turns"] += 1
+            return None
+        X_ref = np.eye(4)
+        X_ref[:3, :3] = R.T
+        X_ref[:3, 3] = -scale * (R.T @ np.asarray(spec_mesh.refpos, dtype=float))
+        X_file = X @ tf.inverse(_X(m.mesh_pos[mesh], m.mesh_quat[mesh])) @ X_ref
+        file_scale = _vec(scale[np.argmax(np.abs(R), axis=1)])  # exactly the numbers written
+        return [(Mesh(source=source, scale=None if file_scale == (1.0, 1.0, 1.0) else file_scale), X_file)]
 
     def material(self, g: int) -> str | None:
         m = self.m
