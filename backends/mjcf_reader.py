@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -102,10 +103,14 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
         return None
     spec.assets = files.assets
     try:
-        model = spec.compile()
+        with warnings.catch_warnings(record=True) as warned:
+            warnings.simplefilter("always")
+            model = spec.compile()
     except ValueError as e:
         files.mujoco_error(str(e))
         return None
+    for w in warned:  # MuJoCo's warnings (a deprecated attribute): said, not printed
+        sink.warning(src.span(src.root), "W0441", f"MuJoCo warns about '{src.file}': {w.message}")
     robot = _Builder(spec, model, files).robot()
     return None if sink.error_count > errors_before else robot
 
@@ -295,13 +300,12 @@ class _Builder:
     def joint(self, j: int, name: str, parent: str, child: str, X: np.ndarray) -> Joint:
         m = self.m
         hinge, limited = m.jnt_type[j] == _HINGE, bool(m.jnt_limited[j])
-        if m.qpos0[m.jnt_qposadr[j]] != 0.0:
-            self.unheld["joint reference position (ref)"] += 1
+        ref = float(m.qpos0[m.jnt_qposadr[j]])  # `ref`: the IR's zero is the pose the file draws
         effort = float(np.max(np.abs(m.jnt_actfrcrange[j]))) if m.jnt_actfrclimited[j] else 0.0
         if hinge and not limited:
             jtype, limit = "continuous", Limit(effort=effort, velocity=0.0)
         else:
-            lower, upper = (float(m.jnt_range[j][0]), float(m.jnt_range[j][1])) if limited \
+            lower, upper = (float(m.jnt_range[j][0]) - ref, float(m.jnt_range[j][1]) - ref) if limited \
                 else (-UNBOUNDED, UNBOUNDED)
             jtype, limit = ("revolute" if hinge else "prismatic"), Limit(lower=lower, upper=upper,
                                                                           effort=effort, velocity=0.0)
@@ -469,7 +473,8 @@ class _Builder:
         m, out = self.m, {}
         for k in range(m.nkey):
             name = m.key(k).name or f"key{k}"
-            out[name] = {jname: float(m.key_qpos[k][m.jnt_qposadr[j]]) for j, jname in self.ir_joint.items()}
+            out[name] = {jname: float(m.key_qpos[k][m.jnt_qposadr[j]] - m.qpos0[m.jnt_qposadr[j]])
+                         for j, jname in self.ir_joint.items()}
         return out
 
     def unheld_text(self) -> str:

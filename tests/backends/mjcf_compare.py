@@ -45,11 +45,16 @@ def configurations(m: mujoco.MjModel, n: int, seed: int = 7) -> list[dict[str, f
     for _ in range(n):
         q = {}
         for j in movable(m):
-            low, high = m.jnt_range[j] if m.jnt_limited[j] else ((-np.pi, np.pi) if m.jnt_type[j] == HINGE
+            low, high = m.jnt_range[j] - m.qpos0[m.jnt_qposadr[j]] if m.jnt_limited[j] else ((-np.pi, np.pi) if m.jnt_type[j] == HINGE
                                                                else (-1.0, 1.0))
             q[_joint_name(m, j)] = float(rng.uniform(low, high))
         out.append(q)
     return out
+
+
+def _range(m: mujoco.MjModel, j: int) -> np.ndarray:
+    """The joint's range from its `ref` (the IR's zero; most joints have ref 0)."""
+    return m.jnt_range[j] - m.qpos0[m.jnt_qposadr[j]]
 
 
 def _root(m: mujoco.MjModel) -> int:
@@ -63,7 +68,7 @@ def original_poses(m: mujoco.MjModel, q: dict[str, float]) -> dict[str, np.ndarr
     d = mujoco.MjData(m)
     d.qpos[:] = m.qpos0
     for j in movable(m):
-        d.qpos[m.jnt_qposadr[j]] = q[_joint_name(m, j)]
+        d.qpos[m.jnt_qposadr[j]] += q[_joint_name(m, j)]  # the IR's zero is MuJoCo's ref (qpos0)
     mujoco.mj_kinematics(m, d)
     out = {}
     for b in range(m.nbody):
@@ -91,7 +96,7 @@ def assert_urdf_matches(original: mujoco.MjModel, urdf: Path, n_random: int = 10
         if original.jnt_limited[j]:
             i = model.idx_qs[jid]
             np.testing.assert_allclose([model.lowerPositionLimit[i], model.upperPositionLimit[i]],
-                                       original.jnt_range[j], atol=tol, rtol=0)
+                                       _range(original, j), atol=tol, rtol=0)
     for q in configurations(original, n_random):
         x = pin.neutral(model)
         for name, value in q.items():
@@ -119,7 +124,7 @@ def assert_mjcf_matches(original: mujoco.MjModel, xml: Path, n_random: int = 10,
         k = mujoco.mj_name2id(out, mujoco.mjtObj.mjOBJ_JOINT, _joint_name(original, j))
         assert k >= 0, _joint_name(original, j)
         if original.jnt_limited[j]:
-            np.testing.assert_allclose(out.jnt_range[k], original.jnt_range[j], atol=tol, rtol=0)
+            np.testing.assert_allclose(out.jnt_range[k], _range(original, j), atol=tol, rtol=0)
     root_name = _name(original, _root(original))
     for q in configurations(original, n_random):
         d.qpos[:] = out.qpos0
