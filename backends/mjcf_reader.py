@@ -48,7 +48,7 @@ from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint, Motor
-from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, Sphere, mesh_source
+from mpc.ir.geometry import Box, Cylinder, Geometry, Mesh, MeshSource, Sphere
 from mpc.ir.kinematics import matrix_pose
 from mpc.ir.robot import (
     Collision,
@@ -84,6 +84,10 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     src = load(path, sink, "MJCF")
     if src is None:
         return None
+    if src.root.tag == "robot" and path.suffix.lower() == ".xml":  # a URDF named .xml, as before
+        from mpc.backends import urdf_reader
+
+        return urdf_reader.read(path, sink, resolver)
     if src.root.tag != "mujoco":
         sink.error(src.span(src.root), "E0402", f"'{src.file}' is not an MJCF: its root element is "
                    f"<{src.root.tag}>, not <mujoco>")
@@ -171,13 +175,28 @@ class _Files:
             path = self.base_dir / uri
             span = self.span_of("mesh", file=mesh.file)
             if why := self.resolver.refusal(path, self.base_dir):
-                self.sink.error(span, "E0650", f"mesh '{mesh.file}' of <mesh> '{mesh.name}' is not read: {why}")
+                self.sink.error(span, "E0650",
+                                f"mesh '{mesh.file}' of <mesh> '{mesh.name}' is not read: {why}")
                 continue
             if not path.is_file():
-                self.sink.error(span, "E0602", f"mesh file '{path}' of <mesh> '{mesh.name}' {why_absent(path)}")
+                self.sink.error(span, "E0602",
+                                f"mesh file '{path}' of <mesh> '{mesh.name}' {why_absent(path)}")
                 continue
-            self.assets[os.path.join(spec.modelfiledir, uri)] = path.read_bytes()
-            self.mesh_paths[mesh.name] = (uri, path)
+            data = path.read_bytes()
+            self.assets[os.path.join(spec.modelfiledir, uri)] = data
+            if path.suffix.lower() == ".msh":  # MuJoCo's own mesh format: its STL, in the cache
+                try:
+                    converted = msh_as_stl(data)
+                except OSError as e:
+                    self.sink.error(span, "E0652", f"the mesh cache cannot keep the STL of '{path}': {e}")
+                    continue
+                if converted is None:
+                    self.sink.error(span, "E0440", f"MuJoCo refuses '{self.src.file}': mesh file '{path}' "
+                                    "is not a .msh file (its sizes do not match its header)")
+                    continue
+                self.mesh_paths[mesh.name] = (uri[:-4] + ".stl", converted)
+            else:
+                self.mesh_paths[mesh.name] = (uri, path)
 
     def mujoco_error(self, text: str) -> None:
         """MuJoCo's error, at the element it names: its line in the main file (MuJoCo gives no
@@ -195,6 +214,39 @@ class _Files:
             else:
                 span = Span(self.src.file, line, 1)
         self.sink.error(span, "E0440", f"MuJoCo refuses '{self.src.file}': {message}")
+
+
+def msh_as_stl(data: bytes) -> Path | None:
+    """The binary STL of a MuJoCo `.msh` file (4 int32 counts: vertices, normals, texture
+    coordinates, faces; then float32 positions, normals, coordinates and int32 faces), kept in
+    the cache under its content's hash; None when the sizes do not match the header."""
+    import hashlib
+
+    from mpc.core.cache import cache_dir, load_entry, store_entry
+
+    if len(data) < 16:
+        return None
+    nv, nn, nt, nf = np.frombuffer(data[:16], dtype="<i4")
+    if min(nv, nn, nt, nf) < 0 or len(data) != 16 + 4 * (3 * nv + 3 * nn + 2 * nt + 3 * nf):
+        return None
+    entry = cache_dir("msh") / f"{hashlib.sha256(data).hexdigest()}.stl"
+    if load_entry(entry)[0] is not None:
+        return entry
+    vertices = np.frombuffer(data, dtype="<f4", count=3 * nv, offset=16).reshape(-1, 3)
+    faces = np.frombuffer(data, dtype="<i4", count=3 * nf, offset=16 + 4 * (3 * nv + 3 * nn + 2 * nt))
+    faces = faces.reshape(-1, 3)
+    if faces.size and (faces.min() < 0 or faces.max() >= nv):
+        return None
+    triangles = vertices[faces]
+    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
+    record = np.zeros(len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    record["n"], record["v"] = normals, triangles
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    store_entry(entry, b"mpc: from a MuJoCo .msh".ljust(80, b" ") + np.uint32(len(faces)).tobytes()
+                + record.tobytes())
+    return entry
 
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
@@ -310,7 +362,8 @@ class _Builder:
             jtype, limit = ("revolute" if hinge else "prismatic"), Limit(lower=lower, upper=upper,
                                                                           effort=effort, velocity=0.0)
         dof = m.jnt_dofadr[j]
-        damping, friction, armature = (float(a[dof]) for a in (m.dof_damping, m.dof_frictionloss, m.dof_armature))
+        damping, friction, armature = (float(a[dof])
+                                       for a in (m.dof_damping, m.dof_frictionloss, m.dof_armature))
         dynamics = Dynamics(damping=damping, friction=friction) if damping or friction else None
         return Joint(name=name, type=jtype, parent=parent, child=child, origin=_pose(X),  # type: ignore[arg-type]
                      axis=_vec(m.jnt_axis[j]), limit=limit, dynamics=dynamics,
@@ -372,7 +425,7 @@ class _Builder:
             self.unheld["mesh without a file"] += 1
             return None
         uri, path = self.files.mesh_paths[name]
-        source = mesh_source(self.files.resolver, uri, self.files.base_dir)
+        source = MeshSource(uri=uri, path=path)  # a .msh file's: its STL in the cache
         # MuJoCo takes a file's vertex v to s ⊙ (Rᵀ (v − refpos)) (R: refquat), then moves it to
         # the mesh's centre of mass and principal axes (mesh_pos, mesh_quat). In the IR the scale
         # acts in the file's frame: s is permuted to it when R permutes the axes (else unheld).

@@ -45,8 +45,10 @@ def configurations(m: mujoco.MjModel, n: int, seed: int = 7) -> list[dict[str, f
     for _ in range(n):
         q = {}
         for j in movable(m):
-            low, high = m.jnt_range[j] - m.qpos0[m.jnt_qposadr[j]] if m.jnt_limited[j] else ((-np.pi, np.pi) if m.jnt_type[j] == HINGE
-                                                               else (-1.0, 1.0))
+            if m.jnt_limited[j]:
+                low, high = _range(m, j)
+            else:
+                low, high = (-np.pi, np.pi) if m.jnt_type[j] == HINGE else (-1.0, 1.0)
             q[_joint_name(m, j)] = float(rng.uniform(low, high))
         out.append(q)
     return out
@@ -108,11 +110,12 @@ def assert_urdf_matches(original: mujoco.MjModel, urdf: Path, n_random: int = 10
                 x[i] = value
         pin.framesForwardKinematics(model, data, x)
         expected = original_poses(original, q)
-        root = np.linalg.inv(data.oMf[model.getFrameId(_name(original, _root(original)))].homogeneous)
+        body = pin.FrameType.BODY  # a joint may have its body's name (MuJoCo's namespaces are apart)
+        root = np.linalg.inv(data.oMf[model.getFrameId(_name(original, _root(original)), body)].homogeneous)
         for name, X in expected.items():
             if name == "world" and floating:
                 continue
-            got = root @ data.oMf[model.getFrameId(name)].homogeneous
+            got = root @ data.oMf[model.getFrameId(name, body)].homogeneous
             np.testing.assert_allclose(got, X, atol=tol, rtol=0, err_msg=name)
 
 

@@ -15,6 +15,7 @@ from mpc.backends import mjcf_reader
 from mpc.compiler.driver import Options, compile_model
 from mpc.core.diagnostics import Severity
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
+from mpc.ir.robot import Robot
 from tests.backends.mjcf_compare import assert_mjcf_matches, assert_urdf_matches
 from tests.conftest import Diags, write
 
@@ -51,7 +52,7 @@ ARM = """
 """
 
 
-def _read(path: Path, diags: Diags):  # noqa: ANN202
+def _read(path: Path, diags: Diags) -> Robot | None:
     return mjcf_reader.read(path, diags)
 
 
@@ -143,7 +144,8 @@ def test_a_free_joint_makes_a_floating_root(tmp_path: Path, diags: Diags) -> Non
     </mujoco>"""
     robot = _read(write(tmp_path / "f.xml", xml), diags)
     w = diags.take("W0440", Severity.WARNING)
-    assert w.message == f"'{tmp_path / 'f.xml'}' holds what mpc's robot model cannot: worldbody geom ×1; left out"
+    assert w.message == (f"'{tmp_path / 'f.xml'}' holds what mpc's robot model cannot: "
+                         "worldbody geom ×1; left out")
     assert robot.root == "torso" and "world" not in robot.links
     out = _compile(tmp_path, xml, diags, name="f.xml")
     diags.take("W0440", Severity.WARNING)
@@ -166,13 +168,20 @@ def test_several_joints_in_one_body_become_a_chain(tmp_path: Path, diags: Diags)
     robot = _read(write(tmp_path / "c.xml", xml), diags)
     assert [(j.parent, j.child) for j in robot.joints.values()] == [
         ("world", "a__x"), ("a__x", "a__y"), ("a__y", "a")]
-    out = _compile(tmp_path, xml, diags, exports=("urdf",), name="c.xml")
-    assert_urdf_matches(mujoco.MjModel.from_xml_path(str(tmp_path / "c.xml")), out / "urdf" / "r.urdf")
+    out = _compile(tmp_path, xml, diags, name="c.xml")
+    diags.take("W0500", Severity.WARNING)  # MJCF has no velocity limits
+    original = mujoco.MjModel.from_xml_path(str(tmp_path / "c.xml"))
+    assert_urdf_matches(original, out / "urdf" / "r.urdf")
+    # MuJoCo refuses a moving body without mass: the chain's joints go back into one body
+    assert_mjcf_matches(original, out / "mjcf" / "r.xml")
+    written = mujoco.MjModel.from_xml_path(str(out / "mjcf" / "r.xml"))
+    assert [written.body(b).name for b in range(written.nbody)] == ["world", "a"]
 
 
 def test_meshes_keep_their_files_scale_and_refpos(tmp_path: Path, diags: Diags) -> None:
     (tmp_path / "assets").mkdir()
-    trimesh.creation.box((0.1, 0.2, 0.3)).apply_translation((0.05, 0.0, 0.0)).export(tmp_path / "assets" / "part.stl")
+    box = trimesh.creation.box((0.1, 0.2, 0.3)).apply_translation((0.05, 0.0, 0.0))
+    box.export(tmp_path / "assets" / "part.stl")
     xml = """
     <mujoco model="m">
       <compiler meshdir="assets"/>
@@ -217,7 +226,8 @@ def test_what_the_ir_cannot_hold_is_one_warning(tmp_path: Path, diags: Diags) ->
         <mujoco model="w">
           <worldbody><body name="a"><joint name="j" type="ball"/><geom type="ellipsoid" size="0.1 0.2 0.3"/>
             <site name="s"/></body>
-            <body name="b" pos="1 0 0"><joint name="k"/><geom type="sphere" size="0.1"/><site name="t"/></body>
+            <body name="b" pos="1 0 0"><joint name="k"/><geom type="sphere" size="0.1"/>
+              <site name="t"/></body>
           </worldbody>
           <tendon><spatial name="t1"><site site="s"/><site site="t"/></spatial></tendon>
           <sensor><jointpos joint="k"/><touch site="s"/></sensor>
@@ -235,10 +245,13 @@ def test_connect_and_weld_become_loop_closures(tmp_path: Path, diags: Diags) -> 
     robot = _read(write(tmp_path / "l.xml", """
         <mujoco model="l">
           <worldbody>
-            <body name="a"><joint name="ja" axis="0 1 0"/><geom type="capsule" size="0.02" fromto="0 0 0 1 0 0"/></body>
-            <body name="b" pos="2 0 0"><joint name="jb" axis="0 1 0"/><geom type="capsule" size="0.02" fromto="0 0 0 -1 0 0"/></body>
+            <body name="a"><joint name="ja" axis="0 1 0"/>
+              <geom type="capsule" size="0.02" fromto="0 0 0 1 0 0"/></body>
+            <body name="b" pos="2 0 0"><joint name="jb" axis="0 1 0"/>
+              <geom type="capsule" size="0.02" fromto="0 0 0 -1 0 0"/></body>
           </worldbody>
-          <equality><connect name="c" body1="a" body2="b" anchor="1 0 0"/><weld name="w" body1="a" body2="b"/></equality>
+          <equality><connect name="c" body1="a" body2="b" anchor="1 0 0"/>
+            <weld name="w" body1="a" body2="b"/></equality>
         </mujoco>"""), diags)
     c, w = robot.cut_joints["c"], robot.cut_joints["w"]
     assert (c.type, c.parent, c.child, w.type) == ("ball", "a", "b", "fixed")
@@ -264,9 +277,15 @@ def test_mujoco_errors_point_at_file_line_and_column(tmp_path: Path, diags: Diag
 def test_malformed_xml_and_wrong_root(tmp_path: Path, diags: Diags) -> None:
     assert _read(write(tmp_path / "m.xml", "<mujoco><worldbody></mujoco>"), diags) is None
     assert diags.take_error("E0401").span.line == 1
-    path = write(tmp_path / "n.xml", "<robot name='x'/>")
+    path = write(tmp_path / "n.xml", "<sdf version='1.9'/>")
     assert _read(path, diags) is None
-    assert diags.take_error("E0402").message == f"'{path}' is not an MJCF: its root element is <robot>, not <mujoco>"
+    assert diags.take_error("E0402").message == (
+        f"'{path}' is not an MJCF: its root element is <sdf>, not <mujoco>")
+
+
+def test_a_urdf_named_xml_is_read_as_urdf(tmp_path: Path, diags: Diags) -> None:
+    robot = _read(write(tmp_path / "r.xml", "<robot name='r'><link name='a'/></robot>"), diags)
+    assert robot is not None and list(robot.links) == ["a"]
 
 
 def test_an_include_or_mesh_outside_the_project_is_refused(tmp_path: Path, diags: Diags) -> None:
@@ -290,4 +309,5 @@ def test_an_include_or_mesh_outside_the_project_is_refused(tmp_path: Path, diags
         <mujoco><asset><mesh name="m" file="{outside / 'm.stl'}"/></asset>
           <worldbody><body name="a"><geom type="mesh" mesh="m"/></body></worldbody></mujoco>""")
     assert mjcf_reader.read(path, diags, resolver) is None
-    assert diags.take_error("E0650").message.startswith(f"mesh '{outside / 'm.stl'}' of <mesh> 'm' is not read: ")
+    assert diags.take_error("E0650").message.startswith(
+        f"mesh '{outside / 'm.stl'}' of <mesh> 'm' is not read: ")
