@@ -14,8 +14,9 @@ What maps to what (specs/definition.md, "MJCF input models"):
   off the body's origin, as a URDF joint sits at its child's origin); a body with no joint
   → a fixed joint `<body>_fixed`; hinge → revolute (limited) or continuous, slide →
   prismatic; several joints in one body → a chain through massless links `<body>__<joint>`;
-  a free joint on the only top body → the robot's floating root; on one of several top
-  bodies → a `floating` joint from a root link `world` (MuJoCo's world body);
+  the only body under `<worldbody>`, when it has no joint or a free joint, is the robot's
+  root (fixed or floating, as a URDF's root is); a free joint on one of several top bodies
+  → a `floating` joint from a root link `world` (MuJoCo's world body);
 - geoms → visuals and collisions: a geom that collides (contype or conaffinity not 0) is a
   collision, and also a visual unless it is in group 3 (Menagerie's collision group); one
   that never collides is a visual; a capsule becomes a cylinder and two spheres;
@@ -106,17 +107,32 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     if sink.error_count > errors_before:
         return None
     spec.assets = files.assets
+    said: list[str] = []
     try:
-        with warnings.catch_warnings(record=True) as warned:
-            warnings.simplefilter("always")
-            model = spec.compile()
+        model = _compile(spec, said)
     except ValueError as e:
         files.mujoco_error(str(e))
         return None
-    for w in warned:  # MuJoCo's warnings (a deprecated attribute): said, not printed
-        sink.warning(src.span(src.root), "W0441", f"MuJoCo warns about '{src.file}': {w.message}")
+    for message in dict.fromkeys(said):  # MuJoCo's warnings (a deprecated attribute): said once
+        sink.warning(src.span(src.root), "W0441", f"MuJoCo warns about '{src.file}': {message}")
     robot = _Builder(spec, model, files).robot()
     return None if sink.error_count > errors_before else robot
+
+
+def _compile(spec: Any, said: list[str]) -> Any:
+    """The compiled model; MuJoCo's warnings go to `said`, not to stderr nor to the
+    MUJOCO_LOG.TXT that MuJoCo would write into the working folder."""
+    import mujoco
+
+    before = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: said.append(str(message).strip()))
+    try:
+        with warnings.catch_warnings(record=True) as warned:
+            warnings.simplefilter("always")
+            return spec.compile()
+    finally:
+        mujoco.set_mju_user_warning(before)
+        said += [str(w.message).strip() for w in warned]
 
 
 @dataclass
@@ -291,7 +307,8 @@ class _Builder:
         m = self.m
         top = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
         joints_of = {b: [j for j in range(m.njnt) if m.jnt_bodyid[j] == b] for b in range(m.nbody)}
-        floating = len(top) == 1 and [m.jnt_type[j] for j in joints_of[top[0]]] == [_FREE]
+        # One top body, welded or free, is the root, as a URDF's; else the world body is.
+        floating = len(top) == 1 and [m.jnt_type[j] for j in joints_of[top[0]]] in ([_FREE], [])
         root = self.body_names[top[0]] if floating else "world"
         self.shift[0] = np.eye(4)
         if floating:  # the world body holds the scene (a floor), not the robot

@@ -61,7 +61,8 @@ def _range(m: mujoco.MjModel, j: int) -> np.ndarray:
 
 def _root(m: mujoco.MjModel) -> int:
     top = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
-    floating = len(top) == 1 and [m.jnt_type[j] for j in range(m.njnt) if m.jnt_bodyid[j] == top[0]] == [FREE]
+    joints = [m.jnt_type[j] for j in range(m.njnt) if m.jnt_bodyid[j] == top[0]] if len(top) == 1 else None
+    floating = joints in ([FREE], [])
     return top[0] if floating else 0
 
 

@@ -107,7 +107,7 @@ ROBOTS = {
     "dm_control/mjcf/test_assets/robot_arm.xml":
         "camera ×1, contact exclusion ×4, sensor ×9",
     "dm_control/mujoco/testing/assets/arm.xml":
-        "contact exclusion ×4, plane ×1",
+        "contact exclusion ×4, worldbody geom ×1",
     "dm_control/mujoco/testing/assets/cartpole.xml":
         "camera ×3, custom numeric ×2, plane ×1, sensor ×2",
     "dm_control/mujoco/testing/assets/cartpole_no_names.xml":
@@ -192,13 +192,16 @@ def _robots() -> list[str]:
     return found
 
 
-def test_the_list_is_complete() -> None:
+def test_the_list_is_complete(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)  # MuJoCo's warnings go to MUJOCO_LOG.TXT in the working folder
     assert _robots() == list(ROBOTS)
 
 
 @pytest.mark.long
 @pytest.mark.parametrize("robot", list(ROBOTS))
-def test_pypi_robot_is_physically_equal(robot: str, tmp_path: Path, diags: Diags) -> None:
+def test_pypi_robot_is_physically_equal(robot: str, tmp_path: Path, diags: Diags,
+                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)  # MuJoCo's warnings go to MUJOCO_LOG.TXT in the working folder
     package, rest = robot.split("/", 1)
     xml = _package_root(package) / rest
     unheld = ROBOTS[robot]

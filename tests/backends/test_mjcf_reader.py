@@ -78,8 +78,8 @@ def _compile(tmp_path: Path, xml: str, diags: Diags, exports: tuple[str, ...] = 
 
 def test_bodies_joints_and_frames(tmp_path: Path, diags: Diags) -> None:
     robot = _read(write(tmp_path / "arm.xml", ARM), diags)
-    assert robot is not None and robot.root == "world"
-    assert set(robot.links) == {"world", "base", "l1", "l2", "l3", "tip"}
+    assert robot is not None and robot.root == "base"  # the one top body: the root, as in URDF
+    assert set(robot.links) == {"base", "l1", "l2", "l3", "tip"}
     j1 = robot.joints["j1"]
     assert (j1.type, j1.parent, j1.child, j1.axis) == ("revolute", "base", "l1", (0.0, 0.0, 1.0))
     # degrees → radians, as MuJoCo compiles them; the joint frame at its anchor (pos)
@@ -90,7 +90,6 @@ def test_bodies_joints_and_frames(tmp_path: Path, diags: Diags) -> None:
     j2 = robot.joints["j2"]
     assert (j2.type, j2.limit.lower, j2.limit.upper, j2.dynamics.friction) == ("prismatic", -0.1, 0.1, 0.2)
     assert robot.joints["j3"].type == "continuous"
-    assert robot.joints["base_fixed"].type == "fixed"
     assert (robot.joints["tip_fixed"].parent, robot.joints["tip_fixed"].type) == ("l1", "fixed")
 
 
@@ -311,3 +310,19 @@ def test_an_include_or_mesh_outside_the_project_is_refused(tmp_path: Path, diags
     assert mjcf_reader.read(path, diags, resolver) is None
     assert diags.take_error("E0650").message.startswith(
         f"mesh '{outside / 'm.stl'}' of <mesh> 'm' is not read: ")
+
+
+def test_mujocos_warnings_are_diagnostics_not_a_log_file(tmp_path: Path, diags: Diags,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    path = write(tmp_path / "t.xml", """
+        <mujoco><compiler settotalmass="5"/>
+          <worldbody><body name="a"><joint name="j"/><geom type="sphere" size="0.1"/></body></worldbody>
+        </mujoco>""")
+    robot = _read(path, diags)
+    w = diags.take("W0441", Severity.WARNING)
+    assert w.message == (f"MuJoCo warns about '{path}': compiler attribute 'settotalmass' is deprecated and "
+                         "will be removed in a future release: scale the masses and densities in the model, "
+                         "or call mj_setTotalmass and mj_setConst on the compiled model")
+    assert robot is not None and robot.links["a"].inertial.mass == pytest.approx(5.0, abs=1e-12)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
