@@ -326,3 +326,51 @@ def test_mujocos_warnings_are_diagnostics_not_a_log_file(tmp_path: Path, diags: 
                          "or call mj_setTotalmass and mj_setConst on the compiled model")
     assert robot is not None and robot.links["a"].inertial.mass == pytest.approx(5.0, abs=1e-12)
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_included_files_and_meshes_are_in_the_builds_fingerprint(tmp_path: Path, diags: Diags) -> None:
+    """`mpc run` fingerprints what a build reads (core/reads.py): MuJoCo's own reads, in C,
+    would not be seen; the reader reads every file itself and hands it to MuJoCo."""
+    from mpc.core.reads import ReadRecorder, recording
+
+    (tmp_path / "meshes").mkdir()
+    trimesh.creation.box((0.1, 0.1, 0.1)).export(tmp_path / "meshes" / "m.stl")
+    write(tmp_path / "parts" / "leg.xml", """
+        <mujoco><body name="leg"><joint name="knee"/><geom type="mesh" mesh="m"/></body></mujoco>""")
+    path = write(tmp_path / "r.xml", """
+        <mujoco model="r"><compiler meshdir="meshes"/><asset><mesh name="m" file="m.stl"/></asset>
+          <worldbody><body name="hip"><geom type="sphere" size="0.1"/>
+            <include file="parts/leg.xml"/></body></worldbody>
+        </mujoco>""")
+    with recording(ReadRecorder()) as recorder:
+        assert _read(path, diags) is not None
+    assert {tmp_path / "r.xml", tmp_path / "parts" / "leg.xml", tmp_path / "meshes" / "m.stl"} <= set(
+        recorder.inputs())
+
+
+def test_a_msh_mesh_becomes_an_stl_in_the_cache(tmp_path: Path, diags: Diags,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    box = trimesh.creation.box((0.1, 0.2, 0.3))
+    vertices, faces = box.vertices.astype("<f4"), box.faces.astype("<i4")
+    header = np.array([len(vertices), 0, 0, len(faces)], dtype="<i4")
+    (tmp_path / "box.msh").write_bytes(header.tobytes() + vertices.tobytes() + faces.tobytes())
+    path = write(tmp_path / "r.xml", """
+        <mujoco model="r"><asset><mesh name="b" file="box.msh"/></asset>
+          <worldbody><body name="a"><joint name="j"/><geom type="mesh" mesh="b" pos="0.1 0 0"/></body>
+          </worldbody></mujoco>""")
+    robot = _read(path, diags)
+    mesh = robot.links["a"].visuals[0].geometry
+    assert mesh.source.uri == "box.stl" and mesh.source.path.parent == tmp_path / "cache" / "msh"
+    stl = trimesh.load(mesh.source.path)
+    assert np.allclose(np.sort(stl.vertices, axis=0), np.sort(box.vertices, axis=0), atol=1e-7)
+    assert stl.volume == pytest.approx(0.1 * 0.2 * 0.3, rel=1e-6)
+    (tmp_path / "bad.msh").write_bytes(header.tobytes())
+    bad = write(tmp_path / "bad.xml", """
+        <mujoco><asset><mesh name="b" file="bad.msh"/></asset>
+          <worldbody><body name="a"><geom type="mesh" mesh="b"/></body></worldbody></mujoco>""")
+    assert _read(bad, diags) is None
+    e = diags.take_error("E0440")
+    assert e.message == (f"MuJoCo refuses '{bad}': mesh file '{tmp_path / 'bad.msh'}' is not a .msh file "
+                         "(its sizes do not match its header)")
+    assert (e.span.line, e.span.col) == (1, 16)  # the <mesh>
