@@ -148,6 +148,7 @@ class _Files:
     includes: dict[str, bytes] = field(default_factory=dict)
     assets: dict[str, bytes] = field(default_factory=dict)
     mesh_paths: dict[str, tuple[str, Path]] = field(default_factory=dict)  # name → (uri, path)
+    _spans: dict[str, dict[str, Span]] = field(default_factory=dict)
 
     def gather_includes(self, src: XmlSource) -> None:
         """Every file `src` includes, nested ones too; MuJoCo finds them from the main
@@ -177,6 +178,14 @@ class _Files:
                 if all(el.get(k) == v for k, v in attrs.items()):
                     return src, el
         return None
+
+    def spans(self, tag: str) -> dict[str, Span]:
+        """The span of each named element `tag` (the language server's hover and go-to), found
+        when first asked for."""
+        if tag not in self._spans:
+            self._spans[tag] = {el.get("name", ""): src.lazy_span(el) for src in reversed(self.sources)
+                                for el in src.root.iter(tag) if el.get("name")}
+        return self._spans[tag]
 
     def span_of(self, tag: str, **attrs: str) -> Span:
         found = self.element(tag, **attrs)
@@ -339,7 +348,8 @@ class _Builder:
                 self.unheld["ball joint"] += 1
         anchor = _vec(m.jnt_pos[movable[-1]]) if movable else (0.0, 0.0, 0.0)
         self.shift[b] = _X(np.array(anchor))
-        self.links[name] = Link(name=name, inertial=self.inertial(b), visuals=(), collisions=())
+        self.links[name] = Link(name=name, inertial=self.inertial(b), visuals=(), collisions=(),
+                                span=self.files.spans("body").get(name))
         self.geoms(b)
         if b == 0 or root_body:
             return
@@ -384,6 +394,7 @@ class _Builder:
         dynamics = Dynamics(damping=damping, friction=friction) if damping or friction else None
         return Joint(name=name, type=jtype, parent=parent, child=child, origin=_pose(X),  # type: ignore[arg-type]
                      axis=_vec(m.jnt_axis[j]), limit=limit, dynamics=dynamics,
+                     span=self.files.spans("joint").get(name),
                      annotations={"armature": armature} if armature else {})
 
     def inertial(self, b: int) -> Inertial | None:
@@ -422,6 +433,7 @@ class _Builder:
                 visuals += [Visual(geometry=s, origin=_pose(Xs), name=n, material=material)
                             for n, (s, Xs) in zip(names, shapes, strict=True)]
         self.links[link.name] = Link(name=link.name, inertial=link.inertial, visuals=tuple(visuals),
+                                     span=link.span,
                                      collisions=tuple(collisions))
 
     def shapes(self, g: int, kind: int, X: np.ndarray) -> list[tuple[Geometry, np.ndarray]] | None:
@@ -482,7 +494,7 @@ class _Builder:
             if name in self.links:
                 name = f"{name}_site"
             X = tf.inverse(self.shift[b]) @ _X(m.site_pos[s], m.site_quat[s])
-            self.links[name] = Link(name=name)
+            self.links[name] = Link(name=name, span=self.files.spans("site").get(name))
             self.joints[f"{name}_fixed"] = Joint(name=f"{name}_fixed", type="fixed",
                                                  parent=self.body_names[b], child=name, origin=_pose(X))
 

@@ -374,3 +374,19 @@ def test_a_msh_mesh_becomes_an_stl_in_the_cache(tmp_path: Path, diags: Diags,
     assert e.message == (f"MuJoCo refuses '{bad}': mesh file '{tmp_path / 'bad.msh'}' is not a .msh file "
                          "(its sizes do not match its header)")
     assert (e.span.line, e.span.col) == (1, 16)  # the <mesh>
+
+
+def test_links_and_joints_know_where_they_are_written(tmp_path: Path, diags: Diags) -> None:
+    """The language server's hover and go-to-definition show a name's element."""
+    write(tmp_path / "parts" / "leg.xml", """
+        <mujoco><body name="leg"><joint name="knee"/><geom type="sphere" size="0.1"/></body></mujoco>""")
+    path = write(tmp_path / "r.xml", """
+        <mujoco model="r">
+          <worldbody><body name="hip"><geom type="sphere" size="0.1"/>
+            <include file="parts/leg.xml"/></body></worldbody>
+        </mujoco>""")
+    robot = _read(path, diags)
+    hip, leg, knee = robot.links["hip"].span, robot.links["leg"].span, robot.joints["knee"].span
+    assert (hip.file, hip.line, hip.col) == (str(path), 2, 14)
+    assert (leg.file, leg.line, leg.col) == (str(tmp_path / "parts" / "leg.xml"), 1, 9)
+    assert (knee.file, knee.line, knee.col) == (str(tmp_path / "parts" / "leg.xml"), 1, 26)
