@@ -455,26 +455,27 @@ class _Writer:
                 continue
             depth, joint, link = item
             # Links that only pass motion on join the body below them, their joints with it.
-            chain, X = [joint], pose_matrix(joint.origin if joint is not None else None)
-            while (below := passes_through(self.robot, link, chain[-1], self._child_bodies(link))) \
-                    is not None:
+            chain: list[Joint] = []  # the joints below `joint` that join its body
+            X = pose_matrix(joint.origin if joint is not None else None)
+            while (below := passes_through(self.robot, link, chain[-1] if chain else joint,
+                                           self._child_bodies(link))) is not None:
                 chain.append(below)
                 X = X @ pose_matrix(below.origin)
                 link = self.robot.links[below.child]
-            pose = _pose_pairs(matrix_pose(X) if len(chain) > 1 else chain[0].origin if chain[0] else None)
+            pose = _pose_pairs(matrix_pose(X) if chain else joint.origin if joint is not None else None)
             self.out.append(f"{IND * depth}<body{self.attrs([('name', link.name), *pose])}>")
             d = depth + 1
             if link.inertial is not None:
                 self._emit_inertial(d, link.inertial)
             anchor = np.zeros(3)  # each joint's place in the body: minus the origins below it
             anchors = []
-            for j in reversed(chain[1:]):
+            for j in reversed(chain):
                 anchors.append(anchor.copy())
                 anchor = anchor - np.asarray(j.origin.xyz if j.origin is not None else (0.0, 0.0, 0.0))
-            anchors.append(anchor)
+            if joint is not None:
+                self._emit_joint(d, joint, top, anchor if chain else None)
             for j, at in zip(chain, reversed(anchors), strict=True):
-                if j is not None:
-                    self._emit_joint(d, j, top, at if len(chain) > 1 else None)
+                self._emit_joint(d, j, top, at)
             self._emit_geoms(d, link)
             todo.append(f"{IND * depth}</body>")
             todo.extend((d, j, self.robot.links[j.child]) for j in reversed(self._child_bodies(link)))

@@ -40,7 +40,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from lxml import etree
 
 from mpc.backends.xml import XmlSource, load
 from mpc.core.diagnostics import Sink
@@ -73,15 +72,15 @@ _UNHELD_GEOMS = {0: "plane", 1: "height field", 4: "ellipsoid", 8: "sdf"}
 # What a compiled model counts that the IR has no place for (its name in W0440 → MjModel's count).
 _MODEL_COUNTS = {"tendon": "ntendon", "sensor": "nsensor", "plugin": "nplugin", "custom numeric": "nnumeric",
                  "custom text": "ntext", "custom tuple": "ntuple", "camera": "ncam", "light": "nlight",
-                 "flex": "nflex", "skin": "nskin", "contact exclusion": "nexclude", "contact pair": "npair"}
+                 "flex": "nflex", "skin": "nskin", "texture": "ntex", "contact exclusion": "nexclude",
+                 "contact pair": "npair"}
 _LINE = re.compile(r"line (\d+)")
 _ELEMENT = re.compile(r"Element '([\w-]+)'")
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Robot | None:
     """Read the MJCF at `path`; None when it has errors (all of them reported)."""
-    import mujoco
-
+    mujoco = _mujoco()
     src = load(path, sink, "MJCF")
     if src is None:
         return None
@@ -119,16 +118,24 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     return None if sink.error_count > errors_before else robot
 
 
+def _mujoco() -> Any:
+    """MuJoCo's module, imported when a file is read (MuJoCo ships no type stubs: Any)."""
+    import mujoco
+
+    return mujoco
+
+
 def _compile(spec: Any, said: list[str]) -> Any:
     """The compiled model; MuJoCo's warnings go to `said`, not to stderr nor to the
     MUJOCO_LOG.TXT that MuJoCo would write into the working folder."""
-    import mujoco
-
+    mujoco = _mujoco()
     before = mujoco.get_mju_user_warning()
     mujoco.set_mju_user_warning(lambda message: said.append(str(message).strip()))
+    warned: list[warnings.WarningMessage] = []
     try:
-        with warnings.catch_warnings(record=True) as warned:
+        with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            warned = caught
             return spec.compile()
     finally:
         mujoco.set_mju_user_warning(before)
@@ -171,7 +178,7 @@ class _Files:
             self.includes[name] = path.read_bytes()
             self.gather_includes(included)
 
-    def element(self, tag: str, **attrs: str) -> tuple[XmlSource, etree._Element] | None:
+    def element(self, tag: str, **attrs: str) -> tuple[XmlSource, Any] | None:
         """The first element `tag` with those attributes, in the main file or an included one."""
         for src in self.sources:
             for el in src.root.iter(tag):
@@ -392,10 +399,14 @@ class _Builder:
         damping, friction, armature = (float(a[dof])
                                        for a in (m.dof_damping, m.dof_frictionloss, m.dof_armature))
         dynamics = Dynamics(damping=damping, friction=friction) if damping or friction else None
-        return Joint(name=name, type=jtype, parent=parent, child=child, origin=_pose(X),  # type: ignore[arg-type]
+        notes: dict[str, object] = {"armature": armature} if armature else {}
+        if stiffness := float(m.jnt_stiffness[j]):  # a spring, kept as the SDF reader keeps one
+            notes |= {"spring_stiffness": stiffness,
+                      "spring_reference": float(m.qpos_spring[m.jnt_qposadr[j]]) - ref}
+        return Joint(name=name, type=jtype, parent=parent, child=child, origin=_pose(X),
                      axis=_vec(m.jnt_axis[j]), limit=limit, dynamics=dynamics,
                      span=self.files.spans("joint").get(name),
-                     annotations={"armature": armature} if armature else {})
+                     annotations=notes)
 
     def inertial(self, b: int) -> Inertial | None:
         m = self.m
@@ -521,8 +532,7 @@ class _Builder:
 
     def world_frames(self) -> dict[int, np.ndarray]:
         """Each body's IR frame in the world at qpos0."""
-        import mujoco
-
+        mujoco = _mujoco()
         data = mujoco.MjData(self.m)
         mujoco.mj_kinematics(self.m, data)
         return {b: _X(data.xpos[b], data.xquat[b]) @ self.shift[b] for b in range(self.m.nbody)}

@@ -24,74 +24,75 @@ from tests.conftest import Diags
 # robot → what its W0440 names ("" for none)
 ROBOTS = {
     "gymnasium_robotics/envs/assets/adroit_hand/adroit_door.xml":
-        "camera ×2, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44",
+        "camera ×2, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44, texture ×9",
     "gymnasium_robotics/envs/assets/adroit_hand/adroit_hammer.xml":
         "camera ×2, contact exclusion ×1, contact pair ×19, light ×1, plane ×1, sensor ×66, "
-        "tendon ×44",
+        "tendon ×44, texture ×9",
     "gymnasium_robotics/envs/assets/adroit_hand/adroit_pen.xml":
-        "camera ×7, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44",
+        "camera ×7, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44, texture ×9",
     "gymnasium_robotics/envs/assets/adroit_hand/adroit_relocate.xml":
-        "camera ×2, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44",
+        "camera ×2, contact pair ×19, light ×1, plane ×1, sensor ×65, tendon ×44, texture ×9",
     "gymnasium_robotics/envs/assets/fetch/pick_and_place.xml":
-        "camera ×4, contact exclusion ×3, light ×1, plane ×1",
+        "camera ×4, contact exclusion ×3, light ×1, plane ×1, texture ×2",
     "gymnasium_robotics/envs/assets/fetch/push.xml":
-        "camera ×4, contact exclusion ×3, light ×1, plane ×1",
+        "camera ×4, contact exclusion ×3, light ×1, plane ×1, texture ×2",
     "gymnasium_robotics/envs/assets/fetch/reach.xml":
-        "camera ×4, contact exclusion ×3, light ×1, plane ×1",
+        "camera ×4, contact exclusion ×3, light ×1, plane ×1, texture ×2",
     "gymnasium_robotics/envs/assets/fetch/slide.xml":
-        "camera ×4, contact exclusion ×3, light ×1, plane ×1",
+        "camera ×4, contact exclusion ×3, light ×1, plane ×1, texture ×2",
     "gymnasium_robotics/envs/assets/hand/manipulate_block.xml":
-        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44",
+        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44, texture ×5",
     "gymnasium_robotics/envs/assets/hand/manipulate_block_touch_sensors.xml":
-        "contact pair ×19, light ×1, plane ×1, sensor ×121, tendon ×44",
+        "contact pair ×19, light ×1, plane ×1, sensor ×121, tendon ×44, texture ×5",
     "gymnasium_robotics/envs/assets/hand/manipulate_egg.xml":
-        "contact pair ×19, ellipsoid ×3, light ×1, plane ×1, sensor ×29, tendon ×44",
+        "contact pair ×19, ellipsoid ×3, light ×1, plane ×1, sensor ×29, tendon ×44, texture ×5",
     "gymnasium_robotics/envs/assets/hand/manipulate_egg_touch_sensors.xml":
-        "contact pair ×19, ellipsoid ×3, light ×1, plane ×1, sensor ×121, tendon ×44",
+        "contact pair ×19, ellipsoid ×3, light ×1, plane ×1, sensor ×121, tendon ×44, texture ×5",
     "gymnasium_robotics/envs/assets/hand/manipulate_pen.xml":
-        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44",
+        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44, texture ×3",
     "gymnasium_robotics/envs/assets/hand/manipulate_pen_touch_sensors.xml":
-        "contact pair ×19, light ×1, plane ×1, sensor ×121, tendon ×44",
+        "contact pair ×19, light ×1, plane ×1, sensor ×121, tendon ×44, texture ×3",
     "gymnasium_robotics/envs/assets/hand/reach.xml":
-        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44",
+        "contact pair ×19, light ×1, plane ×1, sensor ×29, tendon ×44, texture ×3",
     "gymnasium_robotics/envs/assets/kitchen_franka/kitchen_assets/kitchen_env_model.xml":
-        "camera ×2, equality other than a connect or weld of bodies ×5, light ×4, plane ×1",
+        "camera ×2, equality other than a connect or weld of bodies ×5, light ×4, plane ×1, "
+        "texture ×14",
     "gymnasium_robotics/envs/assets/point/point.xml":
-        "plane ×1",
+        "plane ×1, texture ×2",
     "gymnasium_robotics/envs/mujoco/assets/ant.xml":
-        "camera ×1, custom numeric ×1, light ×1, worldbody geom ×1",
+        "camera ×1, custom numeric ×1, light ×1, texture ×3, worldbody geom ×1",
     "gymnasium_robotics/envs/mujoco/assets/half_cheetah.xml":
-        "camera ×1, light ×1, plane ×1",
+        "camera ×1, light ×1, plane ×1, texture ×3",
     "gymnasium_robotics/envs/mujoco/assets/hopper.xml":
-        "camera ×1, light ×1, plane ×1",
+        "camera ×1, light ×1, plane ×1, texture ×3",
     "gymnasium_robotics/envs/mujoco/assets/humanoid.xml":
-        "camera ×2, light ×1, tendon ×2, worldbody geom ×1",
+        "camera ×2, light ×1, tendon ×2, texture ×3, worldbody geom ×1",
     "gymnasium_robotics/envs/mujoco/assets/humanoidstandup.xml":
-        "camera ×2, light ×1, tendon ×2, worldbody geom ×1",
+        "camera ×2, light ×1, tendon ×2, texture ×3, worldbody geom ×1",
     "gymnasium_robotics/envs/mujoco/assets/inverted_double_pendulum.xml":
         "custom numeric ×1, plane ×1",
     "gymnasium_robotics/envs/mujoco/assets/inverted_pendulum.xml": "",
     "gymnasium_robotics/envs/mujoco/assets/point.xml":
-        "light ×1, plane ×1",
+        "light ×1, plane ×1, texture ×3",
     "gymnasium_robotics/envs/mujoco/assets/pusher.xml":
         "light ×1, plane ×1",
     "gymnasium_robotics/envs/mujoco/assets/reacher.xml":
         "plane ×1",
     "gymnasium_robotics/envs/mujoco/assets/swimmer.xml":
-        "camera ×1, light ×1, plane ×1",
+        "camera ×1, light ×1, plane ×1, texture ×3",
     "gymnasium_robotics/envs/mujoco/assets/walker2d.xml":
-        "camera ×1, light ×1, plane ×1",
+        "camera ×1, light ×1, plane ×1, texture ×3",
     "gymnasium_robotics/envs/multiagent_mujoco/assets/coupled_half_cheetah.xml":
-        "camera ×2, light ×1, plane ×1, tendon ×1",
+        "camera ×2, light ×1, plane ×1, tendon ×1, texture ×3",
     "dm_control/locomotion/soccer/assets/boxhead/boxhead.xml":
         "camera ×3, sensor ×3",
     "dm_control/locomotion/walkers/assets/build_fruitfly/assets/drosophila_fused.xml": "",
     "dm_control/locomotion/walkers/assets/dog_v2/dog.xml":
         "actuator not on a hinge or slide ×8, camera ×2, contact exclusion ×30, ellipsoid ×46, "
-        "light ×1, sensor ×13, skin ×1, tendon ×8, worldbody geom ×1",
+        "light ×1, sensor ×13, skin ×1, tendon ×8, texture ×2, worldbody geom ×1",
     "dm_control/locomotion/walkers/assets/fruitfly_v2/floor.xml":
         "actuator not on a hinge or slide ×16, camera ×9, contact exclusion ×26, ellipsoid ×18, "
-        "light ×3, sensor ×15, tendon ×8, worldbody geom ×1",
+        "light ×3, sensor ×15, tendon ×8, texture ×2, worldbody geom ×1",
     "dm_control/locomotion/walkers/assets/fruitfly_v2/fruitfly.xml":
         "actuator not on a hinge or slide ×16, camera ×9, contact exclusion ×26, ellipsoid ×18, "
         "light ×3, sensor ×15, tendon ×8",
@@ -100,7 +101,7 @@ ROBOTS = {
     "dm_control/locomotion/walkers/assets/humanoid_CMU_V2020.xml":
         "camera ×5, contact exclusion ×5, ellipsoid ×2, light ×1, sensor ×15",
     "dm_control/locomotion/walkers/assets/jumping_ball/jumping_ball_with_head.xml":
-        "camera ×2, sensor ×3",
+        "camera ×2, sensor ×3, texture ×1",
     "dm_control/locomotion/walkers/assets/rodent.xml":
         "actuator not on a hinge or slide ×8, camera ×5, contact exclusion ×26, ellipsoid ×22, "
         "light ×1, sensor ×8, skin ×1, tendon ×8",
@@ -113,54 +114,55 @@ ROBOTS = {
     "dm_control/mujoco/testing/assets/cartpole_no_names.xml":
         "camera ×3, custom numeric ×1, plane ×1, sensor ×2",
     "dm_control/mujoco/testing/assets/humanoid.xml":
-        "camera ×2, light ×1, tendon ×2, worldbody geom ×1",
+        "camera ×2, light ×1, tendon ×2, texture ×3, worldbody geom ×1",
     "dm_control/mujoco/testing/assets/model_with_ball_joints.xml":
         "ball joint ×2",
     "dm_control/mujoco/testing/assets/model_with_third_order_actuators.xml": "",
     "dm_control/suite/acrobot.xml":
-        "camera ×2, light ×1, plane ×1",
+        "camera ×2, light ×1, plane ×1, texture ×2",
     "dm_control/suite/ball_in_cup.xml":
-        "camera ×2, light ×1, plane ×1, tendon ×1",
+        "camera ×2, light ×1, plane ×1, tendon ×1, texture ×2",
     "dm_control/suite/cartpole.xml":
-        "camera ×2, light ×1, plane ×1",
+        "camera ×2, light ×1, plane ×1, texture ×2",
     "dm_control/suite/cheetah.xml":
-        "camera ×2, light ×1, plane ×1, sensor ×1",
+        "camera ×2, light ×1, plane ×1, sensor ×1, texture ×2",
     "dm_control/suite/dog.xml":
         "actuator not on a hinge or slide ×8, camera ×4, contact exclusion ×30, ellipsoid ×46, "
-        "light ×1, plane ×5, sensor ×13, skin ×1, tendon ×8",
+        "light ×1, plane ×5, sensor ×13, skin ×1, tendon ×8, texture ×4",
     "dm_control/suite/finger.xml":
-        "camera ×2, light ×1, plane ×1, sensor ×12",
+        "camera ×2, light ×1, plane ×1, sensor ×12, texture ×2",
     "dm_control/suite/fish.xml":
         "actuator not on a hinge or slide ×1, camera ×5, ellipsoid ×7, light ×1, sensor ×2, "
-        "tendon ×2, worldbody geom ×2",
+        "tendon ×2, texture ×2, worldbody geom ×2",
     "dm_control/suite/hopper.xml":
-        "camera ×2, light ×1, plane ×1, sensor ×3",
+        "camera ×2, light ×1, plane ×1, sensor ×3, texture ×2",
     "dm_control/suite/humanoid.xml":
-        "camera ×3, light ×1, sensor ×34, worldbody geom ×1",
+        "camera ×3, light ×1, sensor ×34, texture ×2, worldbody geom ×1",
     "dm_control/suite/humanoid_CMU.xml":
-        "camera ×3, contact exclusion ×5, ellipsoid ×2, light ×1, sensor ×8, worldbody geom ×1",
+        "camera ×3, contact exclusion ×5, ellipsoid ×2, light ×1, sensor ×8, texture ×2, "
+        "worldbody geom ×1",
     "dm_control/suite/manipulator.xml":
         "actuator not on a hinge or slide ×1, camera ×2, "
         "equality other than a connect or weld of bodies ×1, light ×1, plane ×4, sensor ×5, "
-        "tendon ×2",
+        "tendon ×2, texture ×3",
     "dm_control/suite/pendulum.xml":
-        "camera ×2, light ×1, plane ×1",
+        "camera ×2, light ×1, plane ×1, texture ×2",
     "dm_control/suite/point_mass.xml":
-        "actuator not on a hinge or slide ×2, camera ×2, light ×1, plane ×5, tendon ×2",
+        "actuator not on a hinge or slide ×2, camera ×2, light ×1, plane ×5, tendon ×2, texture ×2",
     "dm_control/suite/quadruped.xml":
         "actuator not on a hinge or slide ×8, camera ×4, ellipsoid ×1, "
         "equality other than a connect or weld of bodies ×4, height field ×1, light ×2, plane ×5, "
-        "sensor ×32, tendon ×12",
+        "sensor ×32, tendon ×12, texture ×3",
     "dm_control/suite/reacher.xml":
-        "camera ×2, light ×1, plane ×5",
+        "camera ×2, light ×1, plane ×5, texture ×2",
     "dm_control/suite/stacker.xml":
         "actuator not on a hinge or slide ×1, camera ×2, "
         "equality other than a connect or weld of bodies ×1, light ×1, plane ×4, sensor ×5, "
-        "tendon ×2",
+        "tendon ×2, texture ×3",
     "dm_control/suite/swimmer.xml":
-        "camera ×3, ellipsoid ×1, light ×2, plane ×1, sensor ×6",
+        "camera ×3, ellipsoid ×1, light ×2, plane ×1, sensor ×6, texture ×2",
     "dm_control/suite/walker.xml":
-        "camera ×2, light ×1, plane ×1, sensor ×1",
+        "camera ×2, light ×1, plane ×1, sensor ×1, texture ×2",
     "dm_control/third_party/ant/ant.xml":
         "camera ×4, contact exclusion ×4, sensor ×20",
     "dm_control/third_party/kinova/jaco_arm.xml":

@@ -223,9 +223,11 @@ def test_includes_and_default_classes(tmp_path: Path, diags: Diags) -> None:
 def test_what_the_ir_cannot_hold_is_one_warning(tmp_path: Path, diags: Diags) -> None:
     path = write(tmp_path / "w.xml", """
         <mujoco model="w">
+          <asset><texture name="t" type="2d" builtin="checker" width="8" height="8"/></asset>
           <worldbody><body name="a"><joint name="j" type="ball"/><geom type="ellipsoid" size="0.1 0.2 0.3"/>
             <site name="s"/></body>
-            <body name="b" pos="1 0 0"><joint name="k"/><geom type="sphere" size="0.1"/>
+            <body name="b" pos="1 0 0"><joint name="k" stiffness="2" springref="0.1"/>
+              <geom type="sphere" size="0.1"/>
               <site name="t"/></body>
           </worldbody>
           <tendon><spatial name="t1"><site site="s"/><site site="t"/></spatial></tendon>
@@ -235,9 +237,11 @@ def test_what_the_ir_cannot_hold_is_one_warning(tmp_path: Path, diags: Diags) ->
     robot = _read(path, diags)
     w = diags.take("W0440", Severity.WARNING)
     assert w.message == (f"'{path}' holds what mpc's robot model cannot: ball joint ×1, custom numeric ×1, "
-                         "ellipsoid ×1, sensor ×2, tendon ×1; left out")
+                         "ellipsoid ×1, sensor ×2, tendon ×1, texture ×1; left out")
     assert (w.span.line, w.span.col) == (1, 1)
     assert robot.joints["a_fixed"].type == "fixed"  # a ball joint: fixed at its reference
+    # a spring, as the SDF reader keeps one; springref in degrees, MJCF's default unit
+    assert robot.joints["k"].annotations == {"spring_stiffness": 2.0, "spring_reference": np.deg2rad(0.1)}
 
 
 def test_connect_and_weld_become_loop_closures(tmp_path: Path, diags: Diags) -> None:
