@@ -103,6 +103,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
         files.mujoco_error(str(e))
         return None
     files.gather_meshes(spec)
+    files.gather_other_files(spec)
     if sink.error_count > errors_before:
         return None
     spec.assets = files.assets
@@ -229,6 +230,23 @@ class _Files:
                 self.mesh_paths[mesh.name] = (uri[:-4] + ".stl", converted)
             else:
                 self.mesh_paths[mesh.name] = (uri, path)
+
+    def gather_other_files(self, spec: Any) -> None:
+        """The files MuJoCo's compiler would read besides the meshes: textures, height fields
+        and skins. The robot holds none of them, but MuJoCo reads them, so they follow the read
+        rule and are handed to MuJoCo like the meshes."""
+        uses = [("texture", t.name, spec.texturedir or "", f) for t in spec.textures
+                for f in (t.file, *t.cubefiles) if f]
+        uses += [(tag, item.name, spec.meshdir or "", item.file) for tag, items in
+                 (("hfield", spec.hfields), ("skin", spec.skins)) for item in items if item.file]
+        for tag, name, folder, file in uses:
+            uri = file if os.path.isabs(file) else os.path.join(folder, file)
+            path = self.base_dir / uri
+            if why := self.resolver.refusal(path, self.base_dir):
+                self.sink.error(self.span_of(tag, name=name), "E0650",
+                                f"file '{file}' of <{tag}> '{name}' is not read: {why}")
+            elif path.is_file():  # else MuJoCo says that it is missing
+                self.assets[os.path.join(spec.modelfiledir, uri)] = path.read_bytes()
 
     def mujoco_error(self, text: str) -> None:
         """MuJoCo's error, at the element it names: its line in the main file (MuJoCo gives no

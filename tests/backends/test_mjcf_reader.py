@@ -394,3 +394,24 @@ def test_links_and_joints_know_where_they_are_written(tmp_path: Path, diags: Dia
     assert (hip.file, hip.line, hip.col) == (str(path), 2, 14)
     assert (leg.file, leg.line, leg.col) == (str(tmp_path / "parts" / "leg.xml"), 1, 9)
     assert (knee.file, knee.line, knee.col) == (str(tmp_path / "parts" / "leg.xml"), 1, 26)
+
+
+def test_a_texture_outside_the_project_is_refused(tmp_path: Path, diags: Diags) -> None:
+    """MuJoCo's compiler reads textures; mpc hands them to it, under the read rule."""
+    from mpc.core.packages import PackageResolver
+
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    (outside / "t.png").write_bytes(b"\x89PNG")
+    project = tmp_path / "project"
+    write(project / "robot.yml", "model: {}\n")
+    resolver = PackageResolver()
+    resolver.add_project(project)
+    path = write(project / "r.xml", f"""
+        <mujoco><asset><texture name="t" type="2d" file="{outside / 't.png'}"/></asset>
+          <worldbody><body name="a"><joint name="j"/><geom type="sphere" size="1"/></body></worldbody>
+        </mujoco>""")
+    assert mjcf_reader.read(path, diags, resolver) is None
+    e = diags.take_error("E0650")
+    assert e.message.startswith(f"file '{outside / 't.png'}' of <texture> 't' is not read: ")
+    assert (e.span.line, e.span.col) == (1, 16)

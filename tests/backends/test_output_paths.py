@@ -48,6 +48,10 @@ SITES: dict[tuple[str, str, str], str] = {
     ("mjcf_reader.py", "gather_meshes", "self.base_dir / uri"): READ,
     ("mjcf_reader.py", "gather_meshes", "os.path.join(spec.modelfiledir, uri)"):
         "the name MuJoCo looks a mesh up by among the files handed to it; no file",
+    ("mjcf_reader.py", "gather_other_files", "os.path.join(folder, file)"): READ,
+    ("mjcf_reader.py", "gather_other_files", "self.base_dir / uri"): READ,
+    ("mjcf_reader.py", "gather_other_files", "os.path.join(spec.modelfiledir, uri)"):
+        "the name MuJoCo looks a file up by among the files handed to it; no file",
     ("mjcf_reader.py", "msh_as_stl", "cache_dir('msh') / f'{hashlib.sha256(data).hexdigest()}.stl'"): CACHE,
     ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2] / f'{digest}{suffix}'"): CACHE,
