@@ -76,6 +76,7 @@ _MODEL_COUNTS = {"tendon": "ntendon", "sensor": "nsensor", "plugin": "nplugin", 
                  "contact pair": "npair"}
 _LINE = re.compile(r"line (\d+)")
 _ELEMENT = re.compile(r"Element '([\w-]+)'")
+_ATTRIBUTE = re.compile(r"attribute:? '([\w-]+)'")
 
 
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Robot | None:
@@ -249,20 +250,28 @@ class _Files:
                 self.assets[os.path.join(spec.modelfiledir, uri)] = path.read_bytes()
 
     def mujoco_error(self, text: str) -> None:
-        """MuJoCo's error, at the element it names: its line in the main file (MuJoCo gives no
-        line in an included file) and the column of that element's start tag."""
+        """MuJoCo's error, at the element it names: on the line MuJoCo gives in the main file, at
+        its start tag's column (at the attribute MuJoCo quotes, when it has it). In an included
+        file MuJoCo gives line 0: there the first element of that tag that has the quoted
+        attribute (else the first of that tag) in the included files is taken."""
         message = next((line for line in text.splitlines() if line.strip()), text)
         message = re.sub(r"^(XML )?Error: ", "", message.strip())
-        span = self.src.span(self.src.root)
         line = int(m.group(1)) if (m := _LINE.search(text)) else 0
         tag = m.group(1) if (m := _ELEMENT.search(text)) else None
+        attr = m.group(1) if (m := _ATTRIBUTE.search(message)) else None
         if line > 0:
-            at = [el for el in self.src.root.iter() if isinstance(el.tag, str)
-                  and (tag is None or el.tag == tag) and el.sourceline is not None and el.sourceline >= line]
-            if at:
-                span = self.src.span(min(at, key=lambda el: el.sourceline or 0))
-            else:
-                span = Span(self.src.file, line, 1)
+            found = [(self.src, el) for el in self.src.root.iter() if isinstance(el.tag, str)
+                     and (tag is None or el.tag == tag) and (el.sourceline or 0) >= line]
+            found.sort(key=lambda item: item[1].sourceline or 0)
+        else:
+            found = [(src, el) for src in self.sources[1:] for el in src.root.iter(tag or "")
+                     if tag is not None]
+            found.sort(key=lambda item: attr is None or item[1].get(attr) is None)  # stable
+        if found:
+            src, el = found[0]
+            span = src.span(el, attr if attr is not None and el.get(attr) is not None else None)
+        else:
+            span = Span(self.src.file, line, 1) if line > 0 else self.src.span(self.src.root)
         self.sink.error(span, "E0440", f"MuJoCo refuses '{self.src.file}': {message}")
 
 

@@ -274,7 +274,7 @@ def test_mujoco_errors_point_at_file_line_and_column(tmp_path: Path, diags: Diag
     assert _read(path, diags) is None
     e = diags.take_error("E0440")
     assert e.message == f"MuJoCo refuses '{path}': Schema violation: unrecognized attribute: 'rnge'"
-    assert (e.span.file, e.span.line, e.span.col) == (str(path), 4, 7)
+    assert (e.span.file, e.span.line, e.span.col) == (str(path), 4, 33)  # at the value MuJoCo quotes
 
 
 def test_malformed_xml_and_wrong_root(tmp_path: Path, diags: Diags) -> None:
@@ -415,3 +415,20 @@ def test_a_texture_outside_the_project_is_refused(tmp_path: Path, diags: Diags) 
     e = diags.take_error("E0650")
     assert e.message.startswith(f"file '{outside / 't.png'}' of <texture> 't' is not read: ")
     assert (e.span.line, e.span.col) == (1, 16)
+
+
+def test_an_error_in_an_included_file_points_into_it(tmp_path: Path, diags: Diags) -> None:
+    leg = write(tmp_path / "leg.xml", """
+        <mujoco>
+          <body name="leg">
+            <joint name="knee" rnge="1"/>
+          </body>
+        </mujoco>""")
+    path = write(tmp_path / "r.xml", """
+        <mujoco>
+          <worldbody><body name="hip"><include file="leg.xml"/></body></worldbody>
+        </mujoco>""")
+    assert _read(path, diags) is None
+    e = diags.take_error("E0440")
+    assert e.message == f"MuJoCo refuses '{path}': Schema violation: unrecognized attribute: 'rnge'"
+    assert (e.span.file, e.span.line, e.span.col) == (str(leg), 3, 30)  # at rnge's value

@@ -215,5 +215,5 @@ def test_mjcf_errors_reach_the_command_line(tmp_path: Path, command: str) -> Non
     args = (command, tmp_path / "r.yml") + (("-o", tmp_path / "out") if command == "compile" else ())
     result = mpc(*args)
     assert result.returncode == 1
-    assert (f"{tmp_path / 'bad.xml'}:3:20: error[E0440]: MuJoCo refuses '{tmp_path / 'bad.xml'}': "
+    assert (f"{tmp_path / 'bad.xml'}:3:33: error[E0440]: MuJoCo refuses '{tmp_path / 'bad.xml'}': "
             "Schema violation: unrecognized attribute: 'rnge'") in result.stdout + result.stderr
