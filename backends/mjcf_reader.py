@@ -31,10 +31,12 @@ are E0440 at the file, line and column MuJoCo names.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import warnings
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -98,8 +100,10 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     files.gather_includes(src)
     if sink.error_count > errors_before:
         return None
+    said: list[str] = []  # MuJoCo's warnings
     try:
-        spec = mujoco.MjSpec.from_file(str(path), include=files.includes)
+        with _warnings_into(said):
+            spec = mujoco.MjSpec.from_file(str(path), include=files.includes)
     except ValueError as e:
         files.mujoco_error(str(e))
         return None
@@ -108,14 +112,18 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
     if sink.error_count > errors_before:
         return None
     spec.assets = files.assets
-    said: list[str] = []
     try:
-        model = _compile(spec, said)
+        with _warnings_into(said):
+            model = spec.compile()
     except ValueError as e:
         files.mujoco_error(str(e))
         return None
     for message in dict.fromkeys(said):  # MuJoCo's warnings (a deprecated attribute): said once
         sink.warning(src.span(src.root), "W0441", f"MuJoCo warns about '{src.file}': {message}")
+    if what := _not_finite(model):
+        sink.error(src.span(src.root), "E0480", f"'{src.file}' compiles to a number that is not finite "
+                   f"({what}); no output may hold one")
+        return None
     robot = _Builder(spec, model, files).robot()
     return None if sink.error_count > errors_before else robot
 
@@ -127,8 +135,9 @@ def _mujoco() -> Any:
     return mujoco
 
 
-def _compile(spec: Any, said: list[str]) -> Any:
-    """The compiled model; MuJoCo's warnings go to `said`, not to stderr nor to the
+@contextlib.contextmanager
+def _warnings_into(said: list[str]) -> Iterator[None]:
+    """MuJoCo's warnings inside the block go to `said`, not to stderr nor to the
     MUJOCO_LOG.TXT that MuJoCo would write into the working folder."""
     mujoco = _mujoco()
     before = mujoco.get_mju_user_warning()
@@ -138,10 +147,32 @@ def _compile(spec: Any, said: list[str]) -> Any:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             warned = caught
-            return spec.compile()
+            yield
     finally:
         mujoco.set_mju_user_warning(before)
         said += [str(w.message).strip() for w in warned]
+
+
+# The compiled numbers the robot is made of, and what each is (E0480).
+_NUMBERS = {"body_pos": "a body's position", "body_quat": "a body's orientation",
+            "body_mass": "a body's mass", "body_ipos": "a centre of mass", "body_iquat": "an inertial frame",
+            "body_inertia": "an inertia", "jnt_pos": "a joint's position", "jnt_axis": "a joint's axis",
+            "jnt_range": "a joint's range", "qpos0": "a joint's reference", "dof_damping": "a damping",
+            "dof_frictionloss": "a friction loss", "dof_armature": "an armature",
+            "jnt_stiffness": "a stiffness", "qpos_spring": "a spring reference", "geom_size": "a geom's size",
+            "geom_pos": "a geom's position", "geom_quat": "a geom's orientation", "geom_rgba": "a colour",
+            "mesh_pos": "a mesh's centre", "mesh_quat": "a mesh's axes", "mesh_scale": "a mesh's scale",
+            "site_pos": "a site's position", "site_quat": "a site's orientation", "key_qpos": "a keyframe",
+            "eq_data": "an equality's anchor", "actuator_gainprm": "an actuator's gain",
+            "actuator_biasprm": "an actuator's bias", "actuator_ctrlrange": "a control range",
+            "actuator_forcerange": "a force range", "actuator_gear": "a gear", "mat_rgba": "a colour",
+            "jnt_actfrcrange": "an actuator force range"}
+
+
+def _not_finite(model: Any) -> str | None:
+    """What the first number of the compiled model that is not finite is, or None."""
+    return next((what for name, what in _NUMBERS.items()
+                 if not np.all(np.isfinite(np.asarray(getattr(model, name))))), None)
 
 
 @dataclass
@@ -308,6 +339,16 @@ def msh_as_stl(data: bytes) -> Path | None:
     return entry
 
 
+def _fresh(name: str, taken: set[str]) -> str:
+    """`name`, or `name_2`, `name_3`, … when it is taken; the result is taken from then on."""
+    out, n = name, 1
+    while out in taken:
+        n += 1
+        out = f"{name}_{n}"
+    taken.add(out)
+    return out
+
+
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
     w, x, y, z = (float(v) for v in q / np.linalg.norm(q))
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -336,10 +377,14 @@ class _Builder:
         self.spec, self.m, self.files = spec, model, files
         self.unheld: Counter[str] = Counter()
         m = model
-        self.body_names = [m.body(b).name or f"body{b}" for b in range(m.nbody)]
-        self.body_names[0] = "world"
-        self.joint_names = [m.joint(j).name or f"{self.body_names[m.jnt_bodyid[j]]}_joint{j}"
-                            for j in range(m.njnt)]
+        # The names mpc makes (of unnamed elements, fixed joints, chain links, sites) never
+        # take one the file gives: a taken name gets _2, _3, …
+        self.link_taken = {"world", *(m.body(b).name for b in range(1, m.nbody))}
+        self.joint_taken = {m.joint(j).name for j in range(m.njnt)}
+        self.body_names = ["world"] + [m.body(b).name or _fresh(f"body{b}", self.link_taken)
+                                       for b in range(1, m.nbody)]
+        self.joint_names = [m.joint(j).name or _fresh(f"{self.body_names[m.jnt_bodyid[j]]}_joint{j}",
+                                                      self.joint_taken) for j in range(m.njnt)]
         self.links: dict[str, Link] = {}
         self.joints: dict[str, Joint] = {}
         self.materials: dict[str, Material] = {}
@@ -391,17 +436,19 @@ class _Builder:
         X = tf.inverse(self.shift[parent]) @ _X(m.body_pos[b], m.body_quat[b])
         parent_link = self.body_names[parent]
         if any(m.jnt_type[j] == _FREE for j in joints):
-            self.joints[f"{name}_floating"] = Joint(name=f"{name}_floating", type="floating",
-                                                    parent=parent_link, child=name, origin=_pose(X))
+            jname = _fresh(f"{name}_floating", self.joint_taken)
+            self.joints[jname] = Joint(name=jname, type="floating", parent=parent_link, child=name,
+                                       origin=_pose(X))
             return
         if not movable:
-            self.joints[f"{name}_fixed"] = Joint(name=f"{name}_fixed", type="fixed", parent=parent_link,
-                                                 child=name, origin=_pose(X))
+            jname = _fresh(f"{name}_fixed", self.joint_taken)
+            self.joints[jname] = Joint(name=jname, type="fixed", parent=parent_link, child=name,
+                                       origin=_pose(X))
             return
         previous = np.zeros(3)
         for k, j in enumerate(movable):
             jname = self.joint_names[j]
-            child = name if k == len(movable) - 1 else f"{name}__{jname}"
+            child = name if k == len(movable) - 1 else _fresh(f"{name}__{jname}", self.link_taken)
             if child != name:
                 self.links[child] = Link(name=child)
             X = X @ _X(m.jnt_pos[j] - previous)
@@ -528,13 +575,14 @@ class _Builder:
             b = int(m.site_bodyid[s])
             if skip_world and b == 0:
                 continue
-            name = m.site(s).name or f"{self.body_names[b]}_site{s}"
-            if name in self.links:
-                name = f"{name}_site"
+            site = m.site(s).name
+            wanted = f"{site}_site" if site in self.link_taken else site or f"{self.body_names[b]}_site{s}"
+            name = _fresh(wanted, self.link_taken)
             X = tf.inverse(self.shift[b]) @ _X(m.site_pos[s], m.site_quat[s])
-            self.links[name] = Link(name=name, span=self.files.spans("site").get(name))
-            self.joints[f"{name}_fixed"] = Joint(name=f"{name}_fixed", type="fixed",
-                                                 parent=self.body_names[b], child=name, origin=_pose(X))
+            self.links[name] = Link(name=name, span=self.files.spans("site").get(site))
+            jname = _fresh(f"{name}_fixed", self.joint_taken)
+            self.joints[jname] = Joint(name=jname, type="fixed", parent=self.body_names[b], child=name,
+                                       origin=_pose(X))
 
     def motors(self) -> dict[str, Motor]:
         m, out = self.m, {}

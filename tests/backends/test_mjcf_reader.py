@@ -432,3 +432,28 @@ def test_an_error_in_an_included_file_points_into_it(tmp_path: Path, diags: Diag
     e = diags.take_error("E0440")
     assert e.message == f"MuJoCo refuses '{path}': Schema violation: unrecognized attribute: 'rnge'"
     assert (e.span.file, e.span.line, e.span.col) == (str(leg), 3, 30)  # at rnge's value
+
+
+def test_a_number_that_is_not_finite_is_refused(tmp_path: Path, diags: Diags) -> None:
+    path = write(tmp_path / "n.xml", """
+        <mujoco><worldbody><body name="a" pos="nan 0 0"><joint/><geom size=".1"/></body></worldbody>
+        </mujoco>""")
+    assert _read(path, diags) is None
+    assert diags.take("W0441", Severity.WARNING).message == (
+        f"MuJoCo warns about '{path}': XML contains a 'NaN'. Please check it carefully.")
+    assert diags.take_error("E0480").message == (
+        f"'{path}' compiles to a number that is not finite (a body's position); no output may hold one")
+
+
+def test_the_names_mpc_makes_take_none_the_file_gives(tmp_path: Path, diags: Diags) -> None:
+    robot = _read(write(tmp_path / "c.xml", """
+        <mujoco><worldbody>
+          <body name="a"><joint name="b_fixed"/><geom size=".1"/><site name="a"/>
+            <body name="b"><geom size=".1"/></body></body>
+          <body><joint/><geom size=".1"/></body>
+          <body name="body3"/>
+        </worldbody></mujoco>"""), diags)
+    assert list(robot.links) == ["world", "a", "b", "body3_2", "body3", "a_site"]
+    assert {n: (j.parent, j.child) for n, j in robot.joints.items()} == {
+        "b_fixed": ("world", "a"), "b_fixed_2": ("a", "b"), "body3_2_joint1": ("world", "body3_2"),
+        "body3_fixed": ("world", "body3"), "a_site_fixed": ("a", "a_site")}
