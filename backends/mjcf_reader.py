@@ -191,19 +191,19 @@ class _Files:
     _spans: dict[str, dict[str, Span]] = field(default_factory=dict)
 
     def gather_includes(self, src: XmlSource) -> None:
-        """Every file `src` includes, nested ones too; MuJoCo finds them from the main
-        file's folder."""
+        """Every file `src` includes (`<include>`, and the `<model>` assets that `<attach>`
+        attaches), nested ones too; MuJoCo finds them from the main file's folder."""
         self.sources.append(src)
-        for el in src.root.iter("include"):
+        for el in src.root.iter("include", "model"):
             name = el.get("file", "")
             if not name or name in self.includes:
                 continue
             path = Path(name) if os.path.isabs(name) else self.base_dir / name
             if why := self.resolver.refusal(path, self.base_dir):
-                self.sink.error(src.span(el, "file"), "E0650", f"<include> '{name}' is not read: {why}")
+                self.sink.error(src.span(el, "file"), "E0650", f"<{el.tag}> '{name}' is not read: {why}")
                 continue
             if not path.is_file():
-                self.sink.error(src.span(el, "file"), "E0601", f"<include> '{name}' {why_absent(path)}")
+                self.sink.error(src.span(el, "file"), "E0601", f"<{el.tag}> '{name}' {why_absent(path)}")
                 continue
             included = load(path, self.sink, "MJCF")
             if included is None:

@@ -457,3 +457,27 @@ def test_the_names_mpc_makes_take_none_the_file_gives(tmp_path: Path, diags: Dia
     assert {n: (j.parent, j.child) for n, j in robot.joints.items()} == {
         "b_fixed": ("world", "a"), "b_fixed_2": ("a", "b"), "body3_2_joint1": ("world", "body3_2"),
         "body3_fixed": ("world", "body3"), "a_site_fixed": ("a", "a_site")}
+
+
+def test_an_attached_model_is_read_like_an_include(tmp_path: Path, diags: Diags) -> None:
+    """`<attach>` takes a `<model>` asset's file: read by mpc (the read rule, the fingerprint)
+    and handed to MuJoCo, which attaches it with its prefix."""
+    from mpc.core.reads import ReadRecorder, recording
+
+    write(tmp_path / "sub" / "grip.xml", """
+        <mujoco model="g"><worldbody><body name="g"><joint name="gj" range="-1 1"/><geom size=".1"/></body>
+        </worldbody></mujoco>""")
+    path = write(tmp_path / "r.xml", """
+        <mujoco><asset><model name="grip" file="sub/grip.xml"/></asset>
+          <worldbody><body name="a"><joint name="j"/><geom size=".1"/>
+            <attach model="grip" body="g" prefix="l_"/></body></worldbody></mujoco>""")
+    with recording(ReadRecorder()) as recorder:
+        robot = _read(path, diags)
+    assert robot.joints["l_gj"].parent == "a" and robot.joints["l_gj"].limit.upper == pytest.approx(
+        np.pi / 180)
+    assert tmp_path / "sub" / "grip.xml" in recorder.inputs()
+    missing = write(tmp_path / "m.xml", """
+        <mujoco><asset><model name="grip" file="sub/nope.xml"/></asset><worldbody/></mujoco>""")
+    assert _read(missing, diags) is None
+    assert diags.take_error("E0601").message == (
+        f"<model> 'sub/nope.xml' does not exist")
