@@ -480,4 +480,4 @@ def test_an_attached_model_is_read_like_an_include(tmp_path: Path, diags: Diags)
         <mujoco><asset><model name="grip" file="sub/nope.xml"/></asset><worldbody/></mujoco>""")
     assert _read(missing, diags) is None
     assert diags.take_error("E0601").message == (
-        f"<model> 'sub/nope.xml' does not exist")
+        "<model> 'sub/nope.xml' does not exist")
