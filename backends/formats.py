@@ -109,6 +109,12 @@ def _write_mjcf(robot: Robot, export: Any, out: Path, sink: Sink) -> None:
     mjcf.emit(robot, export, out, sink)
 
 
+def _read_mjcf(path: Path, sink: Sink, resolver: PackageResolver | None) -> Robot | None:
+    from mpc.backends import mjcf_reader
+
+    return mjcf_reader.read(path, sink, resolver)
+
+
 def _mjcf_holds() -> Sequence[Tally]:
     from mpc.backends import mjcf
 
@@ -164,7 +170,8 @@ _FORMATS = (
     Format("sdf", program.SdfExport, _write_sdf, _read_sdf, (".sdf",), kept=True,
            float_keys=SDF_KEYS, numbers="element of an SDF", meshes=Meshes(), package_paths=True,
            exact_inertials=True, in_smurf=True, holds=_sdf_holds),
-    Format("mjcf", program.MjcfExport, _write_mjcf, kept=True, float_keys=MJCF_KEYS,
+    Format("mjcf", program.MjcfExport, _write_mjcf, _read_mjcf, (".xml", ".mjcf"), kept=True,
+           float_keys=MJCF_KEYS,
            numbers="attribute of an MJCF", meshes=Meshes(input_type="obj"),
            cut_joints="MJCF always closes loops with equality constraints", exact_inertials=True,
            holds=_mjcf_holds),

@@ -138,6 +138,23 @@ def _mass_ok(inertial: Inertial | None) -> bool:
             and min(principal(inertial)[0]) >= MJMINVAL)
 
 
+def passes_through(robot: Robot, link: Link, joint: Joint | None, children: list[Joint]) -> Joint | None:
+    """The one joint below `link` when the link only passes motion on: it moves by a 1-dof
+    `joint`, has no mass, shapes or loop closure, and one 1-dof child joint that does not turn
+    the frame (an MJCF input's body with several joints, backends/mjcf_reader.py). MuJoCo refuses
+    a moving body without mass, so the link's joint goes into its child's body (MuJoCo applies
+    a body's joints in order); else None."""
+    if not _one_dof(joint) or link.visuals or link.collisions or len(children) != 1 \
+            or not _one_dof(children[0]) or (children[0].origin is not None and any(children[0].origin.rpy)):
+        return None
+    inertial = link.inertial
+    if inertial is not None and (inertial.mass != 0 or any(principal(inertial)[0])):
+        return None
+    if any(link.name in (c.parent, c.child) for c in robot.cut_joints.values()):
+        return None
+    return children[0]
+
+
 def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = None) -> bool:
     """Report (E0504) each link whose mass properties MuJoCo would refuse or change, by its
     rules: mass and principal moments not negative (MuJoCo clamps them to 0), moments
@@ -146,6 +163,7 @@ def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = N
     check`: those the finished robot keeps)."""
     children, ok = child_joints(robot), True
     moving = {j.child for j in robot.joints.values() if j.type != "fixed"}
+    parent_joint = {j.child: j for j in robot.joints.values()}
     order = [link for _, link in depth_first(robot)]
     welded_mass: dict[str, bool] = {}  # a link welded below it carries mass; from the leaves up
     for link in reversed(order):
@@ -172,7 +190,8 @@ def check(robot: Robot, sink: Sink, span: Span, only: Collection[str] | None = N
             elif a + b < c:
                 problems.append(f"its principal moments violate A + B ≥ C ({fmt_float(a)} + "
                                 f"{fmt_float(b)} < {fmt_float(c)})")
-        if link in moving and not _mass_ok(inertial) and not welded_mass[link]:
+        if link in moving and not _mass_ok(inertial) and not welded_mass[link] and passes_through(
+                robot, robot.links[link], parent_joint.get(link), children.get(link, [])) is None:
             problems.append(f"it moves but its mass or a principal moment is below mjMINVAL "
                             f"({MJMINVAL:g}) and no link welded to it carries mass")
         if problems and (only is None or link in only):
@@ -418,9 +437,10 @@ class _Writer:
                                       ("quat", fmt_floats(q) if q != (1.0, 0.0, 0.0, 0.0) else None),
                                       ("mass", fmt_float(inertial.mass)), ("diaginertia", fmt_floats(d))])
 
-    def _emit_joint(self, depth: int, joint: Joint, top: bool) -> None:
+    def _emit_joint(self, depth: int, joint: Joint, top: bool, pos: np.ndarray | None = None) -> None:
         axis = joint.axis or (1.0, 0.0, 0.0)
         dyn = joint.dynamics
+        at = ("pos", fmt_floats([float(c) for c in pos])) if pos is not None and pos.any() else ("pos", None)
         common: Pairs = [
             ("damping", fmt_float(dyn.damping) if dyn and dyn.damping else None),
             ("frictionloss", fmt_float(dyn.friction) if dyn and dyn.friction else None)]
@@ -431,7 +451,7 @@ class _Writer:
             r = _limits(joint)
             rng: Pairs = [("limited", "true"), ("range", fmt_floats(r))] if r and r[0] < r[1] else []
             kind = "slide" if joint.type == "prismatic" else "hinge"
-            self.leaf(depth, "joint", [("name", joint.name), ("type", kind), ("axis", fmt_floats(axis)),
+            self.leaf(depth, "joint", [("name", joint.name), ("type", kind), at, ("axis", fmt_floats(axis)),
                                        *rng, *common])
             self.qpos.append((joint.name, 0.0))
         elif joint.type == "floating" and top:
@@ -463,13 +483,28 @@ class _Writer:
                 self.out.append(item)
                 continue
             depth, joint, link = item
-            pose = _pose_pairs(joint.origin if joint is not None else None)
+            # Links that only pass motion on join the body below them, their joints with it.
+            chain: list[Joint] = []  # the joints below `joint` that join its body
+            X = pose_matrix(joint.origin if joint is not None else None)
+            while (below := passes_through(self.robot, link, chain[-1] if chain else joint,
+                                           self._child_bodies(link))) is not None:
+                chain.append(below)
+                X = X @ pose_matrix(below.origin)
+                link = self.robot.links[below.child]
+            pose = _pose_pairs(matrix_pose(X) if chain else joint.origin if joint is not None else None)
             self.out.append(f"{IND * depth}<body{self.attrs([('name', link.name), *pose])}>")
             d = depth + 1
             if link.inertial is not None:
                 self._emit_inertial(d, link.inertial)
+            anchor = np.zeros(3)  # each joint's place in the body: minus the origins below it
+            anchors = []
+            for j in reversed(chain):
+                anchors.append(anchor.copy())
+                anchor = anchor - np.asarray(j.origin.xyz if j.origin is not None else (0.0, 0.0, 0.0))
             if joint is not None:
-                self._emit_joint(d, joint, top)
+                self._emit_joint(d, joint, top, anchor if chain else None)
+            for j, at in zip(chain, reversed(anchors), strict=True):
+                self._emit_joint(d, j, top, at)
             self._emit_geoms(d, link)
             todo.append(f"{IND * depth}</body>")
             todo.extend((d, j, self.robot.links[j.child]) for j in reversed(self._child_bodies(link)))

@@ -44,8 +44,8 @@ class Model:
 
 
 def read_model(path: Path, sink: Sink) -> Robot | None:
-    """A model file → a robot, read by the format its suffix names (backends/formats.py; a file
-    of no known suffix as URDF); diagnostics go to `sink`.
+    """A model file (URDF, SDF, SMURF, MJCF) → a robot, read by the format its suffix names
+    (backends/formats.py; a file of no known suffix as URDF); diagnostics go to `sink`.
 
     A SMURF (Phobos names one as compare model) is read with its annotations: cut joints,
     motors and submechanisms take part in the dynamics tests."""

@@ -161,7 +161,7 @@ def _path_list(variable: str) -> list[str]:
 
 # The folders of a model's files in the layout mpc and Phobos write (`urdf/robot.urdf`,
 # `meshes/stl/…`): a file in one may name the files of the folder above (PackageResolver.refusal).
-MODEL_FOLDERS = frozenset({"urdf", "sdf", "smurf"})
+MODEL_FOLDERS = frozenset({"urdf", "sdf", "smurf", "mjcf"})
 
 
 @dataclass

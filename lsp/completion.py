@@ -27,7 +27,8 @@ VALUE_NAMES = {"parent": "link", "child": "link", "take_leaf": "link", "remove_b
                 "parent_link": "link", "joint": "joint", "joints": "joint", "material": "material",
                 "mimic": "joint", "movement_depends_on": "joint", "collision": "collision",
                 "visual": "visual", "links": "link", "exclude": "link", "$exclude": "link"}
-_FILES = {"basefile": (".urdf", ".sdf", ".smurf", ".xacro"), "derived_base": (".yml", ".yaml"),
+_FILES = {"basefile": (".urdf", ".sdf", ".smurf", ".xml", ".mjcf", ".xacro"),
+          "derived_base": (".yml", ".yaml"),
           "defaults": (".yml", ".yaml")}
 
 

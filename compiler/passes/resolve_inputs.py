@@ -6,11 +6,13 @@
 
 from __future__ import annotations
 
+from mpc.backends.formats import FORMATS
 from mpc.compiler.passes.context import PassContext
 from mpc.core.files import why_absent
 from mpc.ir.program import Program
 
-READABLE = (".urdf", ".sdf", ".smurf", ".xacro")
+# The suffixes of the formats' readers (backends/formats.py), and xacro (compiler/inputs.py).
+READABLE = (*(s for f in FORMATS.values() if f.read is not None for s in f.suffixes), ".xacro")
 
 
 def resolve_inputs(program: Program, ctx: PassContext) -> Program:
@@ -29,6 +31,6 @@ def resolve_inputs(program: Program, ctx: PassContext) -> Program:
                            f"'{inp.name}' {why_absent(inp.path)}")
         elif inp.kind == "basefile" and inp.path.suffix.lower() not in READABLE:
             ctx.sink.error(inp.span, "E0202", f"reading '{inp.path.suffix}' input models is not "
-                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf) and xacro "
-                           "(.xacro)")
+                           "supported yet; mpc reads URDF (.urdf), SDF (.sdf), SMURF (.smurf), MJCF (.xml, "
+                           ".mjcf) and xacro (.xacro)")
     return program

@@ -41,6 +41,18 @@ SITES: dict[tuple[str, str, str], str] = {
     ("kccd_tools.py", "run_tools", "confined(folder, f'{robot}.cfg')"): PASSED,
     ("kccd_tools.py", "run_tools", "confined(folder, f'{robot}.urdf')"): PASSED,
     ("kccd_tools.py", "_run", "Path(command[0])"): "the tool's name in a message",
+    ("mjcf_reader.py", "_quat_matrix", "q / np.linalg.norm(q)"): MATH,
+    ("mjcf_reader.py", "gather_includes", "Path(name)"): READ,
+    ("mjcf_reader.py", "gather_includes", "self.base_dir / name"): READ,
+    ("mjcf_reader.py", "gather_meshes", "os.path.join(meshdir, mesh.file)"): READ,
+    ("mjcf_reader.py", "gather_meshes", "self.base_dir / uri"): READ,
+    ("mjcf_reader.py", "gather_meshes", "os.path.join(spec.modelfiledir, uri)"):
+        "the name MuJoCo looks a mesh up by among the files handed to it; no file",
+    ("mjcf_reader.py", "gather_other_files", "os.path.join(folder, file)"): READ,
+    ("mjcf_reader.py", "gather_other_files", "self.base_dir / uri"): READ,
+    ("mjcf_reader.py", "gather_other_files", "os.path.join(spec.modelfiledir, uri)"):
+        "the name MuJoCo looks a file up by among the files handed to it; no file",
+    ("mjcf_reader.py", "msh_as_stl", "cache_dir('msh') / f'{hashlib.sha256(data).hexdigest()}.stl'"): CACHE,
     ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2] / f'{digest}{suffix}'"): CACHE,
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2]"): CACHE,

@@ -57,7 +57,7 @@ def test_the_number_keys_of_a_format_are_named_for_its_errors() -> None:
 
 
 @pytest.mark.parametrize(("name", "format_name"), [
-    ("a.urdf", "urdf"), ("a.URDF", "urdf"), ("a.sdf", "sdf"), ("a.smurf", "smurf"), ("a.xml", "urdf"),
+    ("a.urdf", "urdf"), ("a.URDF", "urdf"), ("a.sdf", "sdf"), ("a.smurf", "smurf"), ("a.xml", "mjcf"),
     ("a", "urdf")])
 def test_an_input_file_is_read_by_the_format_of_its_suffix(name: str, format_name: str) -> None:
     assert reader_of(Path(name)).name == format_name
