@@ -37,7 +37,7 @@ import re
 import warnings
 from collections import Counter
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -61,6 +61,7 @@ from mpc.ir.robot import (
     Limit,
     Link,
     Material,
+    Mimic,
     Pose,
     Robot,
     Visual,
@@ -69,6 +70,7 @@ from mpc.ir.robot import (
 UNBOUNDED = 1e16  # an unlimited slide's range in the IR (a prismatic joint needs one)
 COLLISION_GROUP = 3  # Menagerie's group of collision-only geoms
 _FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3
+_EQ_JOINT = 2  # mjEQ_JOINT
 _MESH_GEOM, _PRIMITIVES = 7, {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
 _UNHELD_GEOMS = {0: "plane", 1: "height field", 4: "ellipsoid", 8: "sdf"}
 # What a compiled model counts that the IR has no place for (its name in W0440 → MjModel's count).
@@ -405,6 +407,8 @@ class _Builder:
         for b in range(0 if not floating else 1, m.nbody):
             self.body(b, joints_of[b], root_body=floating and b == top[0])
         self.sites(skip_world=floating)
+        for name, mimic in self.mimics().items():
+            self.joints[name] = replace(self.joints[name], mimic=mimic)
         robot = Robot(name=self.spec.modelname or self.files.src.file, root=root, links=self.links,
                      joints=self.joints, materials=self.materials, motors=self.motors(),
                      cut_joints=self.cut_joints(), poses=self.poses(),
@@ -619,6 +623,8 @@ class _Builder:
         W = self.world_frames()
         for e in range(m.neq):
             kind, objtype = int(m.eq_type[e]), int(m.eq_objtype[e])
+            if self.mimic_of(e) is not None:
+                continue  # a joint's mimic (`mimics`)
             if kind not in (0, 1) or objtype != 1:  # connect and weld between bodies
                 self.unheld["equality other than a connect or weld of bodies"] += 1
                 continue
@@ -635,6 +641,24 @@ class _Builder:
                                  child=child, origin=matrix_pose(X_PC),
                                  annotations={"joint_origin": {"xyz": list(jo.xyz), "rpy": list(jo.rpy)}})
         return out
+
+    def mimic_of(self, e: int) -> tuple[str, Mimic] | None:
+        """A joint equality that is linear (polycoef's quadratic and higher terms 0) between two
+        joints of the robot → (the follower, its mimic), as the MJCF export writes a mimic; else
+        None. The IR's zero is each joint's `ref`: the offset is moved by both refs."""
+        m = self.m
+        if int(m.eq_type[e]) != _EQ_JOINT:  # its objtype is not set in the compiled model
+            return None
+        j1, j2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        c = m.eq_data[e][:5]
+        if j1 not in self.ir_joint or j2 not in self.ir_joint or any(c[2:5]):
+            return None
+        ref1, ref2 = (float(m.qpos0[m.jnt_qposadr[j]]) for j in (j1, j2))
+        return self.ir_joint[j1], Mimic(joint=self.ir_joint[j2], multiplier=float(c[1]),
+                                        offset=float(c[0]) + float(c[1]) * ref2 - ref1)
+
+    def mimics(self) -> dict[str, Mimic]:
+        return dict(found for e in range(self.m.neq) if (found := self.mimic_of(e)) is not None)
 
     def poses(self) -> dict[str, dict[str, float]]:
         m, out = self.m, {}

@@ -20,7 +20,6 @@ from mpc.core.span import Span
 from mpc.ir.robot import Robot
 
 DEFINITION_SUFFIXES = (".yml", ".yaml", ".ir")
-NOT_READ = {".xml": "MJCF", ".mjcf": "MJCF"}  # written by mpc; refused while no reader takes them
 
 
 class BadSide(Exception):
@@ -61,7 +60,6 @@ def load_side(text: str, sink: Sink, work: Path) -> Side | None:
 
 
 def _read(path: Path, sink: Sink, work: Path) -> tuple[Robot | None, Path | None]:
-    from mpc.backends.formats import reader_of
     from mpc.checks.models import MODEL_PATTERNS, model_in_folder, read_model
 
     if path.is_dir():
@@ -74,10 +72,6 @@ def _read(path: Path, sink: Sink, work: Path) -> tuple[Robot | None, Path | None
     suffix = path.suffix.lower()
     if suffix in DEFINITION_SUFFIXES:
         return _compiled(path, sink, work)
-    if suffix in NOT_READ and suffix not in reader_of(path).suffixes:  # until a reader comes
-        sink.error(Span.of_file(str(path)), "E0740", f"mpc writes {NOT_READ[suffix]} but cannot read it; "
-                   "compare the URDF, SDF or SMURF of the same build, or its definition")
-        return None, None
     return read_model(path, sink), path
 
 

@@ -262,6 +262,25 @@ def test_connect_and_weld_become_loop_closures(tmp_path: Path, diags: Diags) -> 
     assert c.annotations["joint_origin"]["xyz"] == [-1.0, 0.0, 0.0]
 
 
+def test_a_linear_joint_equality_is_a_mimic(tmp_path: Path, diags: Diags) -> None:
+    robot = _read(write(tmp_path / "m.xml", """
+        <mujoco model="m">
+          <compiler angle="radian"/>
+          <worldbody><body name="a"><joint name="ja" axis="0 1 0"/><geom type="sphere" size="0.1"/>
+            <body name="b" pos="1 0 0"><joint name="jb" axis="0 1 0" ref="0.2"/>
+              <geom type="sphere" size="0.1"/>
+              <body name="c" pos="1 0 0"><joint name="jc" axis="0 1 0"/><geom type="sphere" size="0.1"/>
+          </body></body></body></worldbody>
+          <equality><joint joint1="jb" joint2="ja" polycoef="0.5 -2 0 0 0"/>
+            <joint joint1="jc" joint2="ja" polycoef="0 1 0.3 0 0"/></equality>
+        </mujoco>"""), diags)
+    mimic = robot.joints["jb"].mimic  # q_jb = 0.5 - 2 q_ja, in the IR's zero at jb's ref
+    assert (mimic.joint, mimic.multiplier, mimic.offset) == ("ja", -2.0, pytest.approx(0.3, abs=1e-15))
+    assert robot.joints["jc"].mimic is None  # a quadratic term: no mimic
+    assert diags.take("W0440", Severity.WARNING).message.endswith(
+        "holds what mpc's robot model cannot: equality other than a connect or weld of bodies ×1; left out")
+
+
 def test_mujoco_errors_point_at_file_line_and_column(tmp_path: Path, diags: Diags) -> None:
     path = write(tmp_path / "bad.xml", """
         <mujoco>

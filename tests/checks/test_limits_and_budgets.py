@@ -43,7 +43,8 @@ def test_the_unchanged_model_passes_joint_limits(tmp_path: Path) -> None:
     protocol = _tested(tmp_path, ARM, "      - joint_limits\n", release=ARM)
     limits = result(protocol, "joint_limits")
     assert (limits.status, limits.reason) == ("passed", "the limits of 2 movable joints agree")
-    assert protocol.changes == () and "**0 changes** beyond the tolerances (`mpc diff`).\n" in protocol.markdown()
+    assert protocol.changes == ()
+    assert "**0 changes** beyond the tolerances (`mpc diff`).\n" in protocol.markdown()
 
 
 def test_the_protocol_starts_with_the_diff_against_the_release(tmp_path: Path) -> None:
