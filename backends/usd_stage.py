@@ -252,19 +252,22 @@ class Author:
         return root.name if root.name == "world" and massless else None
 
     def body(self, prim: Usd.Prim, link: str) -> None:
+        """RigidBodyAPI and MassAPI: mass, centre of mass, and the principal moments and axes
+        (mjcf.principal). A link without inertial, or with a zero tensor, gets mass and centre
+        of mass only: UsdPhysics reads a zero diagonal inertia as "not given", and its
+        validator refuses one authored."""
         UsdPhysics.RigidBodyAPI.Apply(prim)
         mass = UsdPhysics.MassAPI.Apply(prim)
         inertial = self.robot.links[link].inertial
-        if inertial is None:  # massless: a frame
-            mass.CreateMassAttr(0.0)
-            mass.CreateDiagonalInertiaAttr(Gf.Vec3f(0.0, 0.0, 0.0))
+        mass.CreateMassAttr(float(inertial.mass) if inertial is not None else 0.0)
+        if inertial is None:
             return
-        d, q = principal(inertial)
         xyz = inertial.origin.xyz if inertial.origin is not None else (0.0, 0.0, 0.0)
-        mass.CreateMassAttr(float(inertial.mass))
         mass.CreateCenterOfMassAttr(Gf.Vec3f(*xyz))
-        mass.CreateDiagonalInertiaAttr(Gf.Vec3f(*d))
-        mass.CreatePrincipalAxesAttr(Gf.Quatf(q[0], Gf.Vec3f(q[1], q[2], q[3])))
+        d, q = principal(inertial)
+        if any(d):
+            mass.CreateDiagonalInertiaAttr(Gf.Vec3f(*d))
+            mass.CreatePrincipalAxesAttr(Gf.Quatf(q[0], Gf.Vec3f(q[1], q[2], q[3])))
 
     def filtered_pairs(self) -> None:
         """Links none of whose collisions share a bitmask bit with the other's never collide:
