@@ -27,7 +27,8 @@ URDF = """\
 <robot name="toy bot">
   <material name="red"><color rgba="1 0 0 1"/></material>
   <link name="base">
-    <inertial><mass value="2"/><inertia ixx="0.1" ixy="0.01" ixz="0" iyy="0.2" iyz="0" izz="0.25"/></inertial>
+    <inertial><mass value="2"/>
+      <inertia ixx="0.1" ixy="0.01" ixz="0" iyy="0.2" iyz="0" izz="0.25"/></inertial>
     <visual><geometry><box size="0.2 0.3 0.1"/></geometry><material name="red"/></visual>
     <collision name="base_box"><geometry><box size="0.2 0.3 0.1"/></geometry></collision>
   </link>
@@ -37,17 +38,21 @@ URDF = """\
     <collision name="arm_cyl"><geometry><cylinder radius="0.05" length="0.3"/></geometry></collision>
   </link>
   <link name="slider">
-    <inertial><mass value="0.5"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>
+    <inertial><mass value="0.5"/>
+      <inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>
     <collision name="slider_ball"><geometry><sphere radius="0.04"/></geometry></collision>
   </link>
   <link name="wheel">
-    <inertial><mass value="0.3"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="2e-3"/></inertial>
+    <inertial><mass value="0.3"/>
+      <inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="2e-3"/></inertial>
   </link>
   <link name="finger">
-    <inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
+    <inertial><mass value="0.1"/>
+      <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
   </link>
   <link name="pusher">
-    <inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
+    <inertial><mass value="0.1"/>
+      <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
   </link>
   <link name="tip"/>
   <joint name="shoulder" type="revolute">
