@@ -55,7 +55,7 @@ from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.tree import child_joints, depth_first
 
 __all__ = ["MAX_BODY_DEPTH", "body_depth", "check", "cut_axis", "cut_sites", "emit", "left_out", "principal",
-           "quat_matrix", "to_string"]
+           "to_string"]
 
 Quat = tuple[float, float, float, float]
 # MuJoCo parses MJCF with tinyxml2, which refuses elements nested deeper than 500: <mujoco>,
@@ -83,7 +83,7 @@ def _quat_rpy(rpy: tuple[float, float, float]) -> Quat:
     return q if q[0] >= 0 else (-q[0], -q[1], -q[2], -q[3])
 
 
-def quat_matrix(R: np.ndarray) -> Quat:
+def _quat_matrix(R: np.ndarray) -> Quat:
     """(w, x, y, z) of a rotation matrix; w ≥ 0."""
     from scipy.spatial.transform import Rotation  # not on `mpc check`'s path (front_end.check_inertials)
 
@@ -112,7 +112,7 @@ def principal(inertial: Inertial) -> tuple[tuple[float, float, float], Quat]:
         V[:, 2] = -V[:, 2]
     big = float(np.max(np.abs(w)))
     d = tuple(0.0 if abs(x) <= 1e-12 * big else float(x) for x in w)
-    return d, quat_matrix(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
+    return d, _quat_matrix(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
 
 
 def unusable_inertial(inertial: Inertial) -> str | None:

@@ -45,11 +45,14 @@ def read_ply(data: bytes) -> Triangles | None:
     if [e[0] for e in elements] != ["vertex", "face"]:
         return None
     (_, nv, vprops), (_, nf, fprops) = elements
-    if any(p[0] == "list" or p[0] not in _SCALARS for p in vprops) or len(fprops) != 1 \
+    scalar = [p for p in (*vprops, *fprops[1:]) if len(p) == 2 and p[0] in _SCALARS]
+    if len(scalar) != len(vprops) + len(fprops) - 1 or not fprops or len(fprops[0]) != 4 \
             or fprops[0][0] != "list" or fprops[0][1] not in _SCALARS or fprops[0][2] not in _SCALARS:
         return None
     vtype = np.dtype([(p[1], _SCALARS[p[0]]) for p in vprops])
-    ftype = np.dtype([("n", _SCALARS[fprops[0][1]]), ("i", _SCALARS[fprops[0][2]], (3,))])
+    # the face's list first (three indices, trimesh's triangles), then its other properties
+    ftype = np.dtype([("n", _SCALARS[fprops[0][1]]), ("i", _SCALARS[fprops[0][2]], (3,)),
+                      *((f"_{k}", _SCALARS[p[0]]) for k, p in enumerate(fprops[1:]))])
     start = end + len(b"end_header\n")
     if len(data) < start + nv * vtype.itemsize + nf * ftype.itemsize:
         return None

@@ -30,10 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade, Vt
 
-from mpc.backends.mjcf import cut_sites, principal, quat_matrix
+from mpc.backends.mjcf import cut_sites, principal
 from mpc.backends.usd_kinds import ONE_DOF, closed_cut_axis, mimic_written, written_cut
 from mpc.backends.usd_meshes import Triangles
 from mpc.backends.usd_names import sibling_names, unique_identifiers
+from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, ConvexHull, ConvexPart, Cylinder, Geometry, Mesh, Sphere
 from mpc.ir.kinematics import links_in_root, pose_matrix
@@ -55,12 +56,12 @@ class Layers:
 
 
 def quatd(R: np.ndarray) -> Gf.Quatd:
-    w, x, y, z = quat_matrix(R)
+    w, x, y, z = tf.matrix_to_quat(R)
     return Gf.Quatd(w, Gf.Vec3d(x, y, z))
 
 
 def quatf(R: np.ndarray) -> Gf.Quatf:
-    w, x, y, z = quat_matrix(R)
+    w, x, y, z = tf.matrix_to_quat(R)
     return Gf.Quatf(w, Gf.Vec3f(x, y, z))
 
 
