@@ -27,7 +27,7 @@ from mpc.core.diagnostics import Sink
 from mpc.core.files import confined
 from mpc.ir.geometry import Mesh
 from mpc.ir.program import UsdExport
-from mpc.ir.robot import Robot
+from mpc.ir.robot import Inertial, Robot
 
 __all__ = ["CANNOT_HOLD", "PARTS", "emit", "layers_text", "left_out"]
 
@@ -61,6 +61,16 @@ def _beyond_colour(robot: Robot, options: holds.Options) -> int:
         for m in (*robot.materials.values(), *(m for m in inline if m is not None)))
 
 
+def _no_mass(inertial: Inertial | None) -> bool:
+    """No inertial, mass 0, or a zero inertia tensor: what UsdPhysics reads as "not given"."""
+    if inertial is None or inertial.mass == 0:
+        return True
+    i = inertial.inertia
+    return not any((i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz))
+
+
+_NO_MASS = "massless or point-mass"
+_COMPUTED = " with collision shapes (UsdPhysics reads mass or inertia 0 as \"compute it from the shapes\")"
 _C = holds.Counted
 # What the USD cannot hold, in the order W0500 names it.
 CANNOT_HOLD: tuple[holds.Tally, ...] = (
@@ -68,6 +78,8 @@ CANNOT_HOLD: tuple[holds.Tally, ...] = (
     holds.count(_C("pose", "poses"), lambda r, o: len(r.poses)),
     holds.count(_C("submechanism", "submechanisms"), lambda r, o: len(r.submechanisms)),
     holds.count(_C("annotation category", "annotation categories"), lambda r, o: len(r.annotations)),
+    holds.count(_C(f"{_NO_MASS} link{_COMPUTED}", f"{_NO_MASS} links{_COMPUTED}"), lambda r, o: sum(
+        bool(lk.collisions) and _no_mass(lk.inertial) for lk in r.links.values())),
     holds.count(_C("planar joint", "planar joints"), lambda r, o: sum(
         j.type == "planar" for j in r.joints.values())),
     holds.count(_C("joint velocity limit", "joint velocity limits"), lambda r, o: sum(
