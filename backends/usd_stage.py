@@ -16,7 +16,9 @@ component) to the joint's axis, so localRot0 = R_PJ·R_a and localRot1 = R_a. Re
 in degrees, prismatic in metres; continuous: no limits. A motor is a DriveAPI (angular or
 linear, type force): stiffness p and damping d of its settings, per degree for an angular
 drive, maxForce the joint's effort limit. Mimic joints carry NewtonMimicAPI (Newton's schema:
-joint0 = coef0 + coef1·joint1, coef0 in degrees for a revolute joint). Loop closures
+joint0 = coef0 + coef1·joint1, coef0 in degrees for a revolute joint); velocity limits,
+damping and friction NewtonJointAPI (`newton:velocityLimit`, `newton:damping`,
+`newton:friction`, per degree on a rotational joint), as NVIDIA's converter writes them. Loop closures
 (cut joints) are joints excluded from the articulation: fixed, spherical (ball) and revolute
 (with an axis); W0500 names the others.
 """
@@ -318,6 +320,25 @@ class Author:
         _name(usd_joint.GetPrim(), j.name)
         self._frame(usd_joint, j.parent, j.child, pose_matrix(j.origin), np.eye(4), R_a)
         self.drive(usd_joint.GetPrim(), j)
+        self.dynamics(usd_joint.GetPrim(), j)
+
+    def dynamics(self, prim: Usd.Prim, j: Joint) -> None:
+        """The joint's velocity limit, damping and friction as NewtonJointAPI holds them (per
+        degree on a rotational joint); UsdPhysics has none."""
+        if j.type not in ONE_DOF:
+            return
+        angular = j.type != "prismatic"
+        values = [("newton:velocityLimit", j.limit.velocity if j.limit is not None else None,
+                   DEG if angular else 1.0),
+                  ("newton:damping", j.dynamics.damping if j.dynamics is not None else None,
+                   1 / DEG if angular else 1.0),
+                  ("newton:friction", j.dynamics.friction if j.dynamics is not None else None, 1.0)]
+        given = [(name, float(value) * unit) for name, value, unit in values if value is not None]
+        if not given:
+            return
+        prim.AddAppliedSchema("NewtonJointAPI")
+        for name, value in given:
+            prim.CreateAttribute(name, Sdf.ValueTypeNames.Float, custom=False).Set(value)
 
     def drive(self, prim: Usd.Prim, j: Joint) -> None:
         """The motor of a one-degree-of-freedom joint as a DriveAPI (see the module)."""

@@ -36,6 +36,8 @@ def read(path: str) -> dict[str, Any]:
                            else None, "coeffs": [float(c) for c in builder.joint_mimic_coeffs[i]]}
                    for i, label in enumerate(joints)},
         "dof_limits": {joints[i]: [float(lo), float(hi)] for i, lo, hi in _dof_limits(builder, model)},
+        "velocity_limits": {joints[i]: float(v) for i, v in _per_dof(builder, model.joint_velocity_limit)},
+        "frictions": {joints[i]: float(v) for i, v in _per_dof(builder, model.joint_friction)},
     }
 
 
@@ -45,6 +47,13 @@ def _dof_limits(builder: Any, model: Any) -> list[tuple[int, float, float]]:
     starts = [*builder.joint_qd_start, len(lower)]
     return [(i, lower[starts[i]], upper[starts[i]]) for i in range(len(builder.joint_label))
             if starts[i + 1] - starts[i] == 1]
+
+
+def _per_dof(builder: Any, values: Any) -> list[tuple[int, float]]:
+    """(joint, value) of each joint with one degree of freedom."""
+    array = values.numpy()
+    starts = [*builder.joint_qd_start, len(array)]
+    return [(i, array[starts[i]]) for i in range(len(builder.joint_label)) if starts[i + 1] - starts[i] == 1]
 
 
 def newton_reads(paths: list[Path]) -> dict[str, dict[str, Any]]:

@@ -59,6 +59,7 @@ URDF = """\
     <parent link="base"/><child link="arm 1"/>
     <origin xyz="0.1 0 0.05" rpy="0.1 0.2 0.3"/><axis xyz="0 1 0"/>
     <limit lower="-1.2" upper="0.8" effort="30" velocity="2"/>
+    <dynamics damping="0.5" friction="0.25"/>
   </joint>
   <joint name="slide" type="prismatic">
     <parent link="arm 1"/><child link="slider"/>
@@ -109,8 +110,8 @@ model:
       layout: single
       filename_suffix: _single
 """
-LEFT_OUT = ("the USD leaves out what it cannot hold: 4 joint velocity limits, 1 mimic of or by a joint "
-            "of another kind or without one degree of freedom")
+LEFT_OUT = ("the USD leaves out what it cannot hold: 1 mimic of or by a joint of another kind or without "
+            "one degree of freedom")
 DEG = 180 / math.pi
 
 
@@ -173,15 +174,16 @@ def test_the_stage_says_metres_kilograms_z_up_and_its_default_prim(stage: Usd.St
 def test_the_layered_layout_is_an_interface_with_a_payload_of_three_layers(built: Path) -> None:
     folder = built / "usd"
     assert sorted(str(p.relative_to(folder)) for p in folder.rglob("*")) == [
-        "toy.usda", "toy_payload", "toy_payload/contents.usda", "toy_payload/geometry.usda",
+        "toy.usda", "toy_payload", "toy_payload/contents.usda", "toy_payload/geometry.usdc",
         "toy_payload/materials.usda", "toy_payload/physics.usda", "toy_single.usda"]
     interface = Sdf.Layer.FindOrOpen(str(folder / "toy.usda"))
     assert [p.assetPath for p in interface.GetPrimAtPath("/toy").payloadList.prependedItems] == [
         "./toy_payload/contents.usda"]
     contents = Sdf.Layer.FindOrOpen(str(folder / "toy_payload/contents.usda"))
-    assert list(contents.subLayerPaths) == ["./physics.usda", "./materials.usda", "./geometry.usda"]
+    assert list(contents.subLayerPaths) == ["./physics.usda", "./materials.usda", "./geometry.usdc"]
     physics = (folder / "toy_payload/physics.usda").read_text()
-    geometry = (folder / "toy_payload/geometry.usda").read_text()
+    assert (folder / "toy_payload/geometry.usdc").read_bytes().startswith(b"PXR-USDC")
+    geometry = Sdf.Layer.FindOrOpen(str(folder / "toy_payload/geometry.usdc")).ExportToString()
     assert "PhysicsRevoluteJoint" in physics and "def Mesh" not in physics and "Cube" not in physics
     assert "Physics" not in geometry and "Material" not in geometry
 
@@ -200,7 +202,7 @@ def test_a_rebuild_gives_the_same_bytes(built: Path, tmp_path: Path) -> None:
     sink = Sink()
     result = compile_model(folder / "toy.yml", sink, Options(out=tmp_path / "again"))
     assert result.out is not None
-    for path in sorted((built / "usd").rglob("*.usda")):
+    for path in sorted((built / "usd").rglob("*.usd?")):
         assert (result.out / "usd" / path.relative_to(built / "usd")).read_bytes() == path.read_bytes()
 
 
@@ -298,16 +300,31 @@ def test_visual_colours_are_preview_surfaces(stage: Usd.Stage) -> None:
 def test_a_mimic_joint_is_newtons_mimic_and_newton_reads_it(built: Path) -> None:
     stage = _stage(built)
     prim = stage.GetPrimAtPath("/toy/joints/follow")
-    assert list(prim.GetMetadata("apiSchemas").GetAddedOrExplicitItems()) == ["NewtonMimicAPI"]
+    assert "NewtonMimicAPI" in prim.GetMetadata("apiSchemas").GetAddedOrExplicitItems()
     leader = prim.GetRelationship("newton:mimicJoint").GetTargets()
     assert [str(t) for t in leader] == ["/toy/joints/shoulder"]
     assert prim.GetAttribute("newton:mimicCoef0").Get() == pytest.approx(0.1 * DEG, rel=1e-6)
     assert prim.GetAttribute("newton:mimicCoef1").Get() == 2
-    assert stage.GetPrimAtPath("/toy/joints/push").GetMetadata("apiSchemas") is None
+    push = stage.GetPrimAtPath("/toy/joints/push")
+    assert "NewtonMimicAPI" not in push.GetMetadata("apiSchemas").GetAddedOrExplicitItems()
     read = newton_reads([built / "usd" / "toy.usda"])[str(built / "usd" / "toy.usda")]
     assert read["joints"]["/toy/joints/follow"]["mimic"] == "/toy/joints/shoulder"
     assert read["joints"]["/toy/joints/follow"]["coeffs"] == pytest.approx([0.1, 2.0], rel=1e-6)
     assert read["joints"]["/toy/joints/push"]["mimic"] is None
+    assert read["velocity_limits"]["/toy/joints/shoulder"] == pytest.approx(2, rel=1e-6)
+    assert read["velocity_limits"]["/toy/joints/slide"] == pytest.approx(1, rel=1e-6)
+    assert read["frictions"]["/toy/joints/shoulder"] == pytest.approx(0.25, rel=1e-6)
+
+
+def test_velocity_limits_and_dynamics_are_newtons_joint_attributes(stage: Usd.Stage) -> None:
+    """NewtonJointAPI, in its units: degrees on a rotational joint."""
+    shoulder, slide = (stage.GetPrimAtPath(f"/toy/joints/{n}") for n in ("shoulder", "slide"))
+    assert "NewtonJointAPI" in shoulder.GetMetadata("apiSchemas").GetAddedOrExplicitItems()
+    assert shoulder.GetAttribute("newton:velocityLimit").Get() == pytest.approx(2 * DEG, rel=1e-6)
+    assert shoulder.GetAttribute("newton:damping").Get() == pytest.approx(0.5 / DEG, rel=1e-6)
+    assert shoulder.GetAttribute("newton:friction").Get() == pytest.approx(0.25, rel=1e-6)
+    assert slide.GetAttribute("newton:velocityLimit").Get() == pytest.approx(1, rel=1e-6)
+    assert not slide.GetAttribute("newton:damping").HasAuthoredValue()
 
 
 def test_usd_cores_validators_report_nothing(built: Path) -> None:

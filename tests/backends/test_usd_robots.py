@@ -2,7 +2,7 @@
 every body's mass, centre of mass and inertia and every joint's frame, axis and limits equal
 to Pinocchio's model of the URDF (1e-9 where USD stores doubles, float32 precision where
 UsdPhysics stores floats); Newton, an independent reader of USD physics, gives the same
-masses, inertias and joint limits; usd-core's validators report nothing."""
+masses, inertias, joint limits and velocity limits; usd-core's validators report nothing."""
 
 from __future__ import annotations
 
@@ -204,6 +204,9 @@ def test_newton_reads_the_same_masses_inertias_and_limits(assets: dict[str, Asse
                 assert joint.limit is not None
                 assert got["dof_limits"][path] == pytest.approx([joint.limit.lower, joint.limit.upper],
                                                                 rel=FLOAT, abs=FLOAT), path
+            if joint.type in ("revolute", "continuous", "prismatic") and joint.limit is not None \
+                    and joint.limit.velocity is not None:
+                assert got["velocity_limits"][path] == pytest.approx(joint.limit.velocity, rel=FLOAT), path
 
 
 def test_usd_cores_validators_report_nothing(asset: Asset) -> None:
