@@ -107,7 +107,7 @@ def fidelity(root: Path) -> dict[str, object]:
     approximations: Counter[str] = Counter()
     colours = set()
     mass = 0.0
-    for prim in stage.Traverse():
+    for prim in Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies()):
         listed = prim.GetMetadata("apiSchemas")
         schemas = [str(s) for s in listed.GetAddedOrExplicitItems()] if listed else []
         names = [p.GetName() for p in prim.GetProperties()]
@@ -123,10 +123,10 @@ def fidelity(root: Path) -> dict[str, object]:
             counts[f"collisions: {prim.GetTypeName()}"] += 1
             if prim.HasAPI(UsdPhysics.MeshCollisionAPI):
                 approximations[str(UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr().Get())] += 1
-        if prim.IsA(UsdShade.Shader):
+        if prim.IsA(UsdShade.Shader):  # its colour, or the material's input it is connected to
             colour = UsdShade.Shader(prim).GetInput("diffuseColor")
-            if colour and colour.Get() is not None:
-                colours.add(tuple(round(c, 4) for c in colour.Get()))
+            values = [a.Get() for a in colour.GetValueProducingAttributes()] if colour else []
+            colours.update(tuple(round(c, 4) for c in v) for v in values if v is not None)
         if prim.HasAPI(UsdPhysics.MassAPI):
             mass += UsdPhysics.MassAPI(prim).GetMassAttr().Get() or 0.0
     return {**counts, "colours": len(colours), "approximations": dict(sorted(approximations.items())),
@@ -137,6 +137,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--converter", type=Path, default=Path("/tmp/usdconv-venv"))
+    parser.add_argument("--fidelity-only", action="store_true", help="convert each robot once, no times")
     args = parser.parse_args()
     tool = args.converter / "bin" / "urdf_usd_converter"
     if not tool.is_file():
@@ -160,11 +161,15 @@ def main() -> None:
         b = [str(tool), str(urdf), str(work / f"{name}.conv")]
         timed(a, env)  # warm-up: fills the mesh cache, compiles bytecode
         timed(b, env)
+        if args.fidelity_only:
+            continue
         rows = [(timed(a, env), timed(b, env)) for _ in range(args.runs)]
         med = statistics.median
         print(f"{name:16} {med(r[0][0] for r in rows):9.2f} {med(r[1][0] for r in rows):9.2f} "
               f"{med(r[0][1] for r in rows):8.2f} {med(r[1][1] for r in rows):8.2f} "
               f"{med(r[0][1] / r[1][1] for r in rows):9.2f} {med(r[0][0] / r[1][0] for r in rows):10.2f}")
+    if args.fidelity_only:
+        return fidelities(work, urdfs)
     mpc_in = json.loads(subprocess.run([sys.executable, "-c", IN_PROCESS_MPC, str(args.runs), *definitions],
                                        env=env, check=True, capture_output=True, text=True).stdout)
     conv_in = json.loads(subprocess.run([str(args.converter / "bin" / "python"), "-c", IN_PROCESS_CONVERTER,
@@ -174,6 +179,10 @@ def main() -> None:
     for definition, urdf in zip(definitions, urdfs, strict=True):
         print(f"{Path(urdf).stem:16} mpc {mpc_in[definition]:6.3f}  converter {conv_in[urdf]:6.3f}  "
               f"ratio {mpc_in[definition] / conv_in[urdf]:5.2f}")
+    fidelities(work, urdfs)
+
+
+def fidelities(work: Path, urdfs: list[str]) -> None:
     print("\nfidelity (counted in each tool's USD):")
     for urdf in urdfs:
         name = Path(urdf).stem

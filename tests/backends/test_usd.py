@@ -198,11 +198,14 @@ def test_both_layouts_compose_the_same_prims(built: Path) -> None:
 
 
 def test_a_rebuild_gives_the_same_bytes(built: Path, tmp_path: Path) -> None:
+    """Built anew (`force`: not the kept build), the text and the crate alike."""
     folder = built.parent
     sink = Sink()
-    result = compile_model(folder / "toy.yml", sink, Options(out=tmp_path / "again"))
+    result = compile_model(folder / "toy.yml", sink, Options(out=tmp_path / "again", force=True))
     assert result.out is not None
-    for path in sorted((built / "usd").rglob("*.usd?")):
+    written = sorted((built / "usd").rglob("*.usd?"))
+    assert len(written) == 6
+    for path in written:
         assert (result.out / "usd" / path.relative_to(built / "usd")).read_bytes() == path.read_bytes()
 
 
