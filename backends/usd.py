@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.backends import holds
 from mpc.backends.usd_kinds import ONE_DOF, mimic_written, written_cut
@@ -27,6 +28,9 @@ from mpc.core.files import confined, write_atomic
 from mpc.ir.geometry import Mesh
 from mpc.ir.program import UsdExport
 from mpc.ir.robot import Inertial, Robot
+
+if TYPE_CHECKING:
+    from mpc.backends.usd_pxr import Layer
 
 __all__ = ["CANNOT_HOLD", "PARTS", "emit", "layers_text", "left_out"]
 
@@ -116,8 +120,7 @@ def layers_text(robot: Robot, layout: str, triangles: object, payload_folder: st
     """The content of each layer (USDA text, or a crate's bytes), by its path relative to
     `usd/` ("" for the file the export names) and, for the layered layout, the payload's layers
     in `payload_folder`."""
-    from pxr import Sdf, Usd
-
+    from mpc.backends.usd_pxr import Sdf, Usd
     from mpc.backends.usd_stage import Author, Layers
 
     stage = Usd.Stage.CreateInMemory()
@@ -157,13 +160,11 @@ def layers_text(robot: Robot, layout: str, triangles: object, payload_folder: st
     return out
 
 
-def _crate(layer: object) -> bytes:
+def _crate(layer: Layer) -> bytes:
     """The layer in USD's binary crate format (usd-core writes it only to a file)."""
     import tempfile
 
-    from pxr import Sdf
 
-    assert isinstance(layer, Sdf.Layer)
     with tempfile.TemporaryDirectory(prefix="mpc-usdc-") as folder:
         path = f"{folder}/layer.usdc"
         if not layer.Export(path):
@@ -172,11 +173,10 @@ def _crate(layer: object) -> bytes:
             return crate.read()
 
 
-def _metadata(layer: object, root: str) -> None:
+def _metadata(layer: Layer, root: str) -> None:
     """Metres, kilograms, Z up and the default prim, on a layer."""
-    from pxr import Sdf, UsdGeom, UsdPhysics
+    from mpc.backends.usd_pxr import UsdGeom, UsdPhysics
 
-    assert isinstance(layer, Sdf.Layer)
     layer.defaultPrim = root
     info = dict(layer.pseudoRoot.GetInfo("customLayerData") or {})
     layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, 1.0)

@@ -30,12 +30,27 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics, UsdShade, Vt
 
 from mpc.backends.mjcf import cut_sites, principal
 from mpc.backends.usd_kinds import ONE_DOF, closed_cut_axis, mimic_written, written_cut
 from mpc.backends.usd_meshes import Triangles
 from mpc.backends.usd_names import sibling_names, unique_identifiers
+from mpc.backends.usd_pxr import (
+    Gf,
+    Layer,
+    PhysicsJoint,
+    Prim,
+    PrimPath,
+    Quat,
+    Sdf,
+    Stage,
+    Usd,
+    UsdGeom,
+    UsdPhysics,
+    UsdShade,
+    Vt,
+    Xformable,
+)
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, ConvexHull, ConvexPart, Cylinder, Geometry, Mesh, Sphere
@@ -52,17 +67,17 @@ DEG = 180.0 / math.pi
 class Layers:
     """Where each part is authored (the same layer for `layout: single`)."""
 
-    geometry: Sdf.Layer
-    materials: Sdf.Layer
-    physics: Sdf.Layer
+    geometry: Layer
+    materials: Layer
+    physics: Layer
 
 
-def quatd(R: np.ndarray) -> Gf.Quatd:
+def quatd(R: np.ndarray) -> Quat:
     w, x, y, z = tf.matrix_to_quat(R)
     return Gf.Quatd(w, Gf.Vec3d(x, y, z))
 
 
-def quatf(R: np.ndarray) -> Gf.Quatf:
+def quatf(R: np.ndarray) -> Quat:
     w, x, y, z = tf.matrix_to_quat(R)
     return Gf.Quatf(w, Gf.Vec3f(x, y, z))
 
@@ -97,7 +112,7 @@ def approximation(mesh: Mesh) -> str:
 class Author:
     """Authors one robot onto a stage (see the module's docstring)."""
 
-    def __init__(self, robot: Robot, stage: Usd.Stage, layers: Layers,
+    def __init__(self, robot: Robot, stage: Stage, layers: Layers,
                  triangles: Callable[[Mesh], Triangles]) -> None:
         self.robot, self.stage, self.layers, self.triangles = robot, stage, layers, triangles
         self.root = Sdf.Path("/" + unique_identifiers([robot.name])[robot.name])
@@ -106,16 +121,16 @@ class Author:
         self.X = links_in_root(robot)
         self.joint_names: dict[str, str] = {}
 
-    def shape_paths(self, link: Link, kind: str) -> list[Sdf.Path]:
+    def shape_paths(self, link: Link, kind: str) -> list[PrimPath]:
         """The prims of a link's visuals or collisions (`kind`), in their order."""
         shapes = link.visuals if kind == "visuals" else link.collisions
         folder = self.link_path(link.name).AppendChild(kind)
         return [folder.AppendChild(n) for n in sibling_names(s.name or kind[:-1] for s in shapes)]
 
-    def target(self, layer: Sdf.Layer) -> None:
+    def target(self, layer: Layer) -> None:
         self.stage.SetEditTarget(Usd.EditTarget(layer))
 
-    def link_path(self, link: str) -> Sdf.Path:
+    def link_path(self, link: str) -> PrimPath:
         return self.root.AppendChild(self.link_names[link])
 
     # geometry ------------------------------------------------------------------------------
@@ -139,7 +154,7 @@ class Author:
                     if isinstance(shape, Collision):
                         UsdGeom.Imageable(prim).CreatePurposeAttr(UsdGeom.Tokens.guide)
 
-    def shape(self, path: Sdf.Path, shape: Visual | Collision) -> Usd.Prim:
+    def shape(self, path: PrimPath, shape: Visual | Collision) -> Prim:
         g: Geometry = shape.geometry
         scale: tuple[float, ...] | None = None
         match g:
@@ -192,7 +207,7 @@ class Author:
             return
         folder = self.root.AppendChild("materials")
         UsdGeom.Scope.Define(self.stage, folder)
-        paths: dict[tuple[object, ...], Sdf.Path] = {}
+        paths: dict[tuple[object, ...], PrimPath] = {}
         for (key, m), name in zip(used.items(), sibling_names(m.name for m in used.values()), strict=True):
             paths[key] = path = folder.AppendChild(name)
             material = UsdShade.Material.Define(self.stage, path)
@@ -254,7 +269,7 @@ class Author:
         massless = root.inertial is None or root.inertial.mass == 0
         return root.name if root.name == "world" and massless else None
 
-    def body(self, prim: Usd.Prim, link: str) -> None:
+    def body(self, prim: Prim, link: str) -> None:
         """RigidBodyAPI and MassAPI: mass, centre of mass, and the principal moments and axes
         (mjcf.principal). A link without inertial, or with a zero tensor, gets mass and centre
         of mass only: UsdPhysics reads a zero diagonal inertia as "not given", and its
@@ -287,7 +302,7 @@ class Author:
                 api = UsdPhysics.FilteredPairsAPI.Apply(self.stage.OverridePrim(self.link_path(a)))
                 api.CreateFilteredPairsRel().SetTargets([self.link_path(b) for b in others])
 
-    def _frame(self, joint: UsdPhysics.Joint, parent: str, child: str, X_PJ: np.ndarray, X_CJ: np.ndarray,
+    def _frame(self, joint: PhysicsJoint, parent: str, child: str, X_PJ: np.ndarray, X_CJ: np.ndarray,
                R_a: np.ndarray) -> None:
         joint.CreateBody0Rel().SetTargets([self.link_path(parent)])
         joint.CreateBody1Rel().SetTargets([self.link_path(child)])
@@ -296,9 +311,9 @@ class Author:
         joint.CreateLocalPos1Attr(Gf.Vec3f(*map(float, X_CJ[:3, 3])))
         joint.CreateLocalRot1Attr(quatf(X_CJ[:3, :3] @ R_a))
 
-    def joint(self, path: Sdf.Path, j: Joint) -> None:
+    def joint(self, path: PrimPath, j: Joint) -> None:
         token, R_a = axis_frame(j.axis) if j.type in ONE_DOF else ("X", np.eye(3))
-        usd_joint: UsdPhysics.Joint
+        usd_joint: PhysicsJoint
         if j.type in ("revolute", "continuous"):
             rev = UsdPhysics.RevoluteJoint.Define(self.stage, path)
             rev.CreateAxisAttr(token)
@@ -322,7 +337,7 @@ class Author:
         self.drive(usd_joint.GetPrim(), j)
         self.dynamics(usd_joint.GetPrim(), j)
 
-    def dynamics(self, prim: Usd.Prim, j: Joint) -> None:
+    def dynamics(self, prim: Prim, j: Joint) -> None:
         """The joint's velocity limit, damping and friction as NewtonJointAPI holds them (per
         degree on a rotational joint); UsdPhysics has none."""
         if j.type not in ONE_DOF:
@@ -340,7 +355,7 @@ class Author:
         for name, value in given:
             prim.CreateAttribute(name, Sdf.ValueTypeNames.Float, custom=False).Set(value)
 
-    def drive(self, prim: Usd.Prim, j: Joint) -> None:
+    def drive(self, prim: Prim, j: Joint) -> None:
         """The motor of a one-degree-of-freedom joint as a DriveAPI (see the module)."""
         motors = [m for m in (self.robot.motors[n] for n in sorted(self.robot.motors)) if m.joint == j.name]
         if not motors or j.type not in ONE_DOF:
@@ -358,7 +373,7 @@ class Author:
         if effort:
             drive.CreateMaxForceAttr(abs(effort))
 
-    def mimic(self, folder: Sdf.Path, j: Joint) -> None:
+    def mimic(self, folder: PrimPath, j: Joint) -> None:
         """NewtonMimicAPI on a one-degree-of-freedom joint that follows another of the same kind."""
         m = j.mimic
         leader = self.robot.joints.get(m.joint) if m is not None else None
@@ -373,13 +388,13 @@ class Author:
         prim.CreateAttribute("newton:mimicCoef1", Sdf.ValueTypeNames.Float, custom=False).Set(
             1.0 if m.multiplier is None else m.multiplier)
 
-    def cut(self, path: Sdf.Path, c: CutJoint) -> None:
+    def cut(self, path: PrimPath, c: CutJoint) -> None:
         """A loop closure: a joint excluded from the articulation, at the closure's frame on
         both sides (mjcf.cut_sites)."""
         _, on_parent, on_child = cut_sites(c)[0]
         R_a = np.eye(3)
         if c.type == "fixed":
-            joint: UsdPhysics.Joint = UsdPhysics.FixedJoint.Define(self.stage, path)
+            joint: PhysicsJoint = UsdPhysics.FixedJoint.Define(self.stage, path)
         elif c.type == "ball":
             joint = UsdPhysics.SphericalJoint.Define(self.stage, path)
         else:
@@ -400,11 +415,11 @@ def _material_key(m: Material) -> tuple[object, ...]:
     return (m.name, m.rgba, m.emissive)
 
 
-def _name(prim: Usd.Prim, name: str) -> None:
+def _name(prim: Prim, name: str) -> None:
     prim.CreateAttribute(NAME, Sdf.ValueTypeNames.String, custom=True).Set(name)
 
 
-def _place(xform: UsdGeom.Xformable, xyz: np.ndarray | tuple[float, ...], R: np.ndarray,
+def _place(xform: Xformable, xyz: np.ndarray | tuple[float, ...], R: np.ndarray,
            scale: tuple[float, ...] | None = None) -> None:
     """translate and orient (doubles), and scale when given; only those not the identity."""
     if any(float(x) != 0 for x in xyz):
