@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -120,6 +121,7 @@ class Author:
         self.link_names = unique_identifiers(self.order, taken=("joints", "materials"))
         self.X = links_in_root(robot)
         self.joint_names: dict[str, str] = {}
+        self.arrays: dict[int, tuple[Any, Any, Any, Any]] = {}
 
     def shape_paths(self, link: Link, kind: str) -> list[PrimPath]:
         """The prims of a link's visuals or collisions (`kind`), in their order."""
@@ -154,6 +156,19 @@ class Author:
                     if isinstance(shape, Collision):
                         UsdGeom.Imageable(prim).CreatePurposeAttr(UsdGeom.Tokens.guide)
 
+    def mesh_arrays(self, mesh: Mesh) -> tuple[Any, Any, Any, Any]:
+        """A mesh's points, face sizes, indices and extent as USD's arrays, made once for each
+        mesh file and ops (a leg's mesh used four times is converted once)."""
+        points, faces = self.triangles(mesh)
+        key = id(points)
+        if key not in self.arrays:
+            lo, hi = points.min(axis=0), points.max(axis=0)
+            self.arrays[key] = (Vt.Vec3fArray.FromNumpy(points),
+                                Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)),
+                                Vt.IntArray.FromNumpy(faces.reshape(-1)),
+                                Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
+        return self.arrays[key]
+
     def shape(self, path: PrimPath, shape: Visual | Collision) -> Prim:
         g: Geometry = shape.geometry
         scale: tuple[float, ...] | None = None
@@ -172,13 +187,12 @@ class Author:
                 prim.CreateAxisAttr(UsdGeom.Tokens.z)
             case Mesh():
                 prim = UsdGeom.Mesh.Define(self.stage, path)
-                points, faces = self.triangles(g)
-                prim.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(points))
-                prim.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)))
-                prim.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(faces.reshape(-1)))
+                points, counts, indices, extent = self.mesh_arrays(g)
+                prim.CreatePointsAttr(points)
+                prim.CreateFaceVertexCountsAttr(counts)
+                prim.CreateFaceVertexIndicesAttr(indices)
                 prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
-                lo, hi = points.min(axis=0), points.max(axis=0)
-                prim.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
+                prim.CreateExtentAttr(extent)
                 scale = g.scale
         X = pose_matrix(shape.origin)
         _place(prim, X[:3, 3], X[:3, :3], scale)
