@@ -190,8 +190,16 @@ def emit(robot: Robot, export: UsdExport, out: Path, sink: Sink) -> None:
     """Write `out/usd/<filename or robot.name>.usda` (and its payload's layers, `layered`)."""
     from mpc.backends import meshes, usd_meshes
     from mpc.backends.dae_colours import coloured
+    from mpc.backends.mjcf import unusable_inertial
     from mpc.backends.smurf_forms import named_shapes
 
+    unusable = [(name, problem) for name, link in robot.links.items() if link.inertial is not None
+                and (problem := unusable_inertial(link.inertial)) is not None]
+    for name, problem in unusable:
+        sink.error(robot.links[name].span or export.span, "E0587", f"link '{name}' has an inertial "
+                   f"UsdPhysics cannot hold: {problem}; no USD is written", hint="fix its <inertial>")
+    if unusable:
+        return
     missing = left_out(robot)
     if missing:
         sink.warning(export.span, "W0500", "the USD leaves out what it cannot hold: " + ", ".join(missing))

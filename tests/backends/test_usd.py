@@ -361,3 +361,18 @@ def test_a_ball_loop_closure_is_a_spherical_joint_outside_the_articulation(tmp_p
     np.testing.assert_allclose(on0, on1, atol=1e-6)
     np.testing.assert_allclose(on1[:3, 3], X["pusher"][:3, 3], atol=1e-7)
     assert not stage.GetPrimAtPath("/toy_bot/joints/slot").IsValid()
+
+
+def test_an_inertial_that_is_no_number_is_refused(tmp_path: Path, diags: Diags) -> None:
+    """A definition's `.inf` or an overflowing product (URDF readers refuse them in a file)."""
+    write(tmp_path / "toy.urdf", URDF)
+    robot = urdf_reader.read(tmp_path / "toy.urdf", Sink())
+    assert robot is not None and robot.links["slider"].inertial is not None
+    slider = replace(robot.links["slider"], inertial=replace(robot.links["slider"].inertial, mass=math.inf))
+    robot = replace(robot, links={**robot.links, "slider": slider})
+    usd.emit(robot, UsdExport(span=Span("toy.yml", 1, 1)), tmp_path, diags)
+    error = diags.take_error("E0587")
+    assert error.message == ("link 'slider' has an inertial UsdPhysics cannot hold: its mass, inertia or "
+                             "centre of mass holds a number that is not finite; no USD is written")
+    assert (error.span.file, error.span.line) == (str(tmp_path / "toy.urdf"), 14)
+    assert not (tmp_path / "usd").exists()
