@@ -376,3 +376,51 @@ def test_an_inertial_that_is_no_number_is_refused(tmp_path: Path, diags: Diags) 
                              "centre of mass holds a number that is not finite; no USD is written")
     assert (error.span.file, error.span.line) == (str(tmp_path / "toy.urdf"), 14)
     assert not (tmp_path / "usd").exists()
+
+
+MESHES = """\
+<robot name="meshy">
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial>
+    <visual><geometry><mesh filename="meshes/tetra.stl" scale="2 2 2"/></geometry></visual>
+    <collision name="plain"><geometry><mesh filename="meshes/tetra.stl"/></geometry></collision>
+    <collision name="hulled"><geometry><mesh filename="meshes/tetra.stl"/></geometry></collision>
+    <collision name="split"><geometry><mesh filename="meshes/tetra.stl"/></geometry></collision>
+  </link>
+</robot>
+"""
+
+
+def test_mesh_collisions_take_the_approximation_the_definition_implies(tmp_path: Path) -> None:
+    """`shape: convex` and the parts of `convex_decomposition` are convex: convexHull; a mesh
+    left as it is: none. The visual's triangles are the STL's, its scale the prim's."""
+    from tests.fixtures import tetra_stl
+
+    tetra_stl(tmp_path / "meshes" / "tetra.stl")
+    write(tmp_path / "meshy.urdf", MESHES)
+    definition = write(tmp_path / "meshy.yml", """
+        model:
+          robotname: meshy
+          modelname: meshy-model
+          input_models: {meshy: {basefile: meshy.urdf}}
+          assemble: {model: meshy}
+          collisions:
+            hulled: {shape: convex}
+            split: {shape: convex_decomposition}
+          export_config:
+            - {type: usd, layout: single}
+        """)
+    sink = Sink()
+    result = compile_model(definition, sink, Options(out=tmp_path / "out"))
+    assert result.out is not None, [str(d) for d in sink.diagnostics]
+    stage = Usd.Stage.Open(str(result.out / "usd" / "meshy.usda"))
+    found = {p.GetName(): UsdPhysics.MeshCollisionAPI(p).GetApproximationAttr().Get()
+             for p in stage.Traverse() if p.HasAPI(UsdPhysics.MeshCollisionAPI)}
+    assert found == {"plain": "none", "hulled": "convexHull", "split_0": "convexHull"}
+    visual = UsdGeom.Mesh(stage.GetPrimAtPath("/meshy/base/visuals/base_visual"))
+    assert list(visual.GetFaceVertexCountsAttr().Get()) == [3, 3, 3, 3]
+    points = np.array(visual.GetPointsAttr().Get())
+    assert {tuple(round(float(c), 6) for c in p) for p in points} == {
+        (0, 0, 0), (0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)}
+    assert [op.GetOpName() for op in visual.GetOrderedXformOps()] == ["xformOp:scale"]
+    assert tuple(visual.GetPrim().GetAttribute("xformOp:scale").Get()) == (2, 2, 2)
