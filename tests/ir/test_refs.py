@@ -80,7 +80,8 @@ NOT_NAMES: dict[tuple[str, str], str] = {
     # The program and its exports (ir/program.py): files, folders, repositories, formats, text.
     **{(cls, field): "a file or folder of the output, or its name" for cls, field in (
         ("UrdfExport", "filename"), ("SdfExport", "filename"), ("MjcfExport", "filename"),
-        ("UsdExport", "filename"), ("PdfExport", "filename"), ("JointLimitsExport", "file_name"), ("SmurfExport", "filename"),
+        ("UsdExport", "filename"), ("PdfExport", "filename"), ("JointLimitsExport", "file_name"),
+        ("SmurfExport", "filename"),
         ("SmurfExport", "model_file"), ("SmurfExport", "additional_files"), ("KccdExport", "dirname"),
         ("UrdfExport", "additional_meshes"), ("SdfExport", "additional_meshes"),
         ("MjcfExport", "additional_meshes"), ("CommandExport", "cwd"), ("CommandExport", "executable"),
