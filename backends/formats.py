@@ -121,6 +121,18 @@ def _mjcf_holds() -> Sequence[Tally]:
     return mjcf.CANNOT_HOLD
 
 
+def _write_usd(robot: Robot, export: Any, out: Path, sink: Sink) -> None:
+    from mpc.backends import usd
+
+    usd.emit(robot, export, out, sink)
+
+
+def _usd_holds() -> Sequence[Tally]:
+    from mpc.backends import usd
+
+    return usd.CANNOT_HOLD
+
+
 def _write_smurf(robot: Robot, export: Any, out: Path, sink: Sink) -> None:
     from mpc.backends import smurf
 
@@ -175,6 +187,7 @@ _FORMATS = (
            numbers="attribute of an MJCF", meshes=Meshes(input_type="obj"),
            cut_joints="MJCF always closes loops with equality constraints", exact_inertials=True,
            holds=_mjcf_holds),
+    Format("usd", program.UsdExport, _write_usd, kept=True, holds=_usd_holds),
     Format("smurf", program.SmurfExport, _write_smurf, _read_smurf, (".smurf",), kept=True),
     Format("pdf", program.PdfExport, _write_pdf, kept=True),
     Format("render", program.RenderExport, _write_render, kept=True),

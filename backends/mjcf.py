@@ -60,7 +60,8 @@ from mpc.ir.program import MjcfExport
 from mpc.ir.robot import Collision, Inertial, Joint, Link, Pose, Robot, Visual
 from mpc.ir.tree import child_joints, depth_first
 
-__all__ = ["MAX_BODY_DEPTH", "body_depth", "check", "cut_sites", "emit", "left_out", "to_string"]
+__all__ = ["MAX_BODY_DEPTH", "body_depth", "check", "cut_axis", "cut_sites", "emit", "left_out", "principal",
+           "to_string"]
 
 Quat = tuple[float, float, float, float]
 # MuJoCo parses MJCF with tinyxml2, which refuses elements nested deeper than 500: <mujoco>,
@@ -220,7 +221,7 @@ _HINGE_CUTS = ("revolute", "continuous")
 AXIS_POINT = 0.1  # m along a hinge closure's axis: its second connect's point
 
 
-def _cut_axis(cut: CutJoint) -> np.ndarray | None:
+def cut_axis(cut: CutJoint) -> np.ndarray | None:
     """A revolute closure's axis in the child link's frame (`axis`, as an SDF input gives it)."""
     axis = cut.annotations.get("axis") if cut.type in _HINGE_CUTS else None
     if not isinstance(axis, list | tuple) or len(axis) != 3:
@@ -242,7 +243,7 @@ def cut_sites(cut: CutJoint) -> list[tuple[str, Pose, Pose]]:
                                 tuple(jo.get("rpy", (0.0, 0.0, 0.0)))))  # type: ignore[arg-type]
     X_PJ = pose_matrix(cut.origin) @ X_CJ
     out = [("", matrix_pose(X_PJ), matrix_pose(X_CJ))]
-    axis = _cut_axis(cut)
+    axis = cut_axis(cut)
     if axis is not None:
         shift = np.eye(4)
         shift[:3, 3] = AXIS_POINT * (X_CJ[:3, :3].T @ axis)  # the axis, in the joint frame
@@ -337,7 +338,7 @@ CANNOT_HOLD: tuple[holds.Tally, ...] = (
         len(c.constraint_axes) for c in r.cut_joints.values())),
     holds.count(_C("rotational cut joint's axis (without one, a connect is a ball joint)",
                    "rotational cut joints' axes (without one, a connect is a ball joint)"), lambda r, o: sum(
-        c.type in _POINT_CUTS and c.type != "ball" and _cut_axis(c) is None for c in r.cut_joints.values())),
+        c.type in _POINT_CUTS and c.type != "ball" and cut_axis(c) is None for c in r.cut_joints.values())),
     _uncloseable_cuts,
     _element_tags,
     holds.named(holds.Named("the mass of the root link 'world' (MuJoCo's world body has none)"), _world_mass),

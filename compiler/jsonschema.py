@@ -66,6 +66,7 @@ PAGES: dict[str, tuple[str, str | None, str]] = {
     "UrdfExport": ("exports.md", "Entries", ""),
     "SdfExport": ("exports.md", "Entries", ""),
     "MjcfExport": ("exports.md", "Entries", ""),
+    "UsdExport": ("exports.md", "USD", ""),
     "SmurfExport": ("exports.md", "Entries", ""),
     "PdfExport": ("exports.md", "Entries", ""),
     "RenderExport": ("exports.md", None, ""),
@@ -141,6 +142,7 @@ PROSE: dict[tuple[str, str], str] = {
     ("UrdfExport", "type"): "urdf: a URDF file",
     ("SdfExport", "type"): "sdf: an SDFormat file",
     ("MjcfExport", "type"): "mjcf: a MuJoCo model",
+    ("UsdExport", "type"): "usd: OpenUSD with UsdPhysics",
     ("RenderExport", "type"): "render: pictures of the model",
     ("JointLimitsExport", "type"): "joint_limits: a file of the joints' limits",
     ("KccdExport", "type"): "kccd: the model for KCCD's collision checks",
@@ -227,7 +229,7 @@ PROSE: dict[tuple[str, str], str] = {
 
 TITLES = {"Definition": "model definition file", "ModelSection": "model",
           "UrdfExport": "URDF export", "SdfExport": "SDF export", "MjcfExport": "MJCF export",
-          "SmurfExport": "SMURF export", "PdfExport": "PDF export"}
+          "UsdExport": "USD export", "SmurfExport": "SMURF export", "PdfExport": "PDF export"}
 
 
 def definition_schema() -> dict[str, Any]:

@@ -32,6 +32,7 @@ from mpc.ir.program import (
     SdfExport,
     SubmodelExport,
     UrdfExport,
+    UsdExport,
 )
 
 
@@ -142,6 +143,22 @@ class _Exports:
                             add_floating_base=entry.add_floating_base, submodel=submodel,
                             filename=filename if filename != (submodel or robotname) else "")
         export = self.smurf.link(entry, self.options(entry, fmt, export), submodel)
+        self.written[target] = export
+        return [export]
+
+    def usd(self, entry: Any, robotname: str, submodel: str, inherited: bool) -> list[Export]:
+        """A usd entry: `usd/<filename>.usda` (and its payload folder), as kinematic files are
+        named; two writing one file are E0503."""
+        filename = (entry.filename or robotname) + entry.filename_suffix
+        target = f"{'submodels/' + submodel + '/' if submodel else ''}usd/{filename}"
+        if target in self.written:
+            self.ctx.sink.error(entry.span, "E0503", f"two usd exports would write {target}; give one a "
+                                "filename_suffix", notes=((self.written[target].span, "the other export"),))
+            return []
+        export = UsdExport(span=entry.span, layout=entry.layout, submodel=submodel,
+                           add_floating_base=entry.add_floating_base,
+                           correct_inertials=entry.correct_inertials,
+                           filename=filename if filename != (submodel or robotname) else "")
         self.written[target] = export
         return [export]
 
@@ -349,6 +366,7 @@ LOWERING: dict[str, Lowering] = {
     "urdf": Lowering(schema.UrdfExport, _Exports.kinematic),
     "sdf": Lowering(schema.SdfExport, _Exports.kinematic),
     "mjcf": Lowering(schema.MjcfExport, _Exports.kinematic),
+    "usd": Lowering(schema.UsdExport, _Exports.usd),
     "smurf": Lowering(schema.SmurfExport, _Exports.smurf_entry),
     "pdf": Lowering(schema.PdfExport, _Exports.pdf),
     "render": Lowering(schema.RenderExport, _Exports.render),

@@ -18,12 +18,11 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import trimesh
-
 from mpc.core.span import hardened_parser
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # trimesh is imported where a mesh is read: `material_colours` from the cache needs none
     import collada
+    import trimesh
 
 RGBA = tuple[float, float, float, float]
 COLOURS = "1"  # changes when the colours read change, so old cache entries go unused
@@ -126,6 +125,7 @@ def material_parts(path: Path) -> list[tuple[RGBA | None, trimesh.Trimesh]]:
     order the colours first appear; the triangles of all parts are those `read` gives. Kept
     for the last file read in this process: the parts of one file are asked for one by one."""
     import numpy as np
+    import trimesh
 
     from mpc.core.cache import file_digest
 

@@ -152,6 +152,22 @@ class MjcfExport(ExportEntry):
 
 
 @record(slots=True, kw_only=True)
+class UsdExport(ExportEntry):
+    """A `type: usd` entry: OpenUSD with UsdPhysics (backends/usd.py). layout: `layered` (an
+    interface layer with a payload of physics, materials and geometry layers) or `single` (one
+    file); `add_floating_base` and `correct_inertials` as for URDF. Meshes are held in the
+    USD itself."""
+
+    span: Span
+    filename: str = ""
+    layout: Literal["layered", "single"] = "layered"
+    add_floating_base: bool = False
+    submodel: str = ""
+    correct_inertials: bool = False
+    type: Literal["usd"] = "usd"
+
+
+@record(slots=True, kw_only=True)
 class PdfExport(ExportEntry):
     """A `type: pdf` entry: the kinematic tree as a graph (Graphviz source and PDF)."""
 
@@ -345,7 +361,7 @@ class KccdExport(ExportEntry):
 
 
 # The exports that write a robot (the whole one or a submodel's), optionally floating.
-RobotExport = (UrdfExport | SdfExport | MjcfExport | PdfExport | JointLimitsExport | SmurfExport
+RobotExport = (UrdfExport | SdfExport | MjcfExport | UsdExport | PdfExport | JointLimitsExport | SmurfExport
                | KccdExport | RenderExport)
 Export = RobotExport | SubmodelExport | RosPackageExport | CommandExport
 

@@ -71,3 +71,25 @@ def compose(*Xs: np.ndarray) -> np.ndarray:
     for X in Xs:
         out = out @ X
     return out
+
+
+def matrix_to_quat(R: np.ndarray) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of a rotation matrix, w ≥ 0, by Shepperd's method in Python's floats
+    (SciPy's Rotation costs two seconds of imports)."""
+    m = [[float(R[i][j]) for j in range(3)] for i in range(3)]
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0:
+        s = math.sqrt(trace + 1.0) * 2
+        q = (s / 4, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s)
+    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
+        s = math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]) * 2
+        q = ((m[2][1] - m[1][2]) / s, s / 4, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s)
+    elif m[1][1] > m[2][2]:
+        s = math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]) * 2
+        q = ((m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, s / 4, (m[1][2] + m[2][1]) / s)
+    else:
+        s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
+        q = ((m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4)
+    norm = math.sqrt(sum(c * c for c in q))
+    w, x, y, z = (c / norm for c in q)
+    return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)

@@ -61,6 +61,19 @@ class MjcfExport(_Kinematic):
     scene: bool = False
 
 
+class UsdExport(_Export):
+    """OpenUSD with UsdPhysics (specs/exports.md, "usd")."""
+
+    SECTION: ClassVar[str] = "a usd export"
+    ALIASES: ClassVar[dict[str, str]] = {"add_floatingbase": "add_floating_base"}
+    type: Literal["usd"]
+    layout: Literal["layered", "single"] = "layered"
+    filename: FileName | None = None
+    filename_suffix: FileSuffix = ""
+    add_floating_base: bool = False
+    correct_inertials: bool = False
+
+
 class SmurfExport(_Export):
     """SMURF is always written; the entry exists for old files and changes nothing."""
 
@@ -140,5 +153,5 @@ class SubmodelExport(_Export):
 
 
 # Told apart by `type` (compiler/schema/base.py: BY_TYPE).
-ExportEntry = Annotated[UrdfExport | SdfExport | MjcfExport | SmurfExport | PdfExport | RenderExport
-                        | JointLimitsExport | KccdExport | SubmodelExport, BY_TYPE]
+ExportEntry = Annotated[UrdfExport | SdfExport | MjcfExport | UsdExport | SmurfExport | PdfExport
+                        | RenderExport | JointLimitsExport | KccdExport | SubmodelExport, BY_TYPE]

@@ -56,7 +56,7 @@ SITES: dict[tuple[str, str, str], str] = {
     ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2] / f'{digest}{suffix}'"): CACHE,
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2]"): CACHE,
-    ("mjcf.py", "_cut_axis", "a / np.linalg.norm(a)"): MATH,
+    ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
     ("mjcf_actuation.py", "_actuator", "effort / FULL_EFFORT_AT"): MATH,
     ("mjcf.py", "emit", "confined(out, 'mjcf', f'{name}.xml')"): CONFINED,
     ("mjcf.py", "emit", "confined(out, 'mjcf', f'{name}_scene.xml')"): CONFINED,
@@ -89,6 +89,14 @@ SITES: dict[tuple[str, str, str], str] = {
     ("solid_checks.py", "opened_by", "cache_dir('solids') / f'{h.hexdigest()}.json'"): CACHE,
     ("solid_checks.py", "opened_by", "path.with_name(f'.{path.name}.{os.getpid()}.part')"): CACHE,
     ("urdf.py", "emit", "confined(out, 'urdf', f'{export.filename or robot.name}{suffix}.urdf')"): CONFINED,
+    ("usd.py", "emit", "confined(out, 'usd', f'{name}.usda')"): CONFINED,
+    ("usd.py", "emit", "confined(out, 'usd', rel)"):
+        "confined: the payload's layers, `<filename>_payload/<part>.usda` (filename checked, E0250)",
+    ("usd.py", "layers_text", "Sdf.Path('/' + root)"): "a prim path in the layer, not a file",
+    ("usd_meshes.py", "triangles", "Path(work)"): "a temporary folder of its own",
+    ("usd_meshes.py", "triangles", "folder / rel"): "its temporary folder: mesh paths mpc makes (meshes/…)",
+    ("usd_stage.py", "__init__", "Sdf.Path('/' + unique_identifiers([robot.name])[robot.name])"):
+        "a prim path (a valid identifier), not a file",
     ("xacro_reader.py", "expand", "Path(m.history[-1][-1])"): READ,
     ("xacro_reader.py", "_current_file", "Path(stack[-1])"): READ,
     ("xacro_reader.py", "_locate", "Path(file)"): READ,

@@ -266,3 +266,25 @@ def test_sdf_sensors(tmp_path: Path) -> None:
     checked = subprocess.run([shutil.which("ign") or "ign", "sdf", "-k", str(out / "sdf/arm.sdf")],
                              capture_output=True, text=True)
     assert "Valid." in checked.stdout, checked.stdout + checked.stderr
+
+
+def test_two_usd_exports_of_one_file_are_refused(tmp_path: Path, diags: Diags) -> None:
+    arm(tmp_path)
+    spec = write(tmp_path / "m.yml", HEAD + """
+    - {type: usd}
+    - {type: usd, layout: single}
+""")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    d = diags.take_error("E0503")
+    assert d.message == "two usd exports would write usd/arm; give one a filename_suffix"
+    assert (d.span.line, d.span.col, d.notes[0][0].line) == (9, 7, 8)
+
+
+def test_a_usd_export_takes_only_its_own_keys(tmp_path: Path, diags: Diags) -> None:
+    arm(tmp_path)
+    spec = write(tmp_path / "m.yml", HEAD + """
+    - {type: usd, layout: flat, mesh_format: stl}
+""")
+    assert compile_file(spec, tmp_path / "out", diags).out is None
+    assert diags.take_error("E0201").message == "unknown key 'mesh_format' in a usd export"
+    assert diags.take_error("E0203").message == "'layout' must be one of 'layered' or 'single', got 'flat'"

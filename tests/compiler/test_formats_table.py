@@ -74,7 +74,7 @@ def test_the_table_loads_no_backend() -> None:
 
 def test_the_formats_that_leave_things_out_name_their_tables() -> None:
     """W0500's tables (backends/holds.py) are the descriptors' `holds`."""
-    from mpc.backends import mjcf, sdf
+    from mpc.backends import mjcf, sdf, usd
 
     assert {name: fmt.holds() for name, fmt in FORMATS.items() if fmt.holds is not None} == {
-        "mjcf": mjcf.CANNOT_HOLD, "sdf": sdf.CANNOT_HOLD}
+        "mjcf": mjcf.CANNOT_HOLD, "sdf": sdf.CANNOT_HOLD, "usd": usd.CANNOT_HOLD}

@@ -27,6 +27,17 @@ DELIBERATE: dict[str, tuple[list[list], list[list]]] = {
 # What the old validator never said: keys that have no effect where they stand (issue 20),
 # warned of by the schema now; each kind has its own test in tests/compiler/broken/.
 NEW_WARNINGS = {"W0250", "W0251", "W0252", "W0253", "W0255", "W0256", "W0257"}
+# Export types added since the recording (`usd`, issue 32): messages that list the export types
+# name them too; the lists are compared without them.
+NEW_EXPORT_TYPES = ("usd",)
+
+
+def _without_new_types(d: list) -> list:
+    texts = [x for x in d if isinstance(x, str)]
+    for t in NEW_EXPORT_TYPES:
+        texts = [x.replace(f"'{t}', ", "").replace(f"{t}, ", "") for x in texts]
+    it = iter(texts)
+    return [next(it) if isinstance(x, str) else x for x in d]
 
 
 def test_the_new_validator_reports_what_the_old_one_did() -> None:
@@ -39,7 +50,7 @@ def test_the_new_validator_reports_what_the_old_one_did() -> None:
             continue
         compared += 1
         got, want = diagnostics(doc), expected[name]
-        got = [d for d in got if d[0] not in NEW_WARNINGS]
+        got = [_without_new_types(d) for d in got if d[0] not in NEW_WARNINGS]
         if name in DELIBERATE:
             assert (want, got) == DELIBERATE[name], name
         elif got != want:

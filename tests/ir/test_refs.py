@@ -80,15 +80,16 @@ NOT_NAMES: dict[tuple[str, str], str] = {
     # The program and its exports (ir/program.py): files, folders, repositories, formats, text.
     **{(cls, field): "a file or folder of the output, or its name" for cls, field in (
         ("UrdfExport", "filename"), ("SdfExport", "filename"), ("MjcfExport", "filename"),
-        ("PdfExport", "filename"), ("JointLimitsExport", "file_name"), ("SmurfExport", "filename"),
+        ("UsdExport", "filename"), ("PdfExport", "filename"), ("JointLimitsExport", "file_name"),
+        ("SmurfExport", "filename"),
         ("SmurfExport", "model_file"), ("SmurfExport", "additional_files"), ("KccdExport", "dirname"),
         ("UrdfExport", "additional_meshes"), ("SdfExport", "additional_meshes"),
         ("MjcfExport", "additional_meshes"), ("CommandExport", "cwd"), ("CommandExport", "executable"),
         ("CommandExport", "command"), ("Deployment", "keep_files"), ("Deployment", "add_lfs_track"),
         ("DeploySubmodule", "target"))},
     **{(cls, "submodel"): "a submodel (its folder), not an element" for cls in (
-        "UrdfExport", "SdfExport", "MjcfExport", "PdfExport", "RenderExport", "JointLimitsExport",
-        "SmurfExport", "KccdExport")},
+        "UrdfExport", "SdfExport", "MjcfExport", "UsdExport", "PdfExport", "RenderExport",
+        "JointLimitsExport", "SmurfExport", "KccdExport")},
     **{(cls, field): "a format or a ROS package" for cls, field in (
         ("UrdfExport", "mesh_format"), ("SdfExport", "mesh_format"), ("MjcfExport", "mesh_format"),
         ("UrdfExport", "float_formats"), ("SdfExport", "float_formats"), ("MjcfExport", "float_formats"),

@@ -153,7 +153,7 @@ def test_completion_of_names_as_they_are_at_the_cursor(server: Client, folder: P
 def test_completion_of_enumerations_and_files(server: Client, folder: Path) -> None:
     text = DEFINITION.replace("    - type: urdf", "    - type: \n    - type: urdf")
     uri, _ = opened(server, folder / "enums.yml", text)
-    assert labels(server, uri, 28, 12)[:4] == ["urdf", "sdf", "mjcf", "smurf"]
+    assert labels(server, uri, 28, 12)[:5] == ["urdf", "sdf", "mjcf", "usd", "smurf"]
     server.change(uri, 2, text.replace("basefile: arm.urdf", "basefile: "))
     assert labels(server, uri, 5, 16) == ["arm.urdf", "arm.urdf.xacro", "arm_segment.xacro", "meshes/"]
 
