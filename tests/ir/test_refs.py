@@ -77,6 +77,8 @@ NOT_NAMES: dict[tuple[str, str], str] = {
     ("CutJoint", "name"): "a loop joint's name; joint name editing leaves it (as before)",
     ("CommandExport", "env"): "names of environment variables a command gets",
     ("Input", "xacro_env"): "names of environment variables a xacro model may read",
+    ("ModelTest", "limit_tolerances"): "names of figures (position, velocity, effort)",
+    ("ModelTest", "mirrored"): "the two words of mirrored joint names (left, right), not names",
     # The program and its exports (ir/program.py): files, folders, repositories, formats, text.
     **{(cls, field): "a file or folder of the output, or its name" for cls, field in (
         ("UrdfExport", "filename"), ("SdfExport", "filename"), ("MjcfExport", "filename"),
