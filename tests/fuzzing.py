@@ -13,7 +13,9 @@ deletes, repeats or cuts it. A secret in the environment must reach no message a
 The mesh kinds mutate an STL (ASCII), OBJ or DAE file the URDF uses (copied as it is,
 converted to STL, OBJ and DAE); `loop` makes a file mpc reads a symbolic link that loops;
 `inertia` writes extreme numbers into the inertials of a model exported to MJCF (its
-principal axes).
+principal axes); `mjcf` mutates the MJCF mpc wrote for the arm, read as the input of a
+definition that exports MJCF (actuators, a scene) and USD again. An MJCF an accepted run
+wrote must load in MuJoCo, a USD layer in usd-core.
 """
 
 from __future__ import annotations
@@ -33,7 +35,8 @@ from xml.parsers import expat
 from tests.conftest import definition
 from tests.fixtures import arm
 
-KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf", "xacro", "stl", "obj", "dae", "loop", "inertia")
+KINDS = ("definition", "pipeline", "urdf", "sdf", "smurf", "xacro", "stl", "obj", "dae", "loop", "inertia",
+         "mjcf")
 ESCAPE = "MPCFUZZESCAPE"  # any file with this name outside the case folder is an escape
 ABSOLUTE = f"/tmp/{ESCAPE}"
 SECRET = "MPCFUZZ_SECRET_4e1b"  # the value of MPC_FUZZ_SECRET while a case runs
@@ -67,6 +70,9 @@ INERTIAS = ("1e308", "-1e308", "1.7e308", "1e200", "1e-320", "-1", "0", "nan", "
 # meshes/iv/collision_<link>.stl; the poses give a mutation a pose name to hit.
 ROUTES = ("      ros_pathes: true\n    - type: sdf\n      mesh_format: stl\n    - type: kccd\n"
           "  ros_pkg_name: robot_model\n  poses:\n    init:\n      shoulder: 0.1\n")
+# An MJCF case's exports: MJCF to simulate (actuators, a scene) and USD, each checked by its consumer.
+MJCF_EXPORTS = ("    - type: mjcf\n      actuators: position\n      scene: true\n    - type: usd\n"
+                "      layout: single\n  poses:\n    init:\n      shoulder: 0.1\n")
 
 
 @dataclass(frozen=True)
@@ -133,8 +139,11 @@ class Seeds:
         arm(folder)
         text = definition("arm.urdf") + ROUTES
         (folder / "model.yml").write_text(text)
+        # the MJCF input: the arm as mpc writes it for MuJoCo, with a keyframe, an actuator and a scene
+        (folder / "mjcf_seed.yml").write_text(definition("arm.urdf") + MJCF_EXPORTS)
         with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
             assert main(["compile", str(folder / "model.yml"), "-o", str(folder / "built")]) == 0
+            assert main(["compile", str(folder / "mjcf_seed.yml"), "-o", str(folder / "built_mjcf")]) == 0
         files = {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
         files["pipeline.yml"] = b"pipeline:\n  root: .\n  model_definitions: [model.yml]\n"
         files["arm.urdf.xacro"] = files["arm.urdf"].replace(
@@ -148,6 +157,7 @@ class Seeds:
         files["inertia.yml"] = (definition("arm.urdf") + "    - type: mjcf\n").encode()
         for kind, basefile in (("sdf", "built/sdf/robot.sdf"), ("smurf", "built/smurf/robot.smurf")):
             files[f"{kind}.yml"] = (definition(basefile) + ROUTES).encode()
+        files["mjcf.yml"] = (definition("built_mjcf/mjcf/robot.xml") + MJCF_EXPORTS).encode()
         shutil.rmtree(folder)
         return cls(files)
 
@@ -158,7 +168,8 @@ class Seeds:
                 "smurf": ("built/smurf/robot.smurf", "smurf.yml"),
                 "xacro": ("arm.urdf.xacro", "xacro.yml"), "stl": ("meshes/m.stl", "meshes.yml"),
                 "obj": ("meshes/m.obj", "meshes.yml"), "dae": ("meshes/m.dae", "meshes.yml"),
-                "loop": ("model.yml", "pipeline.yml"), "inertia": ("arm.urdf", "inertia.yml")}[kind]
+                "loop": ("model.yml", "pipeline.yml"), "inertia": ("arm.urdf", "inertia.yml"),
+                "mjcf": ("built_mjcf/mjcf/robot.xml", "mjcf.yml")}[kind]
 
 
 def _mesh_seeds() -> dict[str, bytes]:
@@ -239,10 +250,12 @@ class Outputs:
     def check(self, out: Path, label: str) -> None:
         for path in sorted(out.rglob("*")):
             if not path.is_file() or path.suffix not in (".urdf", ".sdf", ".xml", ".dae", ".config", ".smurf",
-                                                         ".yml"):
+                                                         ".yml", ".usda", ".usdc"):
                 continue
             self.files += 1
-            problem = output_problem(path)
+            problem = output_problem(path) if path.suffix not in (".usda", ".usdc") else None
+            if problem is None and path.parent.name in ("mjcf", "usd") and path.suffix != ".dae":
+                problem = consumer_refuses(path)
             if problem is not None:
                 self.invalid.append(f"{label}: {path.relative_to(out)}: {problem}")
                 continue
@@ -280,6 +293,34 @@ class Outputs:
         shutil.rmtree(self.folder, ignore_errors=True)
         self.folder.mkdir(parents=True, exist_ok=True)
         return refused
+
+
+def consumer_refuses(path: Path) -> str | None:
+    """Why MuJoCo refuses an MJCF file mpc wrote (the robot's, or the scene that includes it),
+    or usd-core a USD layer (the stage it opens, with every payload and sublayer); None when
+    it loads."""
+    if path.suffix == ".xml":
+        import mujoco
+
+        try:
+            mujoco.MjModel.from_xml_path(str(path))
+        except Exception as e:
+            return f"MuJoCo refuses it: {e}"
+        return None
+    from pxr import Tf, Usd
+
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Tf.ErrorException as e:
+        return f"usd-core cannot open it: {e}"
+    if stage is None:
+        return "usd-core cannot open it"
+    for prim in stage.Traverse():
+        for attribute in prim.GetAttributes():  # as written (a schema's fallback may be inf)
+            value = attribute.Get() if attribute.HasAuthoredValue() else None
+            if isinstance(value, float) and not math.isfinite(value):
+                return f"a number that is not finite: {attribute.GetPath()}"
+    return None
 
 
 def output_problem(path: Path) -> str | None:
