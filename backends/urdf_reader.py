@@ -17,6 +17,7 @@ from lxml import etree
 
 from mpc.backends.urdf_fragments import Fragments
 from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load, parse_floats
+from mpc.core.cycles import paused_cycle_collection
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.packages import PackageResolver
 from mpc.core.record import maker
@@ -99,7 +100,8 @@ def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
 
 def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_dir: Path) -> Robot | None:
     errors_before = sink.error_count
-    robot = _Reader(src, sink, resolver or PackageResolver(), base_dir).robot()
+    with paused_cycle_collection():  # a read makes thousands of records and no garbage cycles
+        robot = _Reader(src, sink, resolver or PackageResolver(), base_dir).robot()
     if robot is None or sink.error_count > errors_before:
         return None
     return robot
