@@ -34,6 +34,23 @@ Path_ = tuple[str | int, ...]
 class _Resolver(yaml.resolver.BaseResolver):
     """Implicit tags of the YAML 1.2 core schema."""
 
+    def resolve(self, kind: Any, value: Any, implicit: Any) -> Any:
+        """BaseResolver's tag, kept for each short scalar: it depends on the scalar's text and
+        whether it was plain or quoted alone (no path resolvers here), and a definition repeats
+        its values, parsed on each keystroke in `mpc lsp`."""
+        if kind is not ScalarNode or len(value) > 64:
+            return super().resolve(kind, value, implicit)
+        key = (value, implicit)
+        tag = _SCALAR_TAGS.get(key)
+        if tag is None:
+            if len(_SCALAR_TAGS) >= 4096:
+                _SCALAR_TAGS.clear()
+            tag = _SCALAR_TAGS[key] = super().resolve(kind, value, implicit)
+        return tag
+
+
+_SCALAR_TAGS: dict[tuple[str, Any], str] = {}  # _Resolver.resolve's, by (text, implicit)
+
 
 for tag, pattern, first in [
     ("tag:yaml.org,2002:bool", r"^(?:true|True|TRUE|false|False|FALSE)$", "tTfF"),
