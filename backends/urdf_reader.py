@@ -17,8 +17,8 @@ from lxml import etree
 
 from mpc.backends.urdf_fragments import Fragments
 from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, load, parse_floats
+from mpc.core.cycles import paused_cycle_collection
 from mpc.core.diagnostics import Sink, did_you_mean
-from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
 from mpc.core.record import maker
 from mpc.core.span import Span
@@ -82,7 +82,8 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None,
     src = load(path, sink, "URDF", display)
     if src is None:
         return None
-    return _robot(src, sink, resolver, resolved(path.parent))
+    resolver = resolver or PackageResolver()
+    return _robot(src, sink, resolver, resolver.resolved(path.parent))
 
 
 def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
@@ -99,7 +100,8 @@ def read_text(data: bytes, file: str, base_dir: Path, sink: Sink,
 
 def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_dir: Path) -> Robot | None:
     errors_before = sink.error_count
-    robot = _Reader(src, sink, resolver or PackageResolver(), base_dir).robot()
+    with paused_cycle_collection():  # a read makes thousands of records and no garbage cycles
+        robot = _Reader(src, sink, resolver or PackageResolver(), base_dir).robot()
     if robot is None or sink.error_count > errors_before:
         return None
     return robot

@@ -1,7 +1,10 @@
 """Time to read talos_full_v2.urdf into the IR and emit it as canonical URDF (no mesh copies).
 
-Targets: under 30 ms for read + emit (issue 2); at most 6× lxml's own parse + serialize of
-the same file, in the same process (issue 19), printed as a ratio of the medians.
+Targets: under 30 ms for read + emit (issue 2); at most 4× lxml's own parse + serialize of
+the same file, in the same process (issue 34; 6× in issue 19), printed as a ratio of the medians.
+The ratio is printed twice: of wall times, and of the thread's CPU times. On a busy machine the
+wall time of a read (10 ms) holds the waits of the processes the scheduler ran in between,
+which lxml's 2 ms seldom do: the ratio of CPU times is the one to judge there.
 Run: python bench/bench_urdf.py [repetitions]
 """
 
@@ -28,18 +31,20 @@ def main(reps: int = 30) -> None:
     def name(mesh: Mesh) -> str:
         return mesh.source.uri
 
-    reads, emits, lxml_alone = [], [], []
+    reads, emits, lxml_alone, cpu, lxml_cpu = [], [], [], [], []
     data = path.read_bytes()
     for _ in range(reps):
-        t0 = time.perf_counter()
+        c0, t0 = time.thread_time(), time.perf_counter()
         etree.tostring(etree.fromstring(data))
         lxml_alone.append((time.perf_counter() - t0) * 1e3)
-        t0 = time.perf_counter()
+        lxml_cpu.append((time.thread_time() - c0) * 1e3)
+        c0, t0 = time.thread_time(), time.perf_counter()
         robot = urdf.read(path, Sink())
         t1 = time.perf_counter()
         assert robot is not None
         urdf.to_string(robot, name)
         t2 = time.perf_counter()
+        cpu.append((time.thread_time() - c0) * 1e3)
         reads.append((t1 - t0) * 1e3)
         emits.append((t2 - t1) * 1e3)
     total = [r + e for r, e in zip(reads, emits, strict=True)]
@@ -50,7 +55,10 @@ def main(reps: int = 30) -> None:
     print(f"  total {statistics.median(total):6.2f} ms   (target < 30 ms)")
     lxml_ms = statistics.median(lxml_alone)
     print(f"  lxml parse + serialize alone {lxml_ms:6.2f} ms: mpc's read + emit is "
-          f"{statistics.median(total) / lxml_ms:.1f}× (target ≤ 6×; load average {os.getloadavg()[0]:.1f})")
+          f"{statistics.median(total) / lxml_ms:.1f}× (target ≤ 4×; load average {os.getloadavg()[0]:.1f})")
+    cpu_ms, lxml_cpu_ms = statistics.median(cpu), statistics.median(lxml_cpu)
+    print(f"  CPU time: mpc {cpu_ms:6.2f} ms, lxml {lxml_cpu_ms:6.2f} ms: "
+          f"{cpu_ms / lxml_cpu_ms:.1f}× (target ≤ 4×)")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING
 
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
 from mpc.core.diagnostics import Sink, did_you_mean
-from mpc.core.record import record
 from mpc.core.span import Span, source_line
 
 if TYPE_CHECKING:
@@ -54,7 +53,7 @@ def evaluate(value: object, span: Span, sink: Sink, *, what: str = "value") -> f
     if isinstance(value, list):
         return _pair(value, span, sink, what)
     if isinstance(value, str):
-        return _expression(value, _Where.of(span, value, last=False), sink, what)
+        return _expression(value, _Where(span, value, last=False), sink, what)
     if isinstance(value, bool) or not isinstance(value, int | float):
         sink.error(span, "E0214", f"{what} must be a number, got {_describe(value)}")
         return None
@@ -80,7 +79,7 @@ def _pair(value: list[object], span: Span, sink: Sink, what: str) -> float | Non
         sink.error(span, "E0214", f"unknown unit '{unit}' for {what}{near}", hint="units are deg and rad")
         return None
     if isinstance(number, str):
-        result = _expression(number, _Where.of(span, number, last=True), sink, what)
+        result = _expression(number, _Where(span, number, last=True), sink, what)
     elif isinstance(number, list | dict):
         sink.error(span, "E0214", f"the value in [{unit}, …] for {what} must be a number, "
                                   f"got {_describe(number)}")
@@ -96,33 +95,46 @@ def _describe(value: object) -> str:
     return {type(None): "null", dict: "a mapping", list: "a list"}.get(type(value), type(value).__name__)
 
 
-@record(slots=True)
 class _Where:
-    """Maps offsets in an expression's text onto the file; col: where the text starts, if known."""
+    """Maps offsets in an expression's text onto the file: `at`. Where the text starts on its
+    line is looked up in the file when a diagnostic first asks (most expressions report
+    nothing, and `mpc lsp` evaluates every one of a definition on each keystroke)."""
 
-    span: Span
-    col: int | None
+    __slots__ = ("_col", "_last", "_text", "span")
+    _UNKNOWN = object()
 
-    @classmethod
-    def of(cls, span: Span, text: str, *, last: bool) -> _Where:
-        """Find `text` in the source: the whole scalar, or (last) the last item of a flow list."""
+    def __init__(self, span: Span, text: str, *, last: bool) -> None:
+        """`text`: the whole scalar, or (last) the last item of a flow list."""
+        self.span, self._text, self._last, self._col = span, text, last, _Where._UNKNOWN
+
+    @property
+    def col(self) -> int | None:
+        """The column where the text starts, if known."""
+        if self._col is _Where._UNKNOWN:
+            self._col = self._find()
+        return self._col  # type: ignore[return-value]
+
+    def _find(self) -> int | None:
+        """Find the text in the source line."""
+        span, text, last = self.span, self._text, self._last
         if "\n" in text or span.end_line > span.line:
-            return cls(span, None)  # block and folded scalars: offsets are not columns
+            return None  # block and folded scalars: offsets are not columns
         line = source_line(span.file, span.line)
         if line is None:
-            return cls(span, None if last else span.col)  # unreadable: assume unquoted
+            return None if last else span.col  # unreadable: assume unquoted
         if last:
             stop = span.end_col - 1 if span.end_col > span.col else len(line)
             i = line.rfind(text, span.col - 1, stop)
-            return cls(span, i + 1 if i >= 0 else None)
+            return i + 1 if i >= 0 else None
         col = span.col + (line[span.col - 1:span.col] in ("'", '"'))
         # An escape sequence in a double-quoted scalar breaks the mapping; fall back to the start.
-        return cls(span, col if line[col - 1:col - 1 + len(text)] == text else None)
+        return col if line[col - 1:col - 1 + len(text)] == text else None
 
     def at(self, start: int, end: int) -> Span:
-        if self.col is None:
+        col = self.col
+        if col is None:
             return self.span
-        return Span(self.span.file, self.span.line, self.col + start, self.span.line, self.col + end)
+        return Span(self.span.file, self.span.line, col + start, self.span.line, col + end)
 
 
 def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None:
@@ -185,17 +197,18 @@ class _Evaluator:
                 return self.call(node, func, args)
 
     def call(self, node: Call, func: str, args: tuple[Node, ...]) -> float | None:
-        span = self.where.at(node.start, node.end)
         if func not in FUNCTIONS:
-            self.sink.error(span, "E0212", f"unknown function '{func}' in expression for {self.what}"
-                                           f"{did_you_mean(func, set(FUNCTIONS))}",
+            self.sink.error(self.where.at(node.start, node.end), "E0212",
+                            f"unknown function '{func}' in expression for {self.what}"
+                            f"{did_you_mean(func, set(FUNCTIONS))}",
                             hint=f"functions are {', '.join(FUNCTIONS)}")
             return None
         fewest, most, fn = FUNCTIONS[func]
         if len(args) < fewest or (most is not None and len(args) > most):
             want = f"{'at least ' if most is None else ''}{fewest} argument{'s' if fewest > 1 else ''}"
-            self.sink.error(span, "E0212", f"function '{func}' takes {want} but got {len(args)} "
-                                           f"in expression for {self.what}")
+            self.sink.error(self.where.at(node.start, node.end), "E0212",
+                            f"function '{func}' takes {want} but got {len(args)} "
+                            f"in expression for {self.what}")
             return None
         values = [v for v in [self.value(a) for a in args] if v is not None]
         if len(values) < len(args):

@@ -179,7 +179,7 @@ def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
     would say; E0654 once for a package not found); none is read. Every mesh of the input
     counts, also one a later edit removes. The driver reports them after the names are
     checked, which they do not hinder."""
-    seen: set[Path] = set()
+    seen: set[Path] = set()  # each file is looked for once (most are used by a visual and a collision)
     out = []
     uses = [(name, element, item.geometry) for name, link in robot.links.items()
             for element, items in (("visual", link.visuals), ("collision", link.collisions))
@@ -190,8 +190,9 @@ def _missing_meshes(robot: Robot, where: Span) -> list[Diagnostic]:
         out += unfound_packages(uses, where)
     for name, element, mesh in uses:
         path = mesh.source.path  # None: its package was not found (reported above)
-        if path is not None and path not in seen and not path.is_file():
-            out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{path}' of a {element} of "
-                                  f"link '{name}' {why_absent(path)}", mesh.span or where))
+        if path is not None and path not in seen:
             seen.add(path)
+            if not path.is_file():
+                out.append(Diagnostic(Severity.ERROR, "E0602", f"mesh file '{path}' of a {element} of "
+                                      f"link '{name}' {why_absent(path)}", mesh.span or where))
     return out

@@ -103,10 +103,33 @@ def why_absent(path: Path | str) -> str:
     return "does not exist"
 
 
-def package_roots(folders: Iterable[Path]) -> tuple[Path, ...]:
+def package_roots(folders: Iterable[Path], real_dirs: dict[str, str] | None = None) -> tuple[Path, ...]:
     """The folders whose files inputs may link to, resolved (the definitions' folders,
-    --package roots, the package search path, a checkout: core/packages.py names them)."""
-    return tuple(dict.fromkeys(resolved(f) for f in folders))
+    --package roots, the package search path, a checkout: core/packages.py names them).
+
+    real_dirs: folders resolved before (`input_problem`'s): the roots of a model share most
+    of their path with each other and with its meshes' folders, which realpath would look
+    at again, component by component, for each."""
+    if real_dirs is None:
+        return tuple(dict.fromkeys(resolved(f) for f in folders))
+    return tuple(dict.fromkeys(Path(real_path(str(f), real_dirs)) for f in folders))
+
+
+class Roots(tuple[Path, ...]):
+    """Resolved package roots (`package_roots`) as `input_problem` asks them, for the many
+    files of one model: whether a resolved path is one of them or inside one, by two lookups
+    rather than a comparison with each root."""
+
+    def __new__(cls, roots: Iterable[Path]) -> Roots:
+        self = super().__new__(cls, roots)
+        texts = [str(r) for r in self]
+        self._exact = frozenset(texts)
+        self._below = tuple(t if t.endswith("/") else t + "/" for t in texts)
+        return self
+
+    def hold(self, real: str) -> bool:
+        """Whether the resolved path `real` is one of the roots or inside one (`_within`)."""
+        return real in self._exact or real.startswith(self._below)
 
 
 def input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] | None = None,
@@ -179,7 +202,7 @@ def _input_problem(path: Path, roots: Iterable[Path], real_dirs: dict[str, str] 
         normal = os.path.normpath(os.path.abspath(path))
     if not stat.S_ISREG(mode):
         return "it is not a regular file (a device, FIFO, socket or folder)"
-    if not any(_within(real, str(r)) for r in roots):
+    if not (roots.hold(real) if isinstance(roots, Roots) else any(_within(real, str(r)) for r in roots)):
         if real != normal:  # a link on the way
             return f"it is a link to '{real}', outside the model's package roots"
         return f"it is '{real}', outside the project and the model's package roots"
@@ -221,6 +244,15 @@ def plain_stat(path: Path, real_dirs: dict[str, str]) -> tuple[str, int] | bool:
     except OSError:
         return True
     return True if stat.S_ISLNK(mode) else (joined, mode)
+
+
+def real_path(text: str, real_dirs: dict[str, str]) -> str:
+    """os.path.realpath(text), through `real_dirs` (`_real_folder`) when `text` is absolute and
+    normal (a relative or unusual path, `..` after a link, resolves as realpath resolves it)."""
+    if (text[:1] != "/" or "//" in text or "/./" in text or "/../" in text or text.endswith(("/.", "/.."))
+            or (text.endswith("/") and text != "/")):
+        return os.path.realpath(text)
+    return _real_folder(text, real_dirs)
 
 
 def _realpath(path: Path, real_dirs: dict[str, str] | None) -> str:

@@ -25,11 +25,14 @@ import re
 import stat
 import sys
 import sysconfig
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from mpc.core.reads import note_package
+
+if TYPE_CHECKING:
+    from mpc.core.files import Roots
 
 
 @functools.cache
@@ -178,7 +181,7 @@ class PackageResolver:
     # named on the command line).
     projects: list[Path] = field(default_factory=list)
     _cache: dict[str, Path | None] = field(default_factory=dict)
-    _real_roots: dict[tuple[Path, ...], tuple[Path, ...]] = field(default_factory=dict)
+    _real_roots: dict[tuple[Path, ...], Roots] = field(default_factory=dict)
     _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
     _near: dict[tuple[str, Path], Path | None] = field(default_factory=dict)  # (package, near) → folder
     _named_above: set[Path] = field(default_factory=set)  # packages above a model, by package.xml
@@ -281,10 +284,10 @@ class PackageResolver:
         return input_problem(path, self._package_roots(base_dir), self._real_dirs,
                              None if found is True else found)
 
-    def _package_roots(self, base_dir: Path | None) -> Iterator[Path]:
-        """The package roots and `base_dir`, resolved once for every mesh of a model, and only
-        when a link asks (a generator: most input files are no links)."""
-        from mpc.core.files import package_roots
+    def _package_roots(self, base_dir: Path | None) -> Roots:
+        """The package roots and `base_dir`, resolved once for every mesh of a model (their
+        folders through the resolved folders of its meshes: `_real_dirs`)."""
+        from mpc.core.files import Roots, package_roots
 
         assert self.search_path is not None
         # A package found on the search path is a root wherever its folder links to: the
@@ -294,9 +297,18 @@ class PackageResolver:
         own = (base_dir, base_dir.parent) if base_dir and not self.projects and base_dir.name in \
             MODEL_FOLDERS else (base_dir,) if base_dir else ()
         folders = (*self.package_map.values(), *self.search_path, *found, *self.roots, *self.projects, *own)
-        if folders not in self._real_roots:
-            self._real_roots[folders] = package_roots(folders)
-        yield from self._real_roots[folders]
+        roots = self._real_roots.get(folders)
+        if roots is None:
+            roots = self._real_roots[folders] = Roots(package_roots(folders, self._real_dirs))
+        return roots
+
+    def resolved(self, path: Path) -> Path:
+        """core/files.py `resolved(path)`, through the folders resolved before for this
+        resolver's inputs (`_real_dirs`): a model file's folder shares most of its path with
+        its meshes' folders and the package roots."""
+        from mpc.core.files import real_path
+
+        return Path(real_path(str(path), self._real_dirs))
 
     def locate(self, uri: str, base_dir: Path) -> tuple[Path | None, str]:
         """A filename as written in a file in `base_dir` → (the file, or None when its package

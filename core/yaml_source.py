@@ -26,12 +26,30 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mpc.core.diagnostics import Sink
 from mpc.core.files import special_problem
+from mpc.core.record import maker
 from mpc.core.span import Span
 
 Path_ = tuple[str | int, ...]
 
 class _Resolver(yaml.resolver.BaseResolver):
     """Implicit tags of the YAML 1.2 core schema."""
+
+    def resolve(self, kind: Any, value: Any, implicit: Any) -> Any:
+        """BaseResolver's tag, kept for each short scalar: it depends on the scalar's text and
+        whether it was plain or quoted alone (no path resolvers here), and a definition repeats
+        its values, parsed on each keystroke in `mpc lsp`."""
+        if kind is not ScalarNode or len(value) > 64:
+            return super().resolve(kind, value, implicit)
+        key = (value, implicit)
+        tag = _SCALAR_TAGS.get(key)
+        if tag is None:
+            if len(_SCALAR_TAGS) >= 4096:
+                _SCALAR_TAGS.clear()
+            tag = _SCALAR_TAGS[key] = super().resolve(kind, value, implicit)
+        return tag
+
+
+_SCALAR_TAGS: dict[tuple[str, Any], str] = {}  # _Resolver.resolve's, by (text, implicit)
 
 
 for tag, pattern, first in [
@@ -153,9 +171,17 @@ def _span(file: str, node: Node) -> Span:
 class _Builder:
     def __init__(self, doc: Document, sink: Sink, limits: Limits = LIMITS) -> None:
         self.doc, self.sink, self.limits = doc, sink, limits
+        # Span's maker (core/record.py): a span for every key and value, on each keystroke in
+        # `mpc lsp` (a thousand for a TALOS definition).
+        self.new_span = maker(Span)
         self.unusable = False  # a value no later step can take (a NUL character, a limit hit)
         self.nodes = 0
         self.open: set[int] = set()  # the nodes being built: an alias to one of them is a cycle
+
+    def span(self, node: Node) -> Span:
+        """`_span(file, node)`, made by the maker."""
+        s, e = node.start_mark, node.end_mark
+        return self.new_span(self.doc.file, s.line + 1, s.column + 1, e.line + 1, e.column + 1)
 
     def scalar(self, node: ScalarNode, path: Path_) -> Any:
         v, tag = node.value, node.tag
@@ -200,7 +226,7 @@ class _Builder:
                             "values")
             self.unusable = True
             return None
-        self.doc.values[path] = _span(self.doc.file, node)
+        self.doc.values[path] = self.span(node)
         if isinstance(node, ScalarNode):
             return self.scalar(node, path)
         if id(node) in self.open:
@@ -235,7 +261,7 @@ class _Builder:
                 self.sink.error(_span(self.doc.file, key_node), "E0103", f"duplicate key '{key}'",
                                 notes=((self.doc.keys[key_path], "first written here"),))
                 continue
-            self.doc.keys[key_path] = _span(self.doc.file, key_node)
+            self.doc.keys[key_path] = self.span(key_node)
             out[key] = self.build(value_node, key_path)
         for source in merged:  # explicit keys win over merged ones
             if isinstance(source, MappingNode):

@@ -13,7 +13,6 @@ from lsprotocol import types as lsp
 from mpc.compiler.expr import evaluate
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
-from mpc.ir.kinematics import link_in_root, matrix_pose
 from mpc.ir.robot import Joint, Link, Robot
 from mpc.ir.tree import joints_up
 from mpc.lsp import schema_data
@@ -61,6 +60,9 @@ def describe(robot: Robot, thing: Link | Joint, span: Span | None) -> str:
     out.append(f"mass: {_g(inertial.mass)} kg" if inertial is not None else "no inertial")
     up = joints_up(robot, thing.name)
     out.append(f"parent joint: {up[0].name} ({up[0].type})" if up else "the root link")
+    # numpy (13 MiB the server would hold from its start) is loaded by the first hover on a link
+    from mpc.ir.kinematics import link_in_root, matrix_pose
+
     pose = matrix_pose(link_in_root(robot, thing.name))
     out.append(f"pose in the root frame: xyz {_vec(pose.xyz)}, rpy {_vec(pose.rpy)}")
     return "\n\n".join(out) + where
