@@ -58,7 +58,7 @@ def model_names(tree: etree._ElementTree, paths: dict[str, str]) -> dict[str, se
 URDF = {"link": "link", "joint": "joint", "collision": "link/collision", "visual": "link/visual"}
 SDF = {"link": "model/link", "joint": "model/joint", "collision": "model/link/collision",
        "visual": "model/link/visual"}
-MJCF = {"collision": ".//geom[@group='3']", "visual": ".//geom[@group='1']"}
+MJCF = {"collision": ".//geom[@group='3']", "visual": ".//geom[@group='2']"}
 
 
 @pytest.mark.long
