@@ -135,17 +135,19 @@ def test_files_with_the_same_bytes_keep_their_own_names(tmp_path: Path,
 
 def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
                                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    """STL and OBJ (mirrored too) from one parse of the DAE; a later build's bobj from none."""
+    """The STL from one plain read of the DAE (backends/plain_meshes.py), the OBJ from one
+    trimesh parse; a later build's bobj from none (the parse's normalized form)."""
     spec = _arm(tmp_path / "model")
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
     text = spec.read_text()
     spec.write_text(text + "    - {type: urdf, mesh_format: obj, filename_suffix: _obj}\n")
     assert compile_file(spec, tmp_path / "one", Sink()).out is not None
-    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse"]
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse", "parse"]
     spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
     assert compile_file(spec, tmp_path / "two", Sink()).out is not None
-    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == [
+        "derive", "derive", "derive", "parse", "parse"]
 
 
 _OPENED: list[str] | None = None  # the files opened while a test listens (an audit hook cannot be removed)
