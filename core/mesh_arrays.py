@@ -238,7 +238,8 @@ def _walk(node: Any, parent: np.ndarray, ns: str, ids: dict[str, Any], parts: li
             geometry = ids.get((child.get("url") or "").removeprefix("#"))
             if geometry is None or geometry.tag != f"{ns}geometry" or not _materials_resolve(child, ns, ids):
                 return False
-            found = _geometry(geometry, ns)
+            bound = {str(m.get("symbol")) for m in child.iter(f"{ns}instance_material")}
+            found = _geometry(geometry, ns, bound)
             if found is None:
                 return False
             placed = _repaired(np.asarray(np.dot(parent, local), dtype=np.float64))
@@ -298,55 +299,101 @@ def _materials_resolve(instance: Any, ns: str, ids: dict[str, Any]) -> bool:
     return True
 
 
-def _geometry(geometry: Any, ns: str) -> list[Arrays] | None:
-    """One mesh per triangle primitive of a geometry (lines are no triangles)."""
+def _geometry(geometry: Any, ns: str, bound: set[str]) -> list[Arrays] | None:
+    """One mesh per triangle primitive of a geometry (lines are no triangles), its corners
+    merged as trimesh merges a loaded geometry's vertices (`_merged`). bound: the material
+    symbols its instance binds (a primitive with a bound material keeps its texture
+    coordinates, which keep corners apart)."""
     mesh = geometry.find(f"{ns}mesh")
     if mesh is None:
         return None
     sources: dict[str, Any] = {s.get("id"): s for s in mesh.iterfind(f"{ns}source")}
     vertices = mesh.find(f"{ns}vertices")
-    position = None
-    if vertices is not None:
-        for given in vertices.iterfind(f"{ns}input"):
-            if given.get("semantic") == "POSITION":
-                position = _float_source(sources.get((given.get("source") or "").removeprefix("#")), ns)
-                if position is None:
-                    return None
+    shared = [] if vertices is None else [
+        ("VERTEX" if i.get("semantic") == "POSITION" else i.get("semantic"), i.get("source") or "")
+        for i in vertices.iterfind(f"{ns}input")]
     parts: list[Arrays] = []
     for primitive in mesh:
         tag = primitive.tag[len(ns):] if isinstance(primitive.tag, str) else ""
         if tag not in ("triangles", "polylist", "polygons"):
             continue
-        inputs = primitive.findall(f"{ns}input")
-        stride = 1 + max((int(i.get("offset", "0")) for i in inputs), default=0)
-        offset = next((int(i.get("offset", "0")) for i in inputs if i.get("semantic") == "VERTEX"), None)
-        if offset is None or position is None:
+        inputs: dict[str, list[tuple[int, str]]] = {}  # semantic → (offset, source), in pycollada's order
+        for given in primitive.iterfind(f"{ns}input"):
+            offset = int(given.get("offset", "0"))
+            if given.get("semantic") == "VERTEX":
+                for semantic, source in shared:
+                    inputs.setdefault(str(semantic), []).append((offset, source))
+            else:
+                inputs.setdefault(str(given.get("semantic")), []).append((offset, given.get("source") or ""))
+        stride = 1 + max((offset for found in inputs.values() for offset, _ in found), default=0)
+        rows = _corner_rows(primitive, tag, ns, stride)
+        if rows is None:
+            return None
+        if "VERTEX" not in inputs or not len(rows):
             continue  # no vertices: trimesh skips the primitive
-        if tag == "polygons":
-            polygons = [_ints(p.text) for p in primitive.iterfind(f"{ns}p")]
-            index = np.concatenate(polygons) if polygons else np.zeros(0, dtype=np.int64)
-            counts = np.array([len(p) // stride for p in polygons], dtype=np.int64)
-        else:
-            p = primitive.find(f"{ns}p")
-            index = _ints(None if p is None else p.text)
-            counts = None
-            if tag == "polylist":
-                vcount = primitive.find(f"{ns}vcount")
-                counts = _ints(None if vcount is None else vcount.text)
-        if len(index) % stride:
-            return None
-        corners = index.reshape((-1, stride))[:, offset]
-        if counts is not None:
-            if int(counts.sum()) != len(corners) or (len(counts) and int(counts.min()) < 3):
+        points = _indexed(sources, inputs["VERTEX"][0], rows, ns, 3)
+        normals = _indexed(sources, inputs["NORMAL"][0], rows, ns, 3) if "NORMAL" in inputs else None
+        uv = None
+        if "TEXCOORD" in inputs and primitive.get("material") in bound:
+            uv = _indexed(sources, inputs["TEXCOORD"][0], rows, ns, 2)
+            if uv is None:
                 return None
-            corners = _fan(corners, counts)
-        elif len(corners) % 3:
+        if points is None or ("NORMAL" in inputs and normals is None):
             return None
-        if len(corners) and (int(corners.min()) < 0 or int(corners.max()) >= len(position)):
-            return None
-        points = position[corners].reshape((-1, 3)).astype(np.float64)
-        parts.append(Arrays(points, np.arange(len(points), dtype=np.int64).reshape((-1, 3))))
+        merged = _merged(points, normals, uv)
+        parts.append(Arrays(merged, np.arange(len(merged), dtype=np.int64).reshape((-1, 3))))
     return parts
+
+
+def _corner_rows(primitive: Any, tag: str, ns: str, stride: int) -> np.ndarray | None:
+    """The primitive's corners as rows of indices (one per input offset), three a triangle
+    (a polygon fanned from its first corner); None when the counts do not add up."""
+    if tag == "polygons":
+        polygons = [_ints(p.text) for p in primitive.iterfind(f"{ns}p")]
+        index = np.concatenate(polygons) if polygons else np.zeros(0, dtype=np.int64)
+        counts: np.ndarray | None = np.array([len(p) // stride for p in polygons], dtype=np.int64)
+    else:
+        p = primitive.find(f"{ns}p")
+        index = _ints(None if p is None else p.text)
+        counts = None
+        if tag == "polylist":
+            vcount = primitive.find(f"{ns}vcount")
+            counts = _ints(None if vcount is None else vcount.text)
+    if len(index) % stride:
+        return None
+    rows = index.reshape((-1, stride))
+    if counts is not None:
+        if int(counts.sum()) != len(rows) or (len(counts) and int(counts.min()) < 3):
+            return None
+        return rows[_fan(np.arange(len(rows)), counts)]
+    return rows if len(rows) % 3 == 0 else None
+
+
+def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, ns: str,
+             width: int) -> np.ndarray | None:
+    """An input's values at each corner (float64), or None (a source missing or out of range)."""
+    offset, source = given
+    values = _float_source(sources.get(source.removeprefix("#")), ns, width)
+    if values is None:
+        return None
+    index = rows[:, offset]
+    if int(index.min()) < 0 or int(index.max()) >= len(values):
+        return None
+    return values[index].astype(np.float64)
+
+
+def _merged(points: np.ndarray, normals: np.ndarray | None, uv: np.ndarray | None) -> np.ndarray:
+    """Each corner moved to the first corner that trimesh merges it with: the same position to
+    8 decimals, texture coordinate to 4 and normal to 2 (`Trimesh.merge_vertices`, which
+    trimesh's COLLADA loader does)."""
+    stacked = [points * (10**8)]
+    if uv is not None:
+        stacked.append(uv * (10**4))
+    if normals is not None:
+        stacked.append(normals * (10**2))
+    keys = np.column_stack(stacked).round().astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    return points[first[inverse.reshape(-1)]]
 
 
 def _ints(text: str | None) -> np.ndarray:
@@ -376,8 +423,9 @@ def _fan(corners: np.ndarray, counts: np.ndarray) -> np.ndarray:
     return fanned.reshape(-1)
 
 
-def _float_source(source: Any, ns: str) -> np.ndarray | None:
-    """A <source>'s float array as pycollada reads it (float32), one row per 3 params."""
+def _float_source(source: Any, ns: str, width: int) -> np.ndarray | None:
+    """A <source>'s float array as pycollada reads it (float32, nan made 0), a row of `width`
+    params each."""
     if source is None:
         return None
     array = source.find(f"{ns}float_array")
@@ -385,9 +433,10 @@ def _float_source(source: Any, ns: str) -> np.ndarray | None:
     if array is None or accessor is None:
         return None
     params = accessor.findall(f"{ns}param")
-    if len(params) != 3 or int(accessor.get("stride", "3")) != 3:
+    if len(params) != width or int(accessor.get("stride", str(width))) != width:
         return None
     values = _numbers(array.text, np.float32)
-    if len(values) % 3:
+    if len(values) % width:
         return None
-    return values.reshape((-1, 3))
+    values[np.isnan(values)] = 0
+    return values.reshape((-1, width))

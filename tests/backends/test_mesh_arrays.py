@@ -16,15 +16,9 @@ from mpc.core import mesh_arrays
 from tests.conftest import ERD
 
 MESHES = sorted(p for p in ERD.rglob("*") if p.is_file() and p.suffix.lower() in (".stl", ".dae"))
-# Files where the plain path's triangles differ from pycollada's in a few corners by less than
-# 1e-8 m (not yet understood; their STL bytes differ from trimesh's).
-NEAR = {"baxter_description/meshes/electric_gripper/fingers/limiter.DAE",
-        "hextilt_description/meshes/link_2.dae", "hextilt_description/meshes/link_3.dae",
-        "icub_description/meshes/upmc/visual/icub_l_shank.dae",
-        "icub_description/meshes/upmc/visual/icub_r_shank.dae"}
 
 
-def _trimesh(path: Path):  # noqa: ANN202  (a trimesh.Trimesh)
+def _trimesh(path: Path):  # a trimesh.Trimesh
     from mpc.ir.mesh_source import _parse
 
     return _parse(path, path.suffix.lower(), [])
@@ -50,10 +44,6 @@ def test_plain_path_equals_trimesh(path: Path) -> None:
     ours = plain.vertices[plain.faces]
     theirs = np.asarray(mesh.vertices)[np.asarray(mesh.faces)]
     assert ours.shape == theirs.shape
-    if str(path.relative_to(ERD)) in NEAR:
-        far = np.abs(ours - theirs).max(axis=(1, 2))
-        assert far.max() < 1e-8 and np.count_nonzero(far) <= 5
-        return
     assert np.array_equal(ours, theirs)
     assert np.array_equal(plain_mirrored.vertices[plain_mirrored.faces],
                           np.asarray(mirrored.vertices)[np.asarray(mirrored.faces)])
