@@ -313,6 +313,8 @@ def _geometry(geometry: Any, ns: str, bound: set[str]) -> list[Arrays] | None:
         ("VERTEX" if i.get("semantic") == "POSITION" else i.get("semantic"), i.get("source") or "")
         for i in vertices.iterfind(f"{ns}input")]
     parts: list[Arrays] = []
+    parsed: dict[tuple[str, int], np.ndarray | None] = {}
+    movables: dict[str, np.ndarray] = {}
     for primitive in mesh:
         tag = primitive.tag[len(ns):] if isinstance(primitive.tag, str) else ""
         if tag not in ("triangles", "polylist", "polygons"):
@@ -331,16 +333,19 @@ def _geometry(geometry: Any, ns: str, bound: set[str]) -> list[Arrays] | None:
             return None
         if "VERTEX" not in inputs or not len(rows):
             continue  # no vertices: trimesh skips the primitive
-        points = _indexed(sources, inputs["VERTEX"][0], rows, ns, 3)
-        normals = _indexed(sources, inputs["NORMAL"][0], rows, ns, 3) if "NORMAL" in inputs else None
+        points = _indexed(sources, inputs["VERTEX"][0], rows, ns, 3, parsed)
+        normals = _indexed(sources, inputs["NORMAL"][0], rows, ns, 3, parsed) if "NORMAL" in inputs else None
         uv = None
         if "TEXCOORD" in inputs and primitive.get("material") in bound:
-            uv = _indexed(sources, inputs["TEXCOORD"][0], rows, ns, 2)
+            uv = _indexed(sources, inputs["TEXCOORD"][0], rows, ns, 2, parsed)
             if uv is None:
                 return None
         if points is None or ("NORMAL" in inputs and normals is None):
             return None
-        merged = _merged(points, normals, uv)
+        offset, source = inputs["VERTEX"][0]
+        if source not in movables:  # judged on the source's values: fewer than the corners
+            movables[source] = _movable(np.asarray(parsed[(source, 3)], dtype=np.float64))
+        merged = _merged(points, normals, uv, movables[source][rows[:, offset]])
         parts.append(Arrays(merged, np.arange(len(merged), dtype=np.int64).reshape((-1, 3))))
     return parts
 
@@ -369,11 +374,15 @@ def _corner_rows(primitive: Any, tag: str, ns: str, stride: int) -> np.ndarray |
     return rows if len(rows) % 3 == 0 else None
 
 
-def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, ns: str,
-             width: int) -> np.ndarray | None:
-    """An input's values at each corner (float64), or None (a source missing or out of range)."""
+def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, ns: str, width: int,
+             parsed: dict[tuple[str, int], np.ndarray | None]) -> np.ndarray | None:
+    """An input's values at each corner (float64), or None (a source missing or out of range).
+    parsed: the geometry's sources parsed so far (each is parsed once)."""
     offset, source = given
-    values = _float_source(sources.get(source.removeprefix("#")), ns, width)
+    key = (source, width)
+    if key not in parsed:
+        parsed[key] = _float_source(sources.get(source.removeprefix("#")), ns, width)
+    values = parsed[key]
     if values is None:
         return None
     index = rows[:, offset]
@@ -382,18 +391,53 @@ def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, 
     return values[index].astype(np.float64)
 
 
-def _merged(points: np.ndarray, normals: np.ndarray | None, uv: np.ndarray | None) -> np.ndarray:
+def _merged(points: np.ndarray, normals: np.ndarray | None, uv: np.ndarray | None,
+            movable: np.ndarray) -> np.ndarray:
     """Each corner moved to the first corner that trimesh merges it with: the same position to
     8 decimals, texture coordinate to 4 and normal to 2 (`Trimesh.merge_vertices`, which
-    trimesh's COLLADA loader does)."""
-    stacked = [points * (10**8)]
+    trimesh's COLLADA loader does). Only the corners `movable` marks can move (`_movable`);
+    the others are left as they are."""
+    movable = np.nonzero(movable)[0]
+    if not len(movable):
+        return points
+    stacked = [points[movable] * (10**8)]
     if uv is not None:
-        stacked.append(uv * (10**4))
+        stacked.append(uv[movable] * (10**4))
     if normals is not None:
-        stacked.append(normals * (10**2))
+        stacked.append(normals[movable] * (10**2))
     keys = np.column_stack(stacked).round().astype(np.int64)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    return points[first[inverse.reshape(-1)]]
+    order = np.lexsort(keys.T[::-1])  # stable: the first of equal keys is the first corner
+    ordered = keys[order]
+    starts = np.empty(len(keys), dtype=bool)
+    starts[:1] = True
+    starts[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    first = np.empty(len(keys), dtype=np.int64)
+    first[order] = order[starts][np.cumsum(starts) - 1]
+    merged = points.copy()
+    merged[movable] = points[movable[first]]
+    return merged
+
+
+def _movable(points: np.ndarray) -> np.ndarray:
+    """The points with a coordinate that rounds to 8 decimals as another, different value of
+    its column does (0 and -0 among them). Corners merge only when all their coordinates round
+    alike, so a corner at a point without one merges with none but its equals, and those it
+    merges with have one too."""
+    movable = np.zeros(len(points), dtype=bool)
+    for column in points.T:
+        values, inverse = np.unique(column, return_inverse=True)
+        keys = (values * (10**8)).round()
+        same = keys[1:] == keys[:-1]
+        shared = np.zeros(len(values), dtype=bool)
+        shared[1:] |= same
+        shared[:-1] |= same
+        movable |= shared[inverse.reshape(-1)]
+        zeros = column == 0
+        if zeros.any():
+            signs = np.signbit(column[zeros])
+            if signs.any() and not signs.all():
+                movable |= zeros
+    return movable
 
 
 def _ints(text: str | None) -> np.ndarray:
