@@ -231,3 +231,21 @@ def test_mesh_files_of_one_name_share_an_output_only_with_the_same_bytes(
         digests = [hashlib.sha256(p.read_bytes() + b"()").hexdigest()[:10]
                    for p in (tmp_path / "model/meshes/tetra.stl", other)]
         assert names == sorted(f"tetra_{d}.stl" for d in digests)
+
+
+def test_a_cold_build_of_the_common_conversions_imports_no_mesh_library(tmp_path: Path) -> None:
+    """The UR5 with a mirrored copy (DAE visuals and STL collisions written as STL, mirrored
+    or not), built cold with a pool of two processes (forked from the build): no trimesh,
+    SciPy or pycollada in the build, and its files are those of the trimesh path
+    (tests/fixtures/mesh_output_digests.json, recorded by it)."""
+    import json
+
+    from tests.backends.test_mesh_bytes import DEFINITION, DIGESTS, digests
+
+    spec = write(tmp_path / "arms.yml", "".join(
+        line for line in DEFINITION.splitlines(keepends=True) if "filename_suffix" not in line))
+    env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache"), "MPC_MESH_WORKERS": "2"}
+    assert _warm_modules(spec, tmp_path / "out", env) == "0 []"
+    expected = {k: v for k, v in json.loads(DIGESTS.read_text()).items() if k.startswith("meshes/stl/")}
+    assert len(expected) == 12
+    assert {k: v for k, v in digests(tmp_path / "out").items() if k.startswith("meshes/")} == expected
