@@ -44,7 +44,7 @@ def decode(data: bytes, suffix: str) -> Arrays | None:
             arrays = decode_dae(data)
         else:
             return None
-    except (ValueError, TypeError, KeyError, IndexError, SyntaxError):  # lxml's XMLSyntaxError too
+    except (ValueError, TypeError, KeyError, IndexError, SyntaxError, RecursionError):  # XMLSyntaxError too
         return None
     return arrays if arrays is not None and _sound(arrays) else None
 

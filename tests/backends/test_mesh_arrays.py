@@ -65,3 +65,48 @@ def test_a_file_the_plain_path_does_not_reproduce_is_declined(tmp_path: Path) ->
     assert mesh_arrays.decode((solid.format(x="0") * 2).encode(), ".stl") is None
     assert mesh_arrays.decode(b"<COLLADA><texture/></COLLADA>", ".dae") is None
     assert mesh_arrays.decode(b"not xml", ".dae") is None
+
+
+IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
+
+
+def _dae(material: str = "#m", p: str = "0 1 2", unit: str = "1", matrix: str = IDENTITY) -> bytes:
+    """A COLLADA file of one triangle (a polylist of vcount 3) under a node with `matrix`."""
+    return f"""<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+ <asset><unit meter="{unit}"/></asset>
+ <library_effects><effect id="e"><profile_COMMON><technique sid="t"><phong/></technique>
+ </profile_COMMON></effect></library_effects>
+ <library_materials><material id="m"><instance_effect url="#e"/></material></library_materials>
+ <library_geometries><geometry id="g"><mesh>
+  <source id="g-pos"><float_array id="g-pos-a" count="9">0 0 0 1 0 0 0 1 0</float_array>
+   <technique_common><accessor source="#g-pos-a" count="3" stride="3">
+    <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+   </accessor></technique_common></source>
+  <vertices id="g-v"><input semantic="POSITION" source="#g-pos"/></vertices>
+  <polylist material="s" count="1"><input semantic="VERTEX" source="#g-v" offset="0"/>
+   <vcount>3</vcount><p>{p}</p></polylist>
+ </mesh></geometry></library_geometries>
+ <library_visual_scenes><visual_scene id="s"><node id="n"><matrix>{matrix}</matrix>
+  <instance_geometry url="#g"><bind_material><technique_common>
+   <instance_material symbol="s" target="{material}"/></technique_common></bind_material></instance_geometry>
+ </node></visual_scene></library_visual_scenes>
+ <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>""".encode()
+
+
+def test_a_dae_is_read_with_its_node_and_unit_or_declined(tmp_path: Path) -> None:
+    """Its triangle moved by its node and scaled by its unit, as trimesh reads it; a broken
+    material reference (W0605, reported through trimesh), an index out of range or a word that
+    is no number: declined."""
+    moved = _dae(unit="0.5", matrix="1 0 0 2 0 1 0 0 0 0 1 0 0 0 0 1")
+    plain = mesh_arrays.decode(moved, ".dae")
+    assert plain is not None
+    path = tmp_path / "moved.dae"
+    path.write_bytes(moved)
+    mesh = _trimesh(path)
+    assert np.array_equal(plain.vertices[plain.faces], np.asarray(mesh.vertices)[np.asarray(mesh.faces)])
+    assert plain.vertices[plain.faces].tolist() == [[[1.0, 0.0, 0.0], [1.5, 0.0, 0.0], [1.0, 0.5, 0.0]]]
+    assert mesh_arrays.decode(_dae(material="#missing"), ".dae") is None
+    assert mesh_arrays.decode(_dae(p="0 1 3"), ".dae") is None
+    assert mesh_arrays.decode(_dae(p="0 1 x"), ".dae") is None
