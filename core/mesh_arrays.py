@@ -333,19 +333,19 @@ def _geometry(geometry: Any, ns: str, bound: set[str]) -> list[Arrays] | None:
             return None
         if "VERTEX" not in inputs or not len(rows):
             continue  # no vertices: trimesh skips the primitive
-        points = _indexed(sources, inputs["VERTEX"][0], rows, ns, 3, parsed)
+        position = _indexed(sources, inputs["VERTEX"][0], rows, ns, 3, parsed)
         normals = _indexed(sources, inputs["NORMAL"][0], rows, ns, 3, parsed) if "NORMAL" in inputs else None
         uv = None
         if "TEXCOORD" in inputs and primitive.get("material") in bound:
             uv = _indexed(sources, inputs["TEXCOORD"][0], rows, ns, 2, parsed)
             if uv is None:
                 return None
-        if points is None or ("NORMAL" in inputs and normals is None):
+        if position is None or ("NORMAL" in inputs and normals is None):
             return None
-        offset, source = inputs["VERTEX"][0]
+        source = inputs["VERTEX"][0][1]
         if source not in movables:  # judged on the source's values: fewer than the corners
-            movables[source] = _movable(np.asarray(parsed[(source, 3)], dtype=np.float64))
-        merged = _merged(points, normals, uv, movables[source][rows[:, offset]])
+            movables[source] = _movable(position[0].astype(np.float64))
+        merged = _merged(position, normals, uv, movables[source][position[1]])
         parts.append(Arrays(merged, np.arange(len(merged), dtype=np.int64).reshape((-1, 3))))
     return parts
 
@@ -374,10 +374,13 @@ def _corner_rows(primitive: Any, tag: str, ns: str, stride: int) -> np.ndarray |
     return rows if len(rows) % 3 == 0 else None
 
 
+Indexed = tuple[np.ndarray, np.ndarray]  # a source's values (float32) and their index at each corner
+
+
 def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, ns: str, width: int,
-             parsed: dict[tuple[str, int], np.ndarray | None]) -> np.ndarray | None:
-    """An input's values at each corner (float64), or None (a source missing or out of range).
-    parsed: the geometry's sources parsed so far (each is parsed once)."""
+             parsed: dict[tuple[str, int], np.ndarray | None]) -> Indexed | None:
+    """An input's values and their index at each corner, or None (a source missing or out of
+    range). parsed: the geometry's sources parsed so far (each is parsed once)."""
     offset, source = given
     key = (source, width)
     if key not in parsed:
@@ -388,23 +391,23 @@ def _indexed(sources: dict[str, Any], given: tuple[int, str], rows: np.ndarray, 
     index = rows[:, offset]
     if int(index.min()) < 0 or int(index.max()) >= len(values):
         return None
-    return values[index].astype(np.float64)
+    return values, index
 
 
-def _merged(points: np.ndarray, normals: np.ndarray | None, uv: np.ndarray | None,
+def _merged(position: Indexed, normals: Indexed | None, uv: Indexed | None,
             movable: np.ndarray) -> np.ndarray:
-    """Each corner moved to the first corner that trimesh merges it with: the same position to
-    8 decimals, texture coordinate to 4 and normal to 2 (`Trimesh.merge_vertices`, which
-    trimesh's COLLADA loader does). Only the corners `movable` marks can move (`_movable`);
-    the others are left as they are."""
+    """The corners' points (float64), each moved to the first corner that trimesh merges it
+    with: the same position to 8 decimals, texture coordinate to 4 and normal to 2
+    (`Trimesh.merge_vertices`, which trimesh's COLLADA loader does). Only the corners
+    `movable` marks can move (`_movable`); the others are left as they are."""
+    points = position[0][position[1]].astype(np.float64)
     movable = np.nonzero(movable)[0]
     if not len(movable):
         return points
     stacked = [points[movable] * (10**8)]
-    if uv is not None:
-        stacked.append(uv[movable] * (10**4))
-    if normals is not None:
-        stacked.append(normals[movable] * (10**2))
+    for given, scale in ((uv, 10**4), (normals, 10**2)):
+        if given is not None:
+            stacked.append(given[0][given[1][movable]].astype(np.float64) * scale)
     keys = np.column_stack(stacked).round().astype(np.int64)
     order = np.lexsort(keys.T[::-1])  # stable: the first of equal keys is the first corner
     ordered = keys[order]
@@ -413,9 +416,8 @@ def _merged(points: np.ndarray, normals: np.ndarray | None, uv: np.ndarray | Non
     starts[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
     first = np.empty(len(keys), dtype=np.int64)
     first[order] = order[starts][np.cumsum(starts) - 1]
-    merged = points.copy()
-    merged[movable] = points[movable[first]]
-    return merged
+    points[movable] = points[movable[first]]  # the right side is a copy
+    return points
 
 
 def _movable(points: np.ndarray) -> np.ndarray:
