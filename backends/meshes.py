@@ -324,6 +324,9 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 
+Task = tuple[bool, list[tuple[Path, tuple[MeshOp, ...], Path]]]  # by the plain path or not; its jobs
+
+
 def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
     """Materialise each job into its cache path; {cache path: (code, problem)} for those
     that failed. The jobs of one source go together: all of them by the plain path
@@ -335,15 +338,15 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     groups: dict[Path, list[tuple[Path, tuple[MeshOp, ...], Path]]] = {}
     for job in jobs:
         groups.setdefault(job[0], []).append(job)
-    tasks = []
+    tasks: list[Task] = []
     for group in groups.values():
         if all(plain(src, ops, dest.suffix) for src, ops, dest in group):
-            tasks.append(group)
+            tasks.append((True, group))
         else:
-            tasks.extend([job] for job in group)
+            tasks.extend((False, [job]) for job in group)
     firsts: dict[Path, int] = {}
-    order = sorted(range(len(tasks)), key=lambda i: (firsts.setdefault(tasks[i][0][0], len(firsts))
-                                                    if tasks[i][0][0] not in firsts else len(tasks) + i))
+    order = sorted(range(len(tasks)), key=lambda i: (firsts.setdefault(tasks[i][1][0][0], len(firsts))
+                                                    if tasks[i][1][0][0] not in firsts else len(tasks) + i))
     tasks = [tasks[i] for i in order]
     workers = min(len(tasks), mesh_workers())
     if workers < 2 or len(jobs) < 3:
@@ -352,7 +355,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        heavy = any(len(task) == 1 and not plain(task[0][0], task[0][1], task[0][2].suffix) for task in tasks)
+        heavy = not all(is_plain for is_plain, _ in tasks)
         context = multiprocessing.get_context(_start_method(heavy))
         if context.get_start_method() == "forkserver" and heavy:  # its workers fork from one that has trimesh
             context.set_forkserver_preload(["mpc.ir.mesh_props"])
@@ -362,12 +365,13 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     return {dest: problem for found in results for dest, problem in found.items()}
 
 
-def _materialise_all(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
-    """The jobs of one source, by the plain path when they are its (a group), else by trimesh;
-    {cache path: (code, problem)} for those that failed."""
-    from mpc.backends.plain_meshes import materialise, plain
+def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:
+    """The jobs of one source by the plain path (when `task` says so and the file is one it
+    reproduces), else each by trimesh; {cache path: (code, problem)} for those that failed."""
+    is_plain, jobs = task
+    if is_plain:
+        from mpc.backends.plain_meshes import materialise
 
-    if len(jobs) > 1 or plain(jobs[0][0], jobs[0][1], jobs[0][2].suffix):
         done = materialise(jobs)
         if done is not None:
             return done

@@ -23,8 +23,10 @@ from mpc.core.diagnostics import Sink
 from tests.conftest import compile_file, definition, write
 from tests.mpc_command import mpc_process
 
+# The ball is fine enough (20,480 triangles) that its job lasts while the pool's other worker
+# starts: the plain path (backends/plain_meshes.py) converts the small shapes in a millisecond.
 SHAPES = {"box": lambda: trimesh.creation.box((0.1, 0.2, 0.3)),
-          "ball": lambda: trimesh.creation.icosphere(2, 0.1),
+          "ball": lambda: trimesh.creation.icosphere(5, 0.1),
           "rod": lambda: trimesh.creation.cylinder(0.02, 0.4),
           "cone": lambda: trimesh.creation.cone(0.05, 0.1)}
 
