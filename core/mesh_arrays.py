@@ -103,6 +103,8 @@ def obj_name(data: bytes, file_name: str) -> str | None:
         return file_name
     text = data.decode("utf-8", errors="replace").strip()
     start = text.lower().find("solid")
+    if start < 0:
+        return None
     line = text[start:].split("\n", 1)[0]
     name = line[6:].strip()
     return name or None

@@ -110,3 +110,26 @@ def test_a_dae_is_read_with_its_node_and_unit_or_declined(tmp_path: Path) -> Non
     assert mesh_arrays.decode(_dae(material="#missing"), ".dae") is None
     assert mesh_arrays.decode(_dae(p="0 1 3"), ".dae") is None
     assert mesh_arrays.decode(_dae(p="0 1 x"), ".dae") is None
+
+
+@pytest.mark.parametrize("rel", ["ur_description/meshes/ur5/visual/forearm.dae",
+                                 "talos_data/meshes/arm/arm_1_collision.STL"])
+def test_scales_and_reflections_in_turn_equal_trimesh(rel: str) -> None:
+    """mesh ops one after another (backends/plain_meshes.py): a scale by three factors, one of
+    them negative (a reflection), then a reflection across x, as trimesh applies them."""
+    from mpc.backends.plain_meshes import derive
+    from mpc.ir.geometry import ReflectMesh, ScaleMesh
+
+    path = ERD / rel
+    ops = (ScaleMesh(scale=(0.5, -2.0, 1.5)), ReflectMesh(axis=0))
+    mesh = _trimesh(path)
+    mesh.apply_scale(np.asarray(ops[0].scale))
+    reflect = np.eye(4)
+    reflect[0, 0] = -1.0
+    mesh.apply_transform(reflect)
+    stl = path.suffix.lower() == ".stl"
+    made = derive(path, [(ops, Path("x.stl")), *([(ops, Path("x.obj"))] if stl else [])])
+    assert made is not None
+    assert made[Path("x.stl")] == mesh.export(file_type="stl")
+    if stl:
+        assert made[Path("x.obj")] == mesh.export(file_type="obj").encode()
