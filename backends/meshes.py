@@ -349,7 +349,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
                                                     if tasks[i][1][0][0] not in firsts else len(tasks) + i))
     tasks = [tasks[i] for i in order]
     workers = min(len(tasks), mesh_workers())
-    if workers < 2 or len(jobs) < 3:
+    if workers < 2 or len(jobs) < 3 or _light(tasks):
         results = [_materialise_all(task) for task in tasks]
     else:
         import multiprocessing
@@ -363,6 +363,23 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
                                  initargs=(dict(os.environ),)) as pool:
             results = list(pool.map(_materialise_all, tasks))
     return {dest: problem for found in results for dest, problem in found.items()}
+
+
+# Bytes of source files the plain path reads faster in the build's own process than a pool
+# starts and feeds its workers (the 88-link assembly's 14 MB: 0.86× the wall time, bench/README.md).
+LIGHT = 32 * 2**20
+
+
+def _light(tasks: list[Task]) -> bool:
+    """Whether the tasks are all the plain path's and their sources small (LIGHT), so that they
+    are done here, not in a pool; MPC_MESH_WORKERS set to a number asks for the pool anyway."""
+    if os.environ.get(WORKERS, "").isdigit() or not all(is_plain for is_plain, _ in tasks):
+        return False
+    size = 0
+    for _, jobs in tasks:
+        with contextlib.suppress(OSError):  # reading it reports the problem
+            size += jobs[0][0].stat().st_size
+    return size < LIGHT
 
 
 def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:
