@@ -333,6 +333,8 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     (backends/plain_meshes.py: one read of the file, no trimesh) when it takes each of them,
     else each by trimesh. Several groups run in a pool of processes, one per core, the
     distinct files side by side (a trimesh job parses once: mesh_source.read's single flight)."""
+    if not jobs:
+        return {}
     from mpc.backends.plain_meshes import plain
 
     groups: dict[Path, list[tuple[Path, tuple[MeshOp, ...], Path]]] = {}

@@ -4,16 +4,14 @@ scales (core/mesh_arrays.py); each source decoded once for all the outputs made 
 `plain` says which cache jobs this path takes; `derive` writes their cache entries, or says
 that the file is one the path does not reproduce (the caller then computes every job of that
 source with trimesh, backends/meshes.py `_derive`, as before). The bytes are those the
-trimesh path writes (tests/backends/test_mesh_arrays.py).
+trimesh path writes (tests/backends/test_mesh_arrays.py). numpy is imported only to derive:
+a build whose meshes are all in the cache loads none of it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from mpc.core import mesh_arrays
 from mpc.ir.geometry import MeshOp, ReflectMesh, ScaleMesh
 
 _OUTPUTS = {".stl": (".stl",), ".dae": (".stl",)}  # source suffix → what this path writes of it
@@ -60,6 +58,9 @@ def materialise(jobs: list[Job]) -> dict[Path, tuple[str, str]] | None:
 def derive(src: Path, jobs: list[tuple[tuple[MeshOp, ...], Path]]) -> dict[Path, bytes] | None:
     """The bytes of each job's cache entry (ops, entry path) from one read of `src`; None when
     the file is not one this path reproduces."""
+    import numpy as np
+
+    from mpc.core import mesh_arrays
     from mpc.core.cache import file_digest, trace
 
     try:

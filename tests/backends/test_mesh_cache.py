@@ -249,3 +249,22 @@ def test_a_cold_build_of_the_common_conversions_imports_no_mesh_library(tmp_path
     expected = {k: v for k, v in json.loads(DIGESTS.read_text()).items() if k.startswith("meshes/stl/")}
     assert len(expected) == 12
     assert {k: v for k, v in digests(tmp_path / "out").items() if k.startswith("meshes/")} == expected
+
+
+def test_a_build_whose_meshes_are_cached_imports_no_numpy(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """The DAE arm built once, then its definition edited (so that it is compiled again, not
+    taken from the kept build): its mesh comes from the cache; nothing loads numpy (a fleet of
+    such builds pays no numpy import each)."""
+    spec = _arm(tmp_path / "model")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    assert compile_file(spec, tmp_path / "cold", Sink()).out is not None
+    spec.write_text(spec.read_text() + "# edited\n")
+    probe = ("import sys\nfrom mpc.cli.main import main\n"
+             "code = main(['compile', sys.argv[1], '-o', sys.argv[2]])\n"
+             "print(code, sorted(m for m in ('numpy', 'lxml.etree') if m in sys.modules))\n")
+    env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", probe, str(spec), str(tmp_path / "edited")], env=env,
+                          capture_output=True, text=True, check=True)
+    assert done.stdout.splitlines()[-1].split(" [")[0] == "0"
+    assert "numpy" not in done.stdout.splitlines()[-1]
