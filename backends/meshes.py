@@ -324,29 +324,78 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
 
 
+Task = tuple[bool, list[tuple[Path, tuple[MeshOp, ...], Path]]]  # by the plain path or not; its jobs
+
+
 def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
     """Materialise each job into its cache path; {cache path: (code, problem)} for those
-    that failed. Several jobs run in a pool of processes, one per core; the first job of each
-    source file goes first, so that distinct files are parsed side by side rather than one
-    worker waiting for another's parse of the same file (mesh_source.read's single flight)."""
+    that failed. The jobs of one source go together: all of them by the plain path
+    (backends/plain_meshes.py: one read of the file, no trimesh) when it takes each of them,
+    else each by trimesh. Several groups run in a pool of processes, one per core, the
+    distinct files side by side (a trimesh job parses once: mesh_source.read's single flight)."""
+    if not jobs:
+        return {}
+    from mpc.backends.plain_meshes import plain
+
+    groups: dict[Path, list[tuple[Path, tuple[MeshOp, ...], Path]]] = {}
+    for job in jobs:
+        groups.setdefault(job[0], []).append(job)
+    tasks: list[Task] = []
+    for group in groups.values():
+        if all(plain(src, ops, dest.suffix) for src, ops, dest in group):
+            tasks.append((True, group))
+        else:
+            tasks.extend((False, [job]) for job in group)
     firsts: dict[Path, int] = {}
-    order = sorted(range(len(jobs)), key=lambda i: (firsts.setdefault(jobs[i][0], len(firsts))
-                                                   if jobs[i][0] not in firsts else len(jobs) + i))
-    jobs = [jobs[i] for i in order]
-    workers = min(len(jobs), mesh_workers())
-    if workers < 2 or len(jobs) < 3:
-        results = [_materialise(*job) for job in jobs]
+    order = sorted(range(len(tasks)), key=lambda i: (firsts.setdefault(tasks[i][1][0][0], len(firsts))
+                                                    if tasks[i][1][0][0] not in firsts else len(tasks) + i))
+    tasks = [tasks[i] for i in order]
+    workers = min(len(tasks), mesh_workers())
+    if workers < 2 or len(jobs) < 3 or _light(tasks):
+        results = [_materialise_all(task) for task in tasks]
     else:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        context = multiprocessing.get_context(_start_method())
-        if context.get_start_method() == "forkserver":  # its workers fork from one that has trimesh
+        heavy = not all(is_plain for is_plain, _ in tasks)
+        context = multiprocessing.get_context(_start_method(heavy))
+        if context.get_start_method() == "forkserver" and heavy:  # its workers fork from one that has trimesh
             context.set_forkserver_preload(["mpc.ir.mesh_props"])
         with ProcessPoolExecutor(workers, mp_context=context, initializer=_environment,
                                  initargs=(dict(os.environ),)) as pool:
-            results = list(pool.map(_materialise, *zip(*jobs, strict=True)))
-    return {job[2]: problem for job, problem in zip(jobs, results, strict=True) if problem}
+            results = list(pool.map(_materialise_all, tasks))
+    return {dest: problem for found in results for dest, problem in found.items()}
+
+
+# Bytes of source files the plain path reads faster in the build's own process than a pool
+# starts and feeds its workers (the 88-link assembly's 14 MB: 0.86× the wall time, bench/README.md).
+LIGHT = 32 * 2**20
+
+
+def _light(tasks: list[Task]) -> bool:
+    """Whether the tasks are all the plain path's and their sources small (LIGHT), so that they
+    are done here, not in a pool; MPC_MESH_WORKERS set to a number asks for the pool anyway."""
+    if os.environ.get(WORKERS, "").isdigit() or not all(is_plain for is_plain, _ in tasks):
+        return False
+    size = 0
+    for _, jobs in tasks:
+        with contextlib.suppress(OSError):  # reading it reports the problem
+            size += jobs[0][0].stat().st_size
+    return size < LIGHT
+
+
+def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:
+    """The jobs of one source by the plain path (when `task` says so and the file is one it
+    reproduces), else each by trimesh; {cache path: (code, problem)} for those that failed."""
+    is_plain, jobs = task
+    if is_plain:
+        from mpc.backends.plain_meshes import materialise
+
+        done = materialise(jobs)
+        if done is not None:
+            return done
+    found = {job[2]: _materialise(*job) for job in jobs}
+    return {dest: problem for dest, problem in found.items() if problem}
 
 
 WORKERS = "MPC_MESH_WORKERS"
@@ -370,15 +419,16 @@ def share_cores(builds: int) -> None:
     _share = max(1, usable_cores() // max(1, builds))
 
 
-def _start_method() -> str:
-    """fork, with trimesh imported once here for every worker; forkserver once MuJoCo is
-    loaded (its GL context and threads must not be copied into a worker). The workers run
-    only mesh code, which holds no lock of another thread across a fork."""
+def _start_method(heavy: bool = True) -> str:
+    """fork, with trimesh imported once here for every worker when a job needs it (heavy);
+    forkserver once MuJoCo is loaded (its GL context and threads must not be copied into a
+    worker). The workers run only mesh code, which holds no lock of another thread across a fork."""
     import sys
 
     if "mujoco" in sys.modules:
         return "forkserver"
-    import mpc.ir.mesh_props  # noqa: F401  (trimesh, shared by the forked workers)
+    if heavy:
+        import mpc.ir.mesh_props  # noqa: F401  (trimesh, shared by the forked workers)
 
     return "fork"
 

@@ -8,6 +8,8 @@ with a cache of its own and `--force`: the definitions of examples/, the runnabl
 specs/*.md, and for each example-robot-data URDF (the first N with --erd) a definition that
 exports urdf, sdf, mjcf, smurf, joint_limits and pdf. Prints each difference and a summary;
 exit status 1 when any build differs. For a refactoring that must change no output.
+With --meshes, each example-robot-data URDF has two more definitions that write every mesh
+as STL and as OBJ, as it is and mirrored; --only-meshes: those definitions alone.
 """
 
 from __future__ import annotations
@@ -30,11 +32,19 @@ _EXPORTS = """\
     - {type: joint_limits}
     - {type: pdf}
 """
+_MESH_EXPORTS = """\
+  export_config:
+    - {type: urdf, mesh_format: stl}
+    - {type: urdf, mesh_format: obj, filename_suffix: _obj}
+"""
 
 
-def erd_definitions(work: Path, limit: int | None) -> list[Path]:
+def erd_definitions(work: Path, limit: int | None, meshes: bool = False,
+                    only_meshes: bool = False) -> list[Path]:
     """One definition per example-robot-data URDF, written into `work/erd/` beside a copy of
-    the URDF (each tree reads the meshes from its own installed example-robot-data)."""
+    the URDF (each tree reads the meshes from its own installed example-robot-data); with
+    `meshes`, two more that write every mesh as STL and OBJ, as it is and mirrored (their own
+    definitions: a model another export refuses still has its meshes compared)."""
     from mpc.core.packages import PackageResolver
 
     package = PackageResolver().find("example-robot-data")
@@ -45,9 +55,16 @@ def erd_definitions(work: Path, limit: int | None) -> list[Path]:
         path = work / "erd" / f"{name}.yml"
         path.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(urdf, path.with_suffix(".urdf"))
-        path.write_text(f"model:\n  robotname: robot\n  modelname: {name}\n  input_models:\n"
-                        f"    base:\n      basefile: {name}.urdf\n  assemble:\n    model: base\n" + _EXPORTS)
-        out.append(path)
+        head = (f"model:\n  robotname: robot\n  modelname: {name}\n  input_models:\n"
+                f"    base:\n      basefile: {name}.urdf\n  assemble:\n    model: base\n")
+        path.write_text(head + _EXPORTS)
+        if not only_meshes:
+            out.append(path)
+        if meshes or only_meshes:
+            for suffix, text in (("meshes", head), ("mirrored", head + "    mirror: {}\n")):
+                path = path.with_name(f"{name}__{suffix}.yml")
+                path.write_text(text + _MESH_EXPORTS)
+                out.append(path)
     return out
 
 
@@ -66,9 +83,11 @@ def spec_definitions(work: Path) -> list[Path]:
     return out
 
 
-def definitions(work: Path, limit: int | None) -> list[Path]:
+def definitions(work: Path, limit: int | None, meshes: bool = False, only_meshes: bool = False) -> list[Path]:
+    if only_meshes:
+        return erd_definitions(work, limit, only_meshes=True)
     examples = sorted((ROOT / "examples").glob("*.yml"))
-    return [*examples, *spec_definitions(work), *erd_definitions(work, limit)]
+    return [*examples, *spec_definitions(work), *erd_definitions(work, limit, meshes)]
 
 
 def build(mpc: str, definition: Path, out: Path, cache: Path) -> str:
@@ -95,10 +114,12 @@ def main() -> int:
     parser.add_argument("new")
     parser.add_argument("work", type=Path)
     parser.add_argument("--erd", type=int, default=None, help="only the first N example-robot-data URDFs")
+    parser.add_argument("--meshes", action="store_true", help="convert every example-robot-data mesh too")
+    parser.add_argument("--only-meshes", action="store_true", help="only the mesh definitions of --meshes")
     args = parser.parse_args()
     work = args.work.resolve()
     differ = compared = outputs = 0
-    for definition in definitions(work, args.erd):
+    for definition in definitions(work, args.erd, args.meshes, args.only_meshes):
         results = []
         for side, mpc in (("old", args.old), ("new", args.new)):
             out = work / side / definition.stem

@@ -18,6 +18,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mpc.core.mesh_arrays import unit
 from mpc.core.span import hardened_parser
 
 if TYPE_CHECKING:  # trimesh is imported where a mesh is read: `material_colours` from the cache needs none
@@ -39,7 +40,7 @@ def read(path: Path) -> tuple[trimesh.Trimesh, tuple[str, ...]]:
     """
     document, data, broken = _document(path)
     mesh = _as_trimesh(document)
-    mesh.apply_scale(_unit(data))
+    mesh.apply_scale(unit(data))
     return mesh, broken
 
 
@@ -85,8 +86,9 @@ def _scene(document: collada.Collada) -> trimesh.Scene:
         materials[m.id] = dae._parse_material(m.effect, None)
         if isinstance(m.effect.diffuse, pycollada.material.Map):
             materials[m.id].baseColorFactor = None
-    unit = document.assetInfo.unitmeter
-    metadata = {"units": "meters"} if unit is None or np.isclose(unit, 1.0) else {"units": f"{unit} * meters"}
+    per_unit = document.assetInfo.unitmeter
+    metadata = ({"units": "meters"} if per_unit is None or np.isclose(per_unit, 1.0)
+                else {"units": f"{per_unit} * meters"})
     meshes: dict = {}
     counts: dict = {}
     graph: list = []
@@ -132,7 +134,7 @@ def material_parts(path: Path) -> list[tuple[RGBA | None, trimesh.Trimesh]]:
     key = (str(path), file_digest(path))
     if key not in _PARTS:
         document, data, _ = _document(path)
-        unit = _unit(data)
+        metres = unit(data)
         groups: dict[RGBA | None, list[trimesh.Trimesh]] = {}
         for piece in _scene(document).dump():
             groups.setdefault(_colour(piece), []).append(piece)
@@ -144,7 +146,7 @@ def material_parts(path: Path) -> list[tuple[RGBA | None, trimesh.Trimesh]]:
                 faces.append(np.asarray(piece.faces) + offset)
                 offset += len(piece.vertices)
             mesh = trimesh.Trimesh(np.concatenate(vertices), np.concatenate(faces), process=False)
-            mesh.apply_scale(unit)
+            mesh.apply_scale(metres)
             parts.append((colour, mesh))
         _PARTS.clear()
         _PARTS[key] = parts
@@ -181,12 +183,6 @@ def _without_material_bindings(data: bytes) -> bytes:
     for binding in list(root.iter("{*}bind_material")):
         binding.getparent().remove(binding)
     return etree.tostring(root)
-
-
-def _unit(data: bytes) -> float:
-    """Metres per unit of a COLLADA file (its <unit meter=…>), 1 when it has none."""
-    m = re.search(rb"<unit\b[^>]*\bmeter=\"([0-9.eE+-]+)\"", data[:4096])
-    return float(m.group(1)) if m else 1.0
 
 
 _STAMP = re.compile(rb"<(created|modified)>[^<]*</(created|modified)>")

@@ -135,17 +135,19 @@ def test_files_with_the_same_bytes_keep_their_own_names(tmp_path: Path,
 
 def test_a_mesh_file_is_parsed_once_for_every_format_and_build(tmp_path: Path,
                                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    """STL and OBJ (mirrored too) from one parse of the DAE; a later build's bobj from none."""
+    """The STL from one plain read of the DAE (backends/plain_meshes.py), the OBJ from one
+    trimesh parse; a later build's bobj from none (the parse's normalized form)."""
     spec = _arm(tmp_path / "model")
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
     text = spec.read_text()
     spec.write_text(text + "    - {type: urdf, mesh_format: obj, filename_suffix: _obj}\n")
     assert compile_file(spec, tmp_path / "one", Sink()).out is not None
-    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse"]
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "parse", "parse"]
     spec.write_text(text.replace("mesh_format: stl", "mesh_format: bobj"))
     assert compile_file(spec, tmp_path / "two", Sink()).out is not None
-    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == ["derive", "derive", "derive", "parse"]
+    assert sorted(e.split()[0] for e in _trace(tmp_path / "trace")) == [
+        "derive", "derive", "derive", "parse", "parse"]
 
 
 _OPENED: list[str] | None = None  # the files opened while a test listens (an audit hook cannot be removed)
@@ -229,3 +231,40 @@ def test_mesh_files_of_one_name_share_an_output_only_with_the_same_bytes(
         digests = [hashlib.sha256(p.read_bytes() + b"()").hexdigest()[:10]
                    for p in (tmp_path / "model/meshes/tetra.stl", other)]
         assert names == sorted(f"tetra_{d}.stl" for d in digests)
+
+
+def test_a_cold_build_of_the_common_conversions_imports_no_mesh_library(tmp_path: Path) -> None:
+    """The UR5 with a mirrored copy (DAE visuals and STL collisions written as STL, mirrored
+    or not), built cold with a pool of two processes (forked from the build): no trimesh,
+    SciPy or pycollada in the build, and its files are those of the trimesh path
+    (tests/fixtures/mesh_output_digests.json, recorded by it)."""
+    import json
+
+    from tests.backends.test_mesh_bytes import DEFINITION, DIGESTS, digests
+
+    spec = write(tmp_path / "arms.yml", "".join(
+        line for line in DEFINITION.splitlines(keepends=True) if "filename_suffix" not in line))
+    env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache"), "MPC_MESH_WORKERS": "2"}
+    assert _warm_modules(spec, tmp_path / "out", env) == "0 []"
+    expected = {k: v for k, v in json.loads(DIGESTS.read_text()).items() if k.startswith("meshes/stl/")}
+    assert len(expected) == 12
+    assert {k: v for k, v in digests(tmp_path / "out").items() if k.startswith("meshes/")} == expected
+
+
+def test_a_build_whose_meshes_are_cached_imports_no_numpy(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """The DAE arm built once, then its definition edited (so that it is compiled again, not
+    taken from the kept build): its mesh comes from the cache; nothing loads numpy (a fleet of
+    such builds pays no numpy import each)."""
+    spec = _arm(tmp_path / "model")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    assert compile_file(spec, tmp_path / "cold", Sink()).out is not None
+    spec.write_text(spec.read_text() + "# edited\n")
+    probe = ("import sys\nfrom mpc.cli.main import main\n"
+             "code = main(['compile', sys.argv[1], '-o', sys.argv[2]])\n"
+             "print(code, sorted(m for m in ('numpy', 'lxml.etree') if m in sys.modules))\n")
+    env = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", probe, str(spec), str(tmp_path / "edited")], env=env,
+                          capture_output=True, text=True, check=True)
+    assert done.stdout.splitlines()[-1].split(" [")[0] == "0"
+    assert "numpy" not in done.stdout.splitlines()[-1]
