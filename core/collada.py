@@ -86,7 +86,7 @@ def _scene(document: collada.Collada) -> trimesh.Scene:
         materials[m.id] = dae._parse_material(m.effect, None)
         if isinstance(m.effect.diffuse, pycollada.material.Map):
             materials[m.id].baseColorFactor = None
-    per_unit = document.assetInfo.unitmeter
+    per_unit = document.assetInfo.unitmeter if document.assetInfo is not None else None
     metadata = ({"units": "meters"} if per_unit is None or np.isclose(per_unit, 1.0)
                 else {"units": f"{per_unit} * meters"})
     meshes: dict = {}

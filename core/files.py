@@ -120,6 +120,9 @@ class Roots(tuple[Path, ...]):
     files of one model: whether a resolved path is one of them or inside one, by two lookups
     rather than a comparison with each root."""
 
+    _exact: frozenset[str]
+    _below: tuple[str, ...]
+
     def __new__(cls, roots: Iterable[Path]) -> Roots:
         self = super().__new__(cls, roots)
         texts = [str(r) for r in self]

@@ -196,11 +196,11 @@ def decode_dae(data: bytes) -> Arrays | None:
     nodes' transforms and scaled to metres, as pycollada and trimesh's loader give them."""
     if _UNHANDLED.search(data):
         return None
-    from lxml import etree
+    import lxml.etree
 
     from mpc.core.span import hardened_parser
 
-    root = etree.fromstring(data, hardened_parser(huge=True))
+    root = lxml.etree.fromstring(data, hardened_parser(huge=True))
     ns = root.tag[: root.tag.index("}") + 1] if root.tag.startswith("{") else ""
     ids = {e.get("id"): e for e in root.iter(f"{ns}geometry", f"{ns}visual_scene", f"{ns}material",
                                               f"{ns}effect") if e.get("id") is not None}
@@ -226,12 +226,13 @@ def _walk(node: Any, parent: np.ndarray, ns: str, ids: dict[str, Any], parts: li
         return False
     if not transforms:
         local = np.identity(4, dtype=np.float32)
-    elif len(transforms) == 1:
+    elif len(transforms) == 1 and transforms[0] is not None:
         local = transforms[0].copy()
     else:
         local = np.identity(4, dtype=np.float32)
         for t in transforms:
-            local = np.dot(local, t)
+            if t is not None:  # none is (above); for the type checker
+                local = np.dot(local, t)
     for child in node:
         if child.tag == f"{ns}node":
             if not _walk(child, np.dot(parent, local), ns, ids, parts):
