@@ -21,6 +21,7 @@ import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 
 from mpc.core.reads import note_files
 
@@ -57,6 +58,10 @@ def note_loaded_libraries() -> None:
             paths = {line.split(None, 5)[5].strip() for line in maps if len(line.split(None, 5)) == 6}
     except OSError:
         return
-    python = tuple({os.path.realpath(p) + os.sep for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)})
+    # Python's own folders: the environment and the standard library (not sys.base_prefix,
+    # which is /usr for Debian's Python, where the graphics libraries lie too)
+    paths = sysconfig.get_paths()
+    python = tuple({os.path.realpath(p) + os.sep for p in (
+        sys.prefix, *(paths[k] for k in ("stdlib", "platstdlib", "purelib", "platlib") if k in paths))})
     note_files(sorted(p for p in paths if p.startswith("/") and ".so" in os.path.basename(p)
                       and not os.path.realpath(p).startswith(python)))
