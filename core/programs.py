@@ -60,8 +60,8 @@ def note_loaded_libraries() -> None:
         return
     # Python's own folders: the environment and the standard library (not sys.base_prefix,
     # which is /usr for Debian's Python, where the graphics libraries lie too)
-    paths = sysconfig.get_paths()
+    folders = sysconfig.get_paths()
     python = tuple({os.path.realpath(p) + os.sep for p in (
-        sys.prefix, *(paths[k] for k in ("stdlib", "platstdlib", "purelib", "platlib") if k in paths))})
+        sys.prefix, *(folders[k] for k in ("stdlib", "platstdlib", "purelib", "platlib") if k in folders))})
     note_files(sorted(p for p in paths if p.startswith("/") and ".so" in os.path.basename(p)
                       and not os.path.realpath(p).startswith(python)))
