@@ -49,6 +49,7 @@ from mpc.backends.float_formats import MJCF_KEYS, Formats
 from mpc.backends.xml import fmt_float, fmt_floats, write_path
 from mpc.core.diagnostics import Sink
 from mpc.core.files import confined
+from mpc.core.names import free_name
 from mpc.core.numbers import EPSILON
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
@@ -391,21 +392,14 @@ class _Writer:
         key = (self.mesh_name(mesh), fmt_floats(mesh.scale) if mesh.scale is not None else None)
         if key not in self.assets:
             stem = key[0].rsplit("/", 1)[-1].rsplit(".", 1)[0]
-            name, n, taken = stem, 1, set(self.assets.values())
-            while name in taken:
-                name, n = f"{stem}_{n}", n + 1
-            self.assets[key] = name
+            self.assets[key] = free_name(stem, set(self.assets.values()))
         return self.assets[key]
 
     def material(self, name: str, rgba: tuple[float, float, float, float]) -> str:
         """The asset name of a material colour: its own name, made unique when two colours share it."""
         key = (name or "material", fmt_floats(rgba))  # MuJoCo refuses an empty name
-        name = key[0]
         if key not in self.materials:
-            asset, n, taken = name, 1, set(self.materials.values())
-            while asset in taken:
-                asset, n = f"{name}_{n}", n + 1
-            self.materials[key] = asset
+            self.materials[key] = free_name(key[0], set(self.materials.values()))
         return self.materials[key]
 
     def _emit_geom(self, depth: int, shape: Visual | Collision) -> None:

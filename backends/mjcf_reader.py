@@ -46,6 +46,7 @@ import numpy as np
 from mpc.backends.xml import XmlSource, load
 from mpc.core.diagnostics import Sink
 from mpc.core.files import resolved, why_absent
+from mpc.core.names import free_name
 from mpc.core.packages import PackageResolver
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
@@ -343,10 +344,7 @@ def msh_as_stl(data: bytes) -> Path | None:
 
 def _fresh(name: str, taken: set[str]) -> str:
     """`name`, or `name_2`, `name_3`, … when it is taken; the result is taken from then on."""
-    out, n = name, 1
-    while out in taken:
-        n += 1
-        out = f"{name}_{n}"
+    out = free_name(name, taken, first=2)
     taken.add(out)
     return out
 

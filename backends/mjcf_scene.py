@@ -20,18 +20,12 @@ from typing import Any
 
 from mpc.backends import xml_escape
 from mpc.backends.xml import fmt_float
+from mpc.core.names import free_name
 from mpc.ir.robot import Robot
 
 __all__ = ["floor_height", "scene"]
 
 ALL_BITS = str(2**31 - 1)  # contype and conaffinity are C ints
-
-
-def _free(name: str, taken: set[str]) -> str:
-    out, n = name, 1
-    while out in taken:
-        out, n = f"{name}_{n}", n + 1
-    return out
 
 
 def floor_height(robot_xml: Path, collision_group: int) -> float:
@@ -74,7 +68,7 @@ def scene(robot: Robot, robot_file: str, floor_z: float = 0.0) -> str:
     taken = {*robot.links, *robot.materials,
              *(s.name for lk in robot.links.values() for s in (*lk.visuals, *lk.collisions) if s.name)}
     taken |= {m.name for lk in robot.links.values() for v in lk.visuals if (m := v.inline_material)}
-    floor, ground, sky = (_free(n, taken) for n in ("floor", "groundplane", "skybox"))
+    floor, ground, sky = (free_name(n, taken) for n in ("floor", "groundplane", "skybox"))
     a = xml_escape.attribute
     pos = f' pos="0 0 {fmt_float(floor_z)}"' if floor_z else ""
     return "\n".join([

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from mpc.backends.usd_pxr import Tf
+from mpc.core.names import free_name
 
 
 def unique_identifiers(names: Iterable[str], taken: Iterable[str] = ()) -> dict[str, str]:
@@ -17,10 +18,7 @@ def unique_identifiers(names: Iterable[str], taken: Iterable[str] = ()) -> dict[
     for name in names:
         if name in out:
             continue
-        base = Tf.MakeValidIdentifier(name)
-        new, n = base, 1
-        while new in used:
-            new, n = f"{base}_{n}", n + 1
+        new = free_name(Tf.MakeValidIdentifier(name), used)
         used.add(new)
         out[name] = new
     return out
@@ -31,10 +29,7 @@ def sibling_names(names: Iterable[str]) -> list[str]:
     used: set[str] = set()
     out: list[str] = []
     for name in names:
-        base = Tf.MakeValidIdentifier(name)
-        new, n = base, 1
-        while new in used:
-            new, n = f"{base}_{n}", n + 1
+        new = free_name(Tf.MakeValidIdentifier(name), used)
         used.add(new)
         out.append(new)
     return out
