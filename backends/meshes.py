@@ -189,20 +189,39 @@ def _digest(k: MeshKey) -> str:
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
          robot: Robot | None = None) -> bool:
-    """Write each planned mesh into `out`: a copy of the file, or the result of its ops.
+    """Write each planned mesh into `out` (`contents`), leaving those already there."""
+    from mpc.core.files import confined, copy_file
+
+    found, ok = contents(files, sink, export_span, robot, lambda rel: confined(out, rel).exists())
+    for rel, content in found.items():
+        dest = confined(out, rel)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            dest.write_bytes(content)
+        else:
+            copy_file(content, dest)  # a regular file, checked when the model was read
+    return ok
+
+
+def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Robot | None = None,
+             skip: Callable[[str], bool] = lambda rel: False) -> tuple[dict[str, bytes | Path], bool]:
+    """What each planned mesh is, by its file name: the bytes of the result of its ops, or the
+    source file to copy as it is; and whether none failed. A mesh that fails is reported and
+    left out; one for which `skip(name)` holds is left out silently.
 
     Results are kept in a content-addressed cache (core/cache.py: `meshes/`), keyed by
     the source's bytes, the ops and the format, and computed in parallel (a process pool)
-    when several are missing; a later build with the same inputs only copies them.
+    when several are missing; a later build with the same inputs only reads them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     """
     from mpc.core.cache import load_entry, notes_file, remove_entry, touch_entry
-    from mpc.core.files import confined, copy_file, describe
+    from mpc.core.files import describe
 
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
     entries: dict[Path, bytes] = {}
-    plan_: list[tuple[Path, Path, str]] = []
+    plan_: list[tuple[Path, str]] = []
+    found: dict[str, bytes | Path] = {}
     users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
 
     def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
@@ -211,11 +230,11 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                 f" of a {use.element} of link '{use.link}'" if use else "")
 
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
-        dest = confined(out, rel)
-        if dest.exists():
+        if skip(rel):
             continue
-        if not ops and dest.name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
-                and not dest.name.endswith(".mars.obj"):
+        name = rel.rsplit("/", 1)[-1]
+        if not ops and name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
+                and not name.endswith(".mars.obj"):
             problem = _copy_problem(src)
             if problem is not None:
                 span, of = where(src, ops)
@@ -223,10 +242,10 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
                            hint="export the mesh again from its modelling tool")
                 ok = False
                 continue
-            plan_.append((src, dest, rel))
+            plan_.append((src, rel))
             continue
         try:
-            cached = _cached_path(src, ops, dest.suffix)
+            cached = _cached_path(src, ops, os.path.splitext(name)[1])
             data, bad = load_entry(cached)
             if bad is not None:
                 sink.warning(where(src, ops)[0], "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
@@ -241,9 +260,9 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
         else:
             entries[cached] = data
             touch_entry(cached)
-        plan_.append((cached, dest, rel))
+        plan_.append((cached, rel))
     problems = _compute(list(todo.values()))
-    for source, dest, rel in plan_:
+    for source, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
             span, of = where(src, ops)
@@ -266,12 +285,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        if source in entries:
-            dest.write_bytes(entries[source])
-        else:
-            copy_file(source, dest)  # a regular file, checked when the model was read
-    return ok
+        found[rel] = entries.get(source, source)
+    return found, ok
 
 
 def _copy_problem(src: Path) -> str | None:

@@ -91,14 +91,6 @@ def _quat_rpy(rpy: tuple[float, float, float]) -> Quat:
     return q if q[0] >= 0 else (-q[0], -q[1], -q[2], -q[3])
 
 
-def _quat_matrix(R: np.ndarray) -> Quat:
-    """(w, x, y, z) of a rotation matrix; w ≥ 0."""
-    from scipy.spatial.transform import Rotation  # not on `mpc check`'s path (front_end.check_inertials)
-
-    x, y, z, w = (float(c) for c in Rotation.from_matrix(R).as_quat())
-    return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)
-
-
 def _pose_pairs(pose: Pose | None) -> Pairs:
     """pos and quat of a pose, each left out when it is the identity (MJCF's default)."""
     if pose is None:
@@ -120,7 +112,7 @@ def principal(inertial: Inertial) -> tuple[tuple[float, float, float], Quat]:
         V[:, 2] = -V[:, 2]
     big = float(np.max(np.abs(w)))
     d = tuple(0.0 if abs(x) <= 1e-12 * big else float(x) for x in w)
-    return d, _quat_matrix(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
+    return d, tf.matrix_to_quat(tf.rpy_to_matrix(rpy) @ V)  # type: ignore[return-value]
 
 
 def unusable_inertial(inertial: Inertial) -> str | None:

@@ -120,26 +120,23 @@ def layers_text(robot: Robot, layout: str, triangles: object, payload_folder: st
     """The content of each layer (USDA text, or a crate's bytes), by its path relative to
     `usd/` ("" for the file the export names) and, for the layered layout, the payload's layers
     in `payload_folder`."""
-    from mpc.backends.usd_pxr import Sdf, Usd
+    from mpc.backends.usd_pxr import Sdf
     from mpc.backends.usd_stage import Author, Layers
 
-    stage = Usd.Stage.CreateInMemory()
     if layout == "single":
-        one = stage.GetRootLayer()
+        one = Sdf.Layer.CreateAnonymous("single.usda")
         parts = Layers(one, one, one)
     else:
         parts = Layers(*(Sdf.Layer.CreateAnonymous(f"{p}.usda")
                          for p in ("geometry", "materials", "physics")))
-        stage.GetRootLayer().subLayerPaths = [parts.physics.identifier, parts.materials.identifier,
-                                              parts.geometry.identifier]
-    author = Author(robot, stage, parts, triangles)  # type: ignore[arg-type]
+    author = Author(robot, parts, triangles)  # type: ignore[arg-type]
     author.geometry()
     author.materials_part()
     author.physics()
     root = author.root.name
     if layout == "single":
-        _metadata(stage.GetRootLayer(), root)
-        return {"": stage.GetRootLayer().ExportToString()}
+        _metadata(parts.geometry, root)
+        return {"": parts.geometry.ExportToString()}
     out: dict[str, str | bytes] = {}
     for name, file in PARTS:
         layer = getattr(parts, name)
@@ -175,13 +172,11 @@ def _crate(layer: Layer) -> bytes:
 
 def _metadata(layer: Layer, root: str) -> None:
     """Metres, kilograms, Z up and the default prim, on a layer."""
-    from mpc.backends.usd_pxr import UsdGeom, UsdPhysics
-
     layer.defaultPrim = root
     info = dict(layer.pseudoRoot.GetInfo("customLayerData") or {})
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, 1.0)
-    layer.pseudoRoot.SetInfo(UsdPhysics.Tokens.kilogramsPerUnit, 1.0)
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, UsdGeom.Tokens.z)
+    layer.pseudoRoot.SetInfo("metersPerUnit", 1.0)  # UsdGeom's and UsdPhysics's layer metadata
+    layer.pseudoRoot.SetInfo("kilogramsPerUnit", 1.0)
+    layer.pseudoRoot.SetInfo("upAxis", "Z")
     if info:
         layer.customLayerData = info
 

@@ -2,16 +2,16 @@
 computed once through the mesh cache (backends/meshes.py) as binary PLY, then read here.
 
 USD holds a mesh's points and faces in the layer itself, so the USD export writes no mesh
-files: the PLY files go to a temporary folder, each read back into NumPy arrays (points
-float32, face indices int32) by `read_ply`, a reader of the binary PLY that trimesh writes
-(anything else is read by trimesh).
+files: each PLY's bytes, as the cache holds them, are read into NumPy arrays (points float32,
+face indices int32) by `read_ply`, a reader of the binary PLY that trimesh writes (anything
+else is read by trimesh).
 """
 
 from __future__ import annotations
 
-import tempfile
+import io
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -20,7 +20,13 @@ from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.ir.robot import Robot
 
-Triangles = tuple[np.ndarray, np.ndarray]  # points (n, 3) float32, triangles (m, 3) int32
+
+class Triangles(NamedTuple):
+    points: np.ndarray  # (n, 3) float32
+    faces: np.ndarray  # (m, 3) int32
+    extent: tuple[tuple[float, ...], tuple[float, ...]]  # the points' least and greatest x, y, z
+
+
 
 _SCALARS = {"char": "i1", "uchar": "u1", "int8": "i1", "uint8": "u1", "short": "<i2", "ushort": "<u2",
             "int16": "<i2", "uint16": "<u2", "int": "<i4", "uint": "<u4", "int32": "<i4",
@@ -61,18 +67,25 @@ def read_ply(data: bytes) -> Triangles | None:
     faces = np.frombuffer(data, ftype, nf, start + nv * vtype.itemsize)
     if not np.all(faces["n"] == 3):
         return None
-    points = np.stack([vertices[c].astype(np.float32) for c in ("x", "y", "z")], axis=1)
-    return points, faces["i"].astype(np.int32)
+    columns = [vertices[c].astype(np.float32) for c in ("x", "y", "z")]
+    # the extent from the columns: a minimum down a contiguous column is ten times one down (n, 3)
+    extent = tuple(float(c.min()) for c in columns), tuple(float(c.max()) for c in columns)
+    return Triangles(np.stack(columns, axis=1), faces["i"].astype(np.int32), extent if nv else ((), ()))
 
 
-def _read(path: Path) -> Triangles:
-    parsed = read_ply(path.read_bytes())
+def _read(content: bytes | Path) -> Triangles:
+    """The triangles of a mesh's bytes from the cache (or of a PLY source file used as it is)."""
+    parsed = read_ply(content if isinstance(content, bytes) else content.read_bytes())
     if parsed is not None:
         return parsed
     import trimesh
 
-    mesh: Any = trimesh.load(path, force="mesh", process=False)
-    return np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.int32)
+    source = io.BytesIO(content) if isinstance(content, bytes) else content
+    mesh: Any = trimesh.load(source, file_type="ply", force="mesh", process=False)
+    points = np.asarray(mesh.vertices, dtype=np.float32)
+    extent = ((tuple(map(float, points.min(axis=0))), tuple(map(float, points.max(axis=0))))
+              if len(points) else ((), ()))
+    return Triangles(points, np.asarray(mesh.faces, dtype=np.int32), extent)
 
 
 def triangles(robot: Robot, sink: Sink, span: Span) -> dict[meshes.MeshKey, Triangles] | None:
@@ -81,10 +94,7 @@ def triangles(robot: Robot, sink: Sink, span: Span) -> dict[meshes.MeshKey, Tria
     files = meshes.plan(robot, "ply", sink, span)
     if files is None:
         return None
-    if not files:
-        return {}
-    with tempfile.TemporaryDirectory(prefix="mpc-usd-") as work:
-        folder = Path(work)
-        if not meshes.copy(files, folder, sink, span, robot):
-            return None
-        return {k: _read(folder / rel) for k, rel in files.items()}
+    found, ok = meshes.contents(files, sink, span, robot)
+    if not ok:
+        return None
+    return {k: _read(found[rel]) for k, rel in files.items()}

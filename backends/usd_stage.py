@@ -32,26 +32,13 @@ from typing import Any
 
 import numpy as np
 
+from mpc.backends import usd_specs as specs
 from mpc.backends.mjcf import cut_sites, principal
 from mpc.backends.usd_kinds import ONE_DOF, closed_cut_axis, mimic_written, written_cut
 from mpc.backends.usd_meshes import Triangles
 from mpc.backends.usd_names import sibling_names, unique_identifiers
-from mpc.backends.usd_pxr import (
-    Gf,
-    Layer,
-    PhysicsJoint,
-    Prim,
-    PrimPath,
-    Quat,
-    Sdf,
-    Stage,
-    Usd,
-    UsdGeom,
-    UsdPhysics,
-    UsdShade,
-    Vt,
-    Xformable,
-)
+from mpc.backends.usd_pxr import Gf, Layer, PrimPath, Quat, Sdf, Vt
+from mpc.backends.usd_specs import PrimSpec, T
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, ConvexHull, ConvexPart, Cylinder, Geometry, Mesh, Sphere
@@ -111,11 +98,11 @@ def approximation(mesh: Mesh) -> str:
 
 
 class Author:
-    """Authors one robot onto a stage (see the module's docstring)."""
+    """Authors one robot into its layers (see the module's docstring), as specs
+    (backends/usd_specs.py)."""
 
-    def __init__(self, robot: Robot, stage: Stage, layers: Layers,
-                 triangles: Callable[[Mesh], Triangles]) -> None:
-        self.robot, self.stage, self.layers, self.triangles = robot, stage, layers, triangles
+    def __init__(self, robot: Robot, layers: Layers, triangles: Callable[[Mesh], Triangles]) -> None:
+        self.robot, self.layers, self.triangles = robot, layers, triangles
         self.root = Sdf.Path("/" + unique_identifiers([robot.name])[robot.name])
         self.order = [link for _, link in depth_first(robot)]
         self.link_names = unique_identifiers(self.order, taken=("joints", "materials"))
@@ -129,88 +116,87 @@ class Author:
         folder = self.link_path(link.name).AppendChild(kind)
         return [folder.AppendChild(n) for n in sibling_names(s.name or kind[:-1] for s in shapes)]
 
-    def target(self, layer: Layer) -> None:
-        self.stage.SetEditTarget(Usd.EditTarget(layer))
-
     def link_path(self, link: str) -> PrimPath:
         return self.root.AppendChild(self.link_names[link])
 
     # geometry ------------------------------------------------------------------------------
 
     def geometry(self) -> None:
-        self.target(self.layers.geometry)
-        top = UsdGeom.Xform.Define(self.stage, self.root)
-        Usd.ModelAPI(top.GetPrim()).SetKind("component")
-        _name(top.GetPrim(), self.robot.name)
+        layer = self.layers.geometry
+        top = specs.prim(layer, self.root, "Xform")
+        top.kind = "component"
+        _name(top, self.robot.name)
         for link in self.order:
-            xform = UsdGeom.Xform.Define(self.stage, self.link_path(link))
-            _name(xform.GetPrim(), link)
+            xform = specs.prim(layer, self.link_path(link), "Xform")
+            _name(xform, link)
             _place(xform, self.X[link][:3, 3], self.X[link][:3, :3])
             lk = self.robot.links[link]
             for kind, shapes in (("visuals", lk.visuals), ("collisions", lk.collisions)):
                 if not shapes:
                     continue
-                UsdGeom.Scope.Define(self.stage, self.link_path(link).AppendChild(kind))
+                specs.prim(layer, self.link_path(link).AppendChild(kind), "Scope")
                 for path, shape in zip(self.shape_paths(lk, kind), shapes, strict=True):
-                    prim = self.shape(path, shape)
-                    if isinstance(shape, Collision):
-                        UsdGeom.Imageable(prim).CreatePurposeAttr(UsdGeom.Tokens.guide)
+                    self.shape(path, shape)
 
     def mesh_arrays(self, mesh: Mesh) -> tuple[Any, Any, Any, Any]:
         """A mesh's points, face sizes, indices and extent as USD's arrays, made once for each
         mesh file and ops (a leg's mesh used four times is converted once)."""
-        points, faces = self.triangles(mesh)
+        points, faces, (lo, hi) = self.triangles(mesh)
         key = id(points)
         if key not in self.arrays:
-            lo, hi = points.min(axis=0), points.max(axis=0)
             self.arrays[key] = (Vt.Vec3fArray.FromNumpy(points),
                                 Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)),
                                 Vt.IntArray.FromNumpy(faces.reshape(-1)),
-                                Vt.Vec3fArray([Gf.Vec3f(*map(float, lo)), Gf.Vec3f(*map(float, hi))]))
+                                Vt.Vec3fArray([Gf.Vec3f(*lo), Gf.Vec3f(*hi)]) if lo else Vt.Vec3fArray())
         return self.arrays[key]
 
-    def shape(self, path: PrimPath, shape: Visual | Collision) -> Prim:
+    def shape(self, path: PrimPath, shape: Visual | Collision) -> None:
         g: Geometry = shape.geometry
         scale: tuple[float, ...] | None = None
+        layer = self.layers.geometry
         match g:
             case Box():
-                prim = UsdGeom.Cube.Define(self.stage, path)
-                prim.CreateSizeAttr(1.0)
+                spec = specs.prim(layer, path, "Cube")
+                specs.attribute(spec, "size", T.Double, 1.0)
                 scale = g.size
             case Sphere():
-                prim = UsdGeom.Sphere.Define(self.stage, path)
-                prim.CreateRadiusAttr(g.radius)
+                spec = specs.prim(layer, path, "Sphere")
+                specs.attribute(spec, "radius", T.Double, g.radius)
             case Cylinder():
-                prim = UsdGeom.Cylinder.Define(self.stage, path)
-                prim.CreateRadiusAttr(g.radius)
-                prim.CreateHeightAttr(g.length)
-                prim.CreateAxisAttr(UsdGeom.Tokens.z)
+                spec = specs.prim(layer, path, "Cylinder")
+                specs.attribute(spec, "radius", T.Double, g.radius)
+                specs.attribute(spec, "height", T.Double, g.length)
+                specs.attribute(spec, "axis", T.Token, "Z", uniform=True)
             case Mesh():
-                prim = UsdGeom.Mesh.Define(self.stage, path)
+                spec = specs.prim(layer, path, "Mesh")
                 points, counts, indices, extent = self.mesh_arrays(g)
-                prim.CreatePointsAttr(points)
-                prim.CreateFaceVertexCountsAttr(counts)
-                prim.CreateFaceVertexIndicesAttr(indices)
-                prim.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
-                prim.CreateExtentAttr(extent)
+                specs.attribute(spec, "points", T.Point3fArray, points)
+                specs.attribute(spec, "faceVertexCounts", T.IntArray, counts)
+                specs.attribute(spec, "faceVertexIndices", T.IntArray, indices)
+                specs.attribute(spec, "subdivisionScheme", T.Token, "none", uniform=True)
+                specs.attribute(spec, "extent", T.Float3Array, extent)
                 scale = g.scale
+            case _:
+                raise AssertionError(f"no USD prim for {g!r}")
         X = pose_matrix(shape.origin)
-        _place(prim, X[:3, 3], X[:3, :3], scale)
-        _name(prim.GetPrim(), shape.name or "")
-        if isinstance(shape, Visual):
-            m = _material_of(self.robot, shape)
-            if m is not None and m.rgba is not None:
-                prim.CreateDisplayColorAttr(Vt.Vec3fArray([Gf.Vec3f(*m.rgba[:3])]))
-                if m.rgba[3] != 1:
-                    prim.CreateDisplayOpacityAttr(Vt.FloatArray([m.rgba[3]]))
-        return prim.GetPrim()
+        _place(spec, X[:3, 3], X[:3, :3], scale)
+        _name(spec, shape.name or "")
+        if isinstance(shape, Collision):
+            specs.attribute(spec, "purpose", T.Token, "guide", uniform=True)
+            return
+        m = _material_of(self.robot, shape)
+        if m is not None and m.rgba is not None:
+            specs.attribute(spec, "primvars:displayColor", T.Color3fArray,
+                            Vt.Vec3fArray([Gf.Vec3f(*m.rgba[:3])]))
+            if m.rgba[3] != 1:
+                specs.attribute(spec, "primvars:displayOpacity", T.FloatArray, Vt.FloatArray([m.rgba[3]]))
 
     # materials -----------------------------------------------------------------------------
 
     def materials_part(self) -> None:
         """One UsdPreviewSurface material per distinct coloured material (name, colour and
         emission), bound to its visuals."""
-        self.target(self.layers.materials)
+        layer = self.layers.materials
         used: dict[tuple[object, ...], Material] = {}
         for link in self.order:
             for visual in self.robot.links[link].visuals:
@@ -220,46 +206,50 @@ class Author:
         if not used:
             return
         folder = self.root.AppendChild("materials")
-        UsdGeom.Scope.Define(self.stage, folder)
+        specs.prim(layer, folder, "Scope")
         paths: dict[tuple[object, ...], PrimPath] = {}
         for (key, m), name in zip(used.items(), sibling_names(m.name for m in used.values()), strict=True):
             paths[key] = path = folder.AppendChild(name)
-            material = UsdShade.Material.Define(self.stage, path)
-            _name(material.GetPrim(), m.name)
-            shader = UsdShade.Shader.Define(self.stage, path.AppendChild("PreviewSurface"))
-            shader.CreateIdAttr("UsdPreviewSurface")
+            material = specs.prim(layer, path, "Material")
+            _name(material, m.name)
+            shader_path = path.AppendChild("PreviewSurface")
+            shader = specs.prim(layer, shader_path, "Shader")
+            specs.attribute(shader, "info:id", T.Token, "UsdPreviewSurface", uniform=True)
             assert m.rgba is not None
-            shader.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*m.rgba[:3]))
-            shader.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(float(m.rgba[3]))
+            specs.attribute(shader, "inputs:diffuseColor", T.Color3f, Gf.Vec3f(*m.rgba[:3]))
+            specs.attribute(shader, "inputs:opacity", T.Float, float(m.rgba[3]))
             if m.emissive is not None and len(m.emissive) >= 3:
-                shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(
-                    Gf.Vec3f(*(float(c) for c in m.emissive[:3])))
-            material.CreateSurfaceOutput().ConnectToSource(shader.ConnectableAPI(), "surface")
+                specs.attribute(shader, "inputs:emissiveColor", T.Color3f,
+                                Gf.Vec3f(*(float(c) for c in m.emissive[:3])))
+            Sdf.AttributeSpec(shader, "outputs:surface", T.Token)
+            specs.connect(material, "outputs:surface", T.Token, shader_path.AppendProperty("outputs:surface"))
         for link in self.order:
             lk = self.robot.links[link]
             for path, visual in zip(self.shape_paths(lk, "visuals"), lk.visuals, strict=True):
                 m = _material_of(self.robot, visual)
                 if m is None or m.rgba is None:
                     continue
-                UsdShade.MaterialBindingAPI.Apply(self.stage.OverridePrim(path)).Bind(
-                    UsdShade.Material(self.stage.GetPrimAtPath(paths[_material_key(m)])))
+                spec = specs.prim(layer, path)
+                specs.apply(spec, "MaterialBindingAPI")
+                specs.relationship(spec, "material:binding", [paths[_material_key(m)]])
 
     # physics -------------------------------------------------------------------------------
 
     def physics(self) -> None:
-        self.target(self.layers.physics)
-        UsdPhysics.ArticulationRootAPI.Apply(self.stage.OverridePrim(self.root))
+        layer = self.layers.physics
+        specs.apply(specs.prim(layer, self.root), "PhysicsArticulationRootAPI")
         static = self.static_root()
         for link in self.order:
-            prim = self.stage.OverridePrim(self.link_path(link))
             if link != static:
-                self.body(prim, link)
+                self.body(specs.prim(layer, self.link_path(link)), link)
             lk = self.robot.links[link]
             for path, c in zip(self.shape_paths(lk, "collisions"), lk.collisions, strict=True):
-                cprim = self.stage.OverridePrim(path)
-                UsdPhysics.CollisionAPI.Apply(cprim)
+                cspec = specs.prim(layer, path)
+                specs.apply(cspec, "PhysicsCollisionAPI")
                 if isinstance(c.geometry, Mesh):
-                    UsdPhysics.MeshCollisionAPI.Apply(cprim).CreateApproximationAttr(approximation(c.geometry))
+                    specs.apply(cspec, "PhysicsMeshCollisionAPI")
+                    specs.attribute(cspec, "physics:approximation", T.Token, approximation(c.geometry),
+                                    uniform=True)
         self.filtered_pairs()
         folder = self.root.AppendChild("joints")
         joints = [j for j, _ in depth_first(self.robot) if j is not None]
@@ -268,7 +258,7 @@ class Author:
         closed = [c for c in cuts if written_cut(c)]
         if not written and not closed:
             return
-        self.stage.DefinePrim(folder, "Scope")
+        specs.prim(layer, folder, "Scope")
         self.joint_names = unique_identifiers([*(j.name for j in written), *(c.name for c in closed)])
         for j in written:
             self.joint(folder.AppendChild(self.joint_names[j.name]), j)
@@ -283,23 +273,23 @@ class Author:
         massless = root.inertial is None or root.inertial.mass == 0
         return root.name if root.name == "world" and massless else None
 
-    def body(self, prim: Prim, link: str) -> None:
+    def body(self, spec: PrimSpec, link: str) -> None:
         """RigidBodyAPI and MassAPI: mass, centre of mass, and the principal moments and axes
         (mjcf.principal). A link without inertial, or with a zero tensor, gets mass and centre
         of mass only: UsdPhysics reads a zero diagonal inertia as "not given", and its
         validator refuses one authored."""
-        UsdPhysics.RigidBodyAPI.Apply(prim)
-        mass = UsdPhysics.MassAPI.Apply(prim)
+        specs.apply(spec, "PhysicsRigidBodyAPI", "PhysicsMassAPI")
         inertial = self.robot.links[link].inertial
-        mass.CreateMassAttr(float(inertial.mass) if inertial is not None else 0.0)
+        specs.attribute(spec, "physics:mass", T.Float, float(inertial.mass) if inertial is not None else 0.0)
         if inertial is None:
             return
         xyz = inertial.origin.xyz if inertial.origin is not None else (0.0, 0.0, 0.0)
-        mass.CreateCenterOfMassAttr(Gf.Vec3f(*xyz))
+        specs.attribute(spec, "physics:centerOfMass", T.Point3f, Gf.Vec3f(*xyz))
         d, q = principal(inertial)
         if any(d):
-            mass.CreateDiagonalInertiaAttr(Gf.Vec3f(*d))
-            mass.CreatePrincipalAxesAttr(Gf.Quatf(q[0], Gf.Vec3f(q[1], q[2], q[3])))
+            specs.attribute(spec, "physics:diagonalInertia", T.Float3, Gf.Vec3f(*d))
+            specs.attribute(spec, "physics:principalAxes", T.Quatf,
+                            Gf.Quatf(q[0], Gf.Vec3f(q[1], q[2], q[3])))
 
     def filtered_pairs(self) -> None:
         """Links none of whose collisions share a bitmask bit with the other's never collide:
@@ -313,45 +303,46 @@ class Author:
             others = [b for b in colliding[i + 1:] if all(
                 x is not None and y is not None and not (x & y) for x in shapes[a] for y in shapes[b])]
             if others:
-                api = UsdPhysics.FilteredPairsAPI.Apply(self.stage.OverridePrim(self.link_path(a)))
-                api.CreateFilteredPairsRel().SetTargets([self.link_path(b) for b in others])
+                spec = specs.prim(self.layers.physics, self.link_path(a))
+                specs.apply(spec, "PhysicsFilteredPairsAPI")
+                specs.relationship(spec, "physics:filteredPairs", [self.link_path(b) for b in others])
 
-    def _frame(self, joint: PhysicsJoint, parent: str, child: str, X_PJ: np.ndarray, X_CJ: np.ndarray,
+    def _frame(self, joint: PrimSpec, parent: str, child: str, X_PJ: np.ndarray, X_CJ: np.ndarray,
                R_a: np.ndarray) -> None:
-        joint.CreateBody0Rel().SetTargets([self.link_path(parent)])
-        joint.CreateBody1Rel().SetTargets([self.link_path(child)])
-        joint.CreateLocalPos0Attr(Gf.Vec3f(*map(float, X_PJ[:3, 3])))
-        joint.CreateLocalRot0Attr(quatf(X_PJ[:3, :3] @ R_a))
-        joint.CreateLocalPos1Attr(Gf.Vec3f(*map(float, X_CJ[:3, 3])))
-        joint.CreateLocalRot1Attr(quatf(X_CJ[:3, :3] @ R_a))
+        specs.relationship(joint, "physics:body0", [self.link_path(parent)])
+        specs.relationship(joint, "physics:body1", [self.link_path(child)])
+        specs.attribute(joint, "physics:localPos0", T.Point3f, Gf.Vec3f(*map(float, X_PJ[:3, 3])))
+        specs.attribute(joint, "physics:localRot0", T.Quatf, quatf(X_PJ[:3, :3] @ R_a))
+        specs.attribute(joint, "physics:localPos1", T.Point3f, Gf.Vec3f(*map(float, X_CJ[:3, 3])))
+        specs.attribute(joint, "physics:localRot1", T.Quatf, quatf(X_CJ[:3, :3] @ R_a))
+
+    def _limits(self, joint: PrimSpec, lower: float, upper: float) -> None:
+        specs.attribute(joint, "physics:lowerLimit", T.Float, lower)
+        specs.attribute(joint, "physics:upperLimit", T.Float, upper)
 
     def joint(self, path: PrimPath, j: Joint) -> None:
         token, R_a = axis_frame(j.axis) if j.type in ONE_DOF else ("X", np.eye(3))
-        usd_joint: PhysicsJoint
+        layer = self.layers.physics
+        lim = j.limit
+        limited = lim is not None and (lim.lower is not None or lim.upper is not None)
         if j.type in ("revolute", "continuous"):
-            rev = UsdPhysics.RevoluteJoint.Define(self.stage, path)
-            rev.CreateAxisAttr(token)
-            lim = j.limit
-            if j.type == "revolute" and lim is not None and (lim.lower is not None or lim.upper is not None):
-                rev.CreateLowerLimitAttr((lim.lower or 0.0) * DEG)
-                rev.CreateUpperLimitAttr((lim.upper or 0.0) * DEG)
-            usd_joint = rev
+            spec = specs.prim(layer, path, "PhysicsRevoluteJoint")
+            specs.attribute(spec, "physics:axis", T.Token, token, uniform=True)
+            if j.type == "revolute" and lim is not None and limited:
+                self._limits(spec, (lim.lower or 0.0) * DEG, (lim.upper or 0.0) * DEG)
         elif j.type == "prismatic":
-            pri = UsdPhysics.PrismaticJoint.Define(self.stage, path)
-            pri.CreateAxisAttr(token)
-            lim = j.limit
-            if lim is not None and (lim.lower is not None or lim.upper is not None):
-                pri.CreateLowerLimitAttr(lim.lower or 0.0)
-                pri.CreateUpperLimitAttr(lim.upper or 0.0)
-            usd_joint = pri
+            spec = specs.prim(layer, path, "PhysicsPrismaticJoint")
+            specs.attribute(spec, "physics:axis", T.Token, token, uniform=True)
+            if lim is not None and limited:
+                self._limits(spec, lim.lower or 0.0, lim.upper or 0.0)
         else:
-            usd_joint = UsdPhysics.FixedJoint.Define(self.stage, path)
-        _name(usd_joint.GetPrim(), j.name)
-        self._frame(usd_joint, j.parent, j.child, pose_matrix(j.origin), np.eye(4), R_a)
-        self.drive(usd_joint.GetPrim(), j)
-        self.dynamics(usd_joint.GetPrim(), j)
+            spec = specs.prim(layer, path, "PhysicsFixedJoint")
+        _name(spec, j.name)
+        self._frame(spec, j.parent, j.child, pose_matrix(j.origin), np.eye(4), R_a)
+        self.drive(spec, j)
+        self.dynamics(spec, j)
 
-    def dynamics(self, prim: Prim, j: Joint) -> None:
+    def dynamics(self, spec: PrimSpec, j: Joint) -> None:
         """The joint's velocity limit, damping and friction as NewtonJointAPI holds them (per
         degree on a rotational joint); UsdPhysics has none."""
         if j.type not in ONE_DOF:
@@ -365,11 +356,11 @@ class Author:
         given = [(name, float(value) * unit) for name, value, unit in values if value is not None]
         if not given:
             return
-        prim.AddAppliedSchema("NewtonJointAPI")
+        specs.apply(spec, "NewtonJointAPI")
         for name, value in given:
-            prim.CreateAttribute(name, Sdf.ValueTypeNames.Float, custom=False).Set(value)
+            specs.attribute(spec, name, T.Float, value)
 
-    def drive(self, prim: Prim, j: Joint) -> None:
+    def drive(self, spec: PrimSpec, j: Joint) -> None:
         """The motor of a one-degree-of-freedom joint as a DriveAPI (see the module)."""
         motors = [m for m in (self.robot.motors[n] for n in sorted(self.robot.motors)) if m.joint == j.name]
         if not motors or j.type not in ONE_DOF:
@@ -377,15 +368,16 @@ class Author:
         settings = motors[0].settings
         angular = j.type != "prismatic"
         per = math.pi / 180 if angular else 1.0  # N·m/rad → N·m/degree
-        drive = UsdPhysics.DriveAPI.Apply(prim, "angular" if angular else "linear")
-        drive.CreateTypeAttr("force")
-        for key, create in (("p", drive.CreateStiffnessAttr), ("d", drive.CreateDampingAttr)):
+        kind = "angular" if angular else "linear"
+        specs.apply(spec, f"PhysicsDriveAPI:{kind}")
+        specs.attribute(spec, f"drive:{kind}:physics:type", T.Token, "force", uniform=True)
+        for key, attr in (("p", "stiffness"), ("d", "damping")):
             value = settings.get(key)
             if isinstance(value, int | float) and not isinstance(value, bool):
-                create(float(value) * per)
+                specs.attribute(spec, f"drive:{kind}:physics:{attr}", T.Float, float(value) * per)
         effort = j.limit.effort if j.limit is not None else None
         if effort:
-            drive.CreateMaxForceAttr(abs(effort))
+            specs.attribute(spec, f"drive:{kind}:physics:maxForce", T.Float, abs(effort))
 
     def mimic(self, folder: PrimPath, j: Joint) -> None:
         """NewtonMimicAPI on a one-degree-of-freedom joint that follows another of the same kind."""
@@ -393,53 +385,51 @@ class Author:
         leader = self.robot.joints.get(m.joint) if m is not None else None
         if m is None or not mimic_written(j, leader):
             return
-        prim = self.stage.GetPrimAtPath(folder.AppendChild(self.joint_names[j.name]))
-        prim.AddAppliedSchema("NewtonMimicAPI")
-        prim.CreateRelationship("newton:mimicJoint", custom=False).SetTargets(
-            [folder.AppendChild(self.joint_names[m.joint])])
+        spec = specs.prim(self.layers.physics, folder.AppendChild(self.joint_names[j.name]))
+        specs.apply(spec, "NewtonMimicAPI")
+        specs.relationship(spec, "newton:mimicJoint", [folder.AppendChild(self.joint_names[m.joint])])
         offset = (m.offset or 0.0) * (DEG if j.type != "prismatic" else 1.0)
-        prim.CreateAttribute("newton:mimicCoef0", Sdf.ValueTypeNames.Float, custom=False).Set(offset)
-        prim.CreateAttribute("newton:mimicCoef1", Sdf.ValueTypeNames.Float, custom=False).Set(
-            1.0 if m.multiplier is None else m.multiplier)
+        specs.attribute(spec, "newton:mimicCoef0", T.Float, offset)
+        specs.attribute(spec, "newton:mimicCoef1", T.Float, 1.0 if m.multiplier is None else m.multiplier)
 
     def cut(self, path: PrimPath, c: CutJoint) -> None:
         """A loop closure: a joint excluded from the articulation, at the closure's frame on
         both sides (mjcf.cut_sites)."""
         _, on_parent, on_child = cut_sites(c)[0]
         R_a = np.eye(3)
+        layer = self.layers.physics
         if c.type == "fixed":
-            joint: PhysicsJoint = UsdPhysics.FixedJoint.Define(self.stage, path)
+            spec = specs.prim(layer, path, "PhysicsFixedJoint")
         elif c.type == "ball":
-            joint = UsdPhysics.SphericalJoint.Define(self.stage, path)
+            spec = specs.prim(layer, path, "PhysicsSphericalJoint")
         else:
             axis = closed_cut_axis(c)
             assert axis is not None
             # the axis is in the child link's frame; the joint frame's own axis is R_CJᵀ·a
             R_CJ = pose_matrix(on_child)[:3, :3]
             token, R_a = axis_frame(tuple(float(x) for x in R_CJ.T @ np.asarray(axis)))  # type: ignore[arg-type]
-            rev = UsdPhysics.RevoluteJoint.Define(self.stage, path)
-            rev.CreateAxisAttr(token)
-            joint = rev
-        joint.CreateExcludeFromArticulationAttr(True)
-        _name(joint.GetPrim(), c.name)
-        self._frame(joint, c.parent, c.child, pose_matrix(on_parent), pose_matrix(on_child), R_a)
+            spec = specs.prim(layer, path, "PhysicsRevoluteJoint")
+            specs.attribute(spec, "physics:axis", T.Token, token, uniform=True)
+        specs.attribute(spec, "physics:excludeFromArticulation", T.Bool, True, uniform=True)
+        _name(spec, c.name)
+        self._frame(spec, c.parent, c.child, pose_matrix(on_parent), pose_matrix(on_child), R_a)
 
 
 def _material_key(m: Material) -> tuple[object, ...]:
     return (m.name, m.rgba, m.emissive)
 
 
-def _name(prim: Prim, name: str) -> None:
-    prim.CreateAttribute(NAME, Sdf.ValueTypeNames.String, custom=True).Set(name)
+def _name(spec: PrimSpec, name: str) -> None:
+    specs.attribute(spec, NAME, T.String, name, custom=True)
 
 
-def _place(xform: Xformable, xyz: np.ndarray | tuple[float, ...], R: np.ndarray,
+def _place(spec: PrimSpec, xyz: np.ndarray | tuple[float, ...], R: np.ndarray,
            scale: tuple[float, ...] | None = None) -> None:
     """translate and orient (doubles), and scale when given; only those not the identity."""
-    if any(float(x) != 0 for x in xyz):
-        xform.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(*map(float, xyz)))
-    if not np.array_equal(R, np.eye(3)):
-        xform.AddOrientOp(UsdGeom.XformOp.PrecisionDouble).Set(quatd(R))
-    if scale is not None and tuple(scale) != (1.0, 1.0, 1.0):
-        xform.AddScaleOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(*map(float, scale)))
-
+    identity = R[0, 0] == R[1, 1] == R[2, 2] == 1 and not (R[0, 1] or R[0, 2] or R[1, 0] or R[1, 2]
+                                                           or R[2, 0] or R[2, 1])
+    specs.place(spec,
+                translate=Gf.Vec3d(*map(float, xyz)) if any(float(x) != 0 for x in xyz) else None,
+                orient=None if identity else quatd(R),
+                scale=Gf.Vec3d(*map(float, scale)) if scale is not None and tuple(scale) != (1.0, 1.0, 1.0)
+                else None)

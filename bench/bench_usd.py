@@ -16,7 +16,9 @@ of each (mpc's mesh cache warm, its build cache not used: `mpc compile --force`)
   child processes, and the ratio mpc / converter of each pair;
 - in one process: each tool's Python API called again and again in one process of its
   environment (the imports paid once): mpc's `compile_model`, the converter's
-  `Converter().convert`.
+  `Converter().convert`;
+- the four robots at once, whole processes, as a CI job builds them: one `mpc run PIPELINE -j 1
+  --force` (one process, one core) against the converter run once per robot.
 The machine is shared: quote the CPU figures and the ratios.
 
 Fidelity: both outputs opened with usd-core here, counted: mimic joints (NewtonMimicAPI or
@@ -147,6 +149,7 @@ def main() -> None:
     mpc = str(Path(sys.executable).with_name("mpc"))
     work = Path(tempfile.mkdtemp(prefix="bench-usd-"))
     env = {**os.environ, "MPC_CACHE_DIR": str(work / "cache")}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # users' runs import compiled bytecode (both tools)
     definitions, urdfs = [], []
     print(f"{'robot':16} {'mpc wall':>9} {'conv wall':>9} {'mpc cpu':>8} {'conv cpu':>8} "
           f"{'cpu ratio':>9} {'wall ratio':>10}")
@@ -170,6 +173,22 @@ def main() -> None:
               f"{med(r[0][1] / r[1][1] for r in rows):9.2f} {med(r[0][0] / r[1][0] for r in rows):10.2f}")
     if args.fidelity_only:
         return fidelities(work, urdfs)
+    pipeline = work / "pipeline.yml"
+    pipeline.write_text("pipeline:\n  root: .\n  model_definitions:\n"
+                        + "".join(f"    - {Path(d).name}\n" for d in definitions))
+    run = [mpc, "run", str(pipeline), "-j", "1", "--force", "-o", str(work / "run")]
+    timed(run, env)
+    fleet = []
+    for _ in range(args.runs):
+        ours = timed(run, env)
+        theirs = [timed([str(tool), urdf, str(work / f"{Path(urdf).stem}.conv")], env) for urdf in urdfs]
+        fleet.append((ours, (sum(t[0] for t in theirs), sum(t[1] for t in theirs))))
+    med = statistics.median
+    print(f"\nthe four at once: mpc run -j 1 wall {med(f[0][0] for f in fleet):.2f} s, cpu "
+          f"{med(f[0][1] for f in fleet):.2f} s; the converter four times wall "
+          f"{med(f[1][0] for f in fleet):.2f} s, "
+          f"cpu {med(f[1][1] for f in fleet):.2f} s; ratio wall {med(f[0][0] / f[1][0] for f in fleet):.2f}, "
+          f"cpu {med(f[0][1] / f[1][1] for f in fleet):.2f}")
     mpc_in = json.loads(subprocess.run([sys.executable, "-c", IN_PROCESS_MPC, str(args.runs), *definitions],
                                        env=env, check=True, capture_output=True, text=True).stdout)
     conv_in = json.loads(subprocess.run([str(args.converter / "bin" / "python"), "-c", IN_PROCESS_CONVERTER,

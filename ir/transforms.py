@@ -74,22 +74,24 @@ def compose(*Xs: np.ndarray) -> np.ndarray:
 
 
 def matrix_to_quat(R: np.ndarray) -> tuple[float, float, float, float]:
-    """(w, x, y, z) of a rotation matrix, w ≥ 0, by Shepperd's method in Python's floats
-    (SciPy's Rotation costs two seconds of imports)."""
+    """(w, x, y, z) of a rotation matrix, w ≥ 0, by the method of SciPy's
+    `Rotation.from_matrix` (Markley's: built on the largest of the diagonal and the trace), in
+    Python's floats and in SciPy's order of operations, so that the digits are SciPy's: the
+    outputs written with SciPy keep their bytes, without SciPy's 0.2–2 s of imports."""
     m = [[float(R[i][j]) for j in range(3)] for i in range(3)]
     trace = m[0][0] + m[1][1] + m[2][2]
-    if trace > 0:
-        s = math.sqrt(trace + 1.0) * 2
-        q = (s / 4, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s)
-    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
-        s = math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]) * 2
-        q = ((m[2][1] - m[1][2]) / s, s / 4, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s)
-    elif m[1][1] > m[2][2]:
-        s = math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]) * 2
-        q = ((m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, s / 4, (m[1][2] + m[2][1]) / s)
+    decision = (m[0][0], m[1][1], m[2][2], trace)
+    choice = max(range(4), key=lambda c: (decision[c], -c))  # the first of equals, as argmax
+    q = [0.0, 0.0, 0.0, 0.0]  # x, y, z, w
+    if choice == 3:
+        q = [m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1], 1 + trace]
     else:
-        s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
-        q = ((m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4)
-    norm = math.sqrt(sum(c * c for c in q))
-    w, x, y, z = (c / norm for c in q)
+        i = choice
+        j, k = (i + 1) % 3, (i + 2) % 3
+        q[i] = 1 - trace + 2 * m[i][i]
+        q[j] = m[j][i] + m[i][j]
+        q[k] = m[k][i] + m[i][k]
+        q[3] = m[k][j] - m[j][k]
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    x, y, z, w = (c / norm for c in q)
     return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)

@@ -108,6 +108,7 @@ class Runner:
         self.fingerprints: dict[str, str | None] = {}  # compile fingerprints of finished models
         self.done: set[str] = set()
         self.running: dict[str, _Running] = {}
+        self.shared: set[str] = set()  # modules finished workers imported (_preload)
         self.status_error: str | None = None  # why status.json could not be written
         self.start = time.perf_counter()  # when the run started
         self.freshness = Freshness(plan, self.store, opts.stages, opts.package_map, opts.werror, opts.force,
@@ -238,7 +239,7 @@ class Runner:
         from mpc.core.cache import cache_dir
         from mpc.pipeline import worker
 
-        _preload()
+        _preload(self.shared)
         share_cores(side_by_side)  # the worker forks with its share of the cores for its meshes
         model = self.plan.models[name]
         try:
@@ -292,6 +293,7 @@ class Runner:
                 except (EOFError, OSError):
                     pass  # the worker died before it could tell; its exit status says how
                 else:
+                    self.shared.update((r.message or {}).get("imported", ()))
                     continue  # the worker exits right after sending
             r.process.join()
             r.conn.close()
@@ -455,7 +457,17 @@ def _unwritable(name: str, model: PlannedModel, error: OSError) -> Diagnostic:
                       model.span)
 
 
-def _preload() -> None:
-    """Import what every build uses before forking, so workers share it instead of importing it."""
+def _preload(shared: set[str]) -> None:
+    """Import what every build uses before forking, so workers share it instead of importing it,
+    and what finished workers imported (`worker.shareable`: a pipeline of USD models pays for
+    usd-core once, not once per model)."""
+    import importlib
+
     from mpc.backends import urdf  # noqa: F401
     from mpc.compiler import driver, front_end  # noqa: F401
+    from mpc.compiler.schema.definition import Definition
+
+    Definition.model_rebuild()  # built on first use (schema/base.py): once here, not in every worker
+    for module in sorted(shared - set(sys.modules)):
+        with contextlib.suppress(Exception):  # one that cannot be imported here is imported there
+            importlib.import_module(module)

@@ -93,8 +93,6 @@ SITES: dict[tuple[str, str, str], str] = {
     ("usd.py", "emit", "confined(out, 'usd', rel)"):
         "confined: the payload's layers, `<filename>_payload/<part>.usda` (filename checked, E0250)",
     ("usd.py", "layers_text", "Sdf.Path('/' + root)"): "a prim path in the layer, not a file",
-    ("usd_meshes.py", "triangles", "Path(work)"): "a temporary folder of its own",
-    ("usd_meshes.py", "triangles", "folder / rel"): "its temporary folder: mesh paths mpc makes (meshes/…)",
     ("usd_stage.py", "__init__", "Sdf.Path('/' + unique_identifiers([robot.name])[robot.name])"):
         "a prim path (a valid identifier), not a file",
     ("xacro_reader.py", "expand", "Path(m.history[-1][-1])"): READ,

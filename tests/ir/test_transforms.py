@@ -36,3 +36,25 @@ def test_inverse_and_compose(xyz: tuple, rpy: tuple) -> None:
     np.testing.assert_allclose(tf.compose(X, tf.inverse(X)), np.eye(4), atol=1e-12)
     back_xyz, back_rpy = tf.matrix_to_pose(X)
     np.testing.assert_allclose(tf.pose_to_matrix(back_xyz, back_rpy), X, atol=1e-12)
+
+
+def test_matrix_to_quat_has_scipys_digits() -> None:
+    """The MJCF and USD writers' quaternions are SciPy's `Rotation.from_matrix`, to the last bit
+    (the files written before SciPy was dropped keep their bytes): on principal frames of random
+    inertias, on the 24 axis-aligned rotations (where the largest of diagonal and trace ties), and
+    with w < 0 turned to w ≥ 0 as the writers did."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(2026)
+    matrices = []
+    for _ in range(3000):
+        a = rng.normal(size=(3, 3))
+        V = np.linalg.eigh(a + a.T)[1]
+        V[:, 2] *= np.sign(np.linalg.det(V))
+        matrices.append(V)
+    quarter = (0.0, np.pi / 2, np.pi, -np.pi / 2)
+    matrices += [Rotation.from_euler("xyz", (r, p, y)).as_matrix()
+                 for r in quarter for p in quarter for y in quarter]
+    for R in matrices:
+        x, y, z, w = (float(c) for c in Rotation.from_matrix(R).as_quat())
+        assert tf.matrix_to_quat(R) == ((w, x, y, z) if w >= 0 else (-w, -x, -y, -z))

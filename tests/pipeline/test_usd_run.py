@@ -3,6 +3,7 @@ the cache (a second run builds nothing and the output keeps its bytes)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from tests.conftest import write
@@ -40,3 +41,58 @@ def test_mpc_run_builds_lists_and_keeps_a_usd_export(tmp_path: Path) -> None:
     second = run_json(pipeline, cache=tmp_path / "cache", cwd=project)
     assert second.returncode == 0 and second.state("arm-model") == "cached"
     assert {p: p.read_bytes() for p in (out / "usd").rglob("*") if p.is_file()} == before
+
+
+WATCH = """
+import sys
+import os
+from pathlib import Path
+
+from mpc.cli.main import main as mpc_main
+from mpc.pipeline import worker
+
+started = worker.main
+
+
+def main(job, *args):  # noqa: ANN001, ANN202
+    with open(sys.argv[1], "a") as seen:  # what the forked worker has before it builds
+        seen.write(f"{job.model} {'pxr.Sdf' in sys.modules} {'mpc.backends.usd_stage' in sys.modules}\\n")
+    started(job, *args)
+
+
+worker.main = main
+sys.exit(mpc_main(["run", sys.argv[2], "-j", "1"]))
+"""
+
+
+def test_later_workers_share_what_the_first_imported(tmp_path: Path) -> None:
+    """The runner imports what a finished worker imported (usd-core, the usd backend) before it
+    forks the next: three USD models, one at a time, import usd-core once."""
+    import subprocess
+    import sys
+
+    project = tmp_path / "project"
+    arm(project)
+    for name in ("one", "two", "three"):
+        write(project / f"{name}.yml", f"""
+            model:
+              robotname: arm
+              modelname: {name}
+              input_models: {{arm: {{basefile: arm.urdf}}}}
+              assemble: {{model: arm}}
+              export_config:
+                - type: usd
+            """)
+    pipeline = write(project / "pipeline.yml", """
+        pipeline:
+          model_definitions: [one.yml, two.yml, three.yml]
+          root: .
+        """)
+    seen = tmp_path / "seen.txt"
+    environ = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", WATCH, str(seen), str(pipeline)], cwd=project,
+                          capture_output=True, text=True, env=environ)
+    assert done.returncode == 0, done.stdout + done.stderr
+    lines = seen.read_text().splitlines()
+    assert sorted(line.split()[1:] == ["False", "False"] for line in lines) == [False, False, True]
+    assert sorted(line.split()[1:] == ["True", "True"] for line in lines) == [False, True, True]
