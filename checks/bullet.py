@@ -9,6 +9,7 @@ from __future__ import annotations
 from mpc.checks.console import captured_fds
 from mpc.checks.protocol import Result, failed, passed
 from mpc.checks.registry import Context, register
+from mpc.core.heap import give_back
 from mpc.ir.program import ModelTest
 
 
@@ -33,6 +34,7 @@ def load_in_pybullet(ctx: Context, test: ModelTest) -> Result:
             loaded, error = 0, str(e)
         finally:
             pybullet.disconnect(client)
+            give_back()  # what PyBullet freed (its model of the robot), before the pictures
     console = log[0] if log else ""
     if error:
         lines = [ln.strip() for ln in console.splitlines()]

@@ -150,7 +150,7 @@ def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, s
     kinematic tree as a PDF with the changed links coloured (the model has a pdf export).
     changed: the links to colour, {name in either model: why} (default: changed_links)."""
     from mpc.backends.render import ZERO, clamped_note, pose_values
-    from mpc.backends.scene import GLMissing, Scene, frame, png
+    from mpc.backends.scene import GLMissing, Scene, frame, png, side_by_side
 
     views = render.views if render is not None else ("iso", "front", "side")
     size = render.size if render is not None else DEFAULT_SIZE
@@ -159,34 +159,37 @@ def draw(old: Robot, new: Robot, tol: Tolerances, render: RenderExport | None, s
     quiet = Sink()  # what the build reported already (W0500 …) is not the diff's business
     span = Span.of_file(new.name)
     with tempfile.TemporaryDirectory(prefix="mpc-diff-") as work:
-        scenes = []
-        for side, robot, colour in (("release", old, CHANGED_RELEASE), ("new", new, CHANGED_NEW)):
-            folder = Path(work) / side
-            folder.mkdir()
-            scene = Scene.build(robot, folder, quiet, span, "visual", background)
-            if scene is None:
-                out.problem = f"the {side} model cannot be drawn: " + next(
-                    (d.message for d in quiet.diagnostics if d.severity.name == "ERROR"), "")
-                return out
-            scene.colour({link: colour for link in out.changed}, UNCHANGED)
-            scene.pose(pose_values(robot, ZERO))  # at 0, or at the limit nearest it
+        # Both models in one scene: the meshes they share are read, compiled and drawn from once.
+        scene = Scene.build(side_by_side([old, new]), Path(work), quiet, span, "visual", background)
+        if scene is None:
+            out.problem = "the models cannot be drawn: " + next(
+                (d.message for d in quiet.diagnostics if d.severity.name == "ERROR"), "")
+            return out
+        sides = (("release", old, CHANGED_RELEASE), ("new", new, CHANGED_NEW))
+        scene.colour({f"{i}/{link}": colour for i, (_, _, colour) in enumerate(sides)
+                      for link in out.changed}, UNCHANGED)
+        scene.pose({f"{i}/{joint}": value for i, (_, robot, _) in enumerate(sides)
+                    for joint, value in pose_values(robot, ZERO).items()})  # at 0, or the limit nearest
+        for side, robot, _ in sides:
             note = clamped_note(robot)
             if note:
                 out.notes.append(f"The {side} model: {note}.")
-            scenes.append(scene)
         try:
-            points = np.concatenate([s.points() for s in scenes])
+            points = scene.points()
             for view in views:
                 camera = frame(points, view, size)
-                release, new_picture = (s.draw(camera, size) for s in scenes)
+                pictures = []
+                for i in range(len(sides)):
+                    scene.only(i)
+                    pictures.append(scene.draw(camera, size))
+                release, new_picture = pictures
                 overlay = _overlay(release, new_picture)
                 for side, picture in zip(SIDES, (release, new_picture, overlay), strict=True):
                     out.files[f"{view}_{side}.png"] = png(picture)
         except GLMissing as e:
             out.files, out.problem = {}, f"no EGL to draw with ({e})"
         finally:
-            for s in scenes:
-                s.close()
+            scene.close()
     if out.problem:
         sink.warning(span, "W0720", f"the test protocol has no pictures: {out.problem}")
     if tree:
