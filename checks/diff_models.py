@@ -22,11 +22,10 @@ from mpc.checks.diff_extras import extras
 from mpc.checks.diff_match import Matching, match
 from mpc.checks.diff_shapes import link_shapes
 from mpc.checks.pictures import turned
-from mpc.ir.inertia import body, combine
+from mpc.ir.inertia import body, combine, placed
 from mpc.ir.kinematics import links_in_root
 from mpc.ir.program import Tolerances
 from mpc.ir.robot import Inertial, Joint, Link, Robot
-from mpc.ir.solids import placed
 
 
 @dataclass

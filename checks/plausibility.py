@@ -161,17 +161,19 @@ class _Shapes:
         return geometry
 
     def _mesh(self, geometry: Mesh) -> Any:
-        from mpc.ir.mesh_props import as_trimesh
+        from mpc.ir.bitmask import mesh_triangles
 
         key = self._key(geometry)
         if key not in self.meshes:
-            self.meshes[key] = as_trimesh(geometry)
+            self.meshes[key] = mesh_triangles(geometry)
         return self.meshes[key]
 
     def corners(self, geometry: Geometry) -> np.ndarray:
         """The 8 corners of the shape's bounding box in its frame (4×8, homogeneous)."""
         if isinstance(geometry, Mesh):
-            lo, hi = self._mesh(geometry).bounds
+            vertices, faces = self._mesh(geometry)
+            used = vertices[faces.reshape(-1)]  # trimesh's bounds: of the vertices triangles use
+            lo, hi = used.min(axis=0), used.max(axis=0)
         else:
             if isinstance(geometry, Box):
                 half = np.asarray(geometry.size, dtype=float) / 2

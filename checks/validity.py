@@ -22,9 +22,11 @@ import numpy as np
 
 from mpc.checks.protocol import Result, failed, first_of, passed, vector_text
 from mpc.checks.registry import Context, register
+from mpc.checks.shape_figures import figures
 from mpc.checks.topology import MOVABLE
 from mpc.core.span import Span
 from mpc.ir.geometry import Box, Cylinder, Geometry, Sphere
+from mpc.ir.inertia import principal
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.program import DENSITY, FACTOR, ModelTest
 from mpc.ir.robot import Inertia, Robot
@@ -61,12 +63,10 @@ def _corners(geometry: Geometry) -> np.ndarray | None:
     elif isinstance(geometry, Sphere):
         lo, hi = -np.full(3, geometry.radius), np.full(3, geometry.radius)
     else:
-        from mpc.ir.mesh_props import MeshError, as_trimesh
-
-        try:
-            lo, hi = as_trimesh(geometry).bounds
-        except MeshError:
+        bounds = figures(geometry).bounds
+        if bounds is None:
             return None
+        lo, hi = np.asarray(bounds[0]), np.asarray(bounds[1])
     return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
 
 
@@ -105,15 +105,20 @@ def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: 
     inertial = link.inertial
     if inertial is None or inertial.mass <= 0 or not link.collisions:
         return []
-    from mpc.ir.mesh_props import MeshError, solid
-    from mpc.ir.solids import principal, union
+    if len(link.collisions) == 1:  # the common case, from the cache (checks/shape_figures.py)
+        one = figures(link.collisions[0].geometry)
+        closed, volume, moments = one.closed, one.volume, np.asarray(one.moments)
+    else:
+        from mpc.ir.mesh_props import MeshError, solid
+        from mpc.ir.solids import union
 
-    try:
-        whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in link.collisions])
-    except MeshError:
-        return []
-    volume = whole.props.mass
-    if not whole.closed or volume <= 0:
+        try:
+            whole = union([(solid(c.geometry), pose_matrix(c.origin)) for c in link.collisions])
+        except MeshError:
+            return []
+        closed, volume = whole.closed, whole.props.mass
+        moments = principal(whole.props) if volume > 0 else np.zeros(3)
+    if not closed or volume <= 0:
         return []
     out = []
     rho = inertial.mass / volume
@@ -122,7 +127,7 @@ def plausibility(robot: Robot, name: str, density: tuple[float, float], factor: 
                              f"{volume:.4g} m³ of collision solid) lies outside "
                              f"{density[0]:g}–{density[1]:g} kg/m³"))
     declared = principal_moments(inertial.inertia)
-    expected = principal(whole.props) * rho
+    expected = moments * rho
     if declared[0] > 0 and expected[0] > 0:
         ratio = np.maximum(declared / expected, expected / declared)
         if float(np.max(ratio)) > factor:

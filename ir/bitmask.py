@@ -23,13 +23,15 @@ from mpc.ir.tree import parent_joint
 BITS = 16
 
 
-def coal_object(geometry: Geometry, mesh: object = None) -> object:
+Triangles = tuple[np.ndarray, np.ndarray]  # vertices (n, 3), triangles (m, 3)
+
+
+def coal_object(geometry: Geometry, triangles: Triangles | None = None) -> object:
     """The shape as a coal collision object in its own frame (a mesh: a BVH of its triangles;
-    `mesh`: its trimesh, when the caller read it already)."""
+    `triangles`: the mesh's (`mesh_triangles`), when the caller read them already)."""
     import coal
 
     from mpc.ir.geometry import Box, Cylinder, Sphere
-    from mpc.ir.mesh_props import as_trimesh
 
     if isinstance(geometry, Box):
         return coal.Box(*geometry.size)
@@ -37,14 +39,37 @@ def coal_object(geometry: Geometry, mesh: object = None) -> object:
         return coal.Cylinder(geometry.radius, geometry.length)
     if isinstance(geometry, Sphere):
         return coal.Sphere(geometry.radius)
-    if mesh is None:
-        mesh = as_trimesh(geometry)
+    vertices, faces = triangles if triangles is not None else mesh_triangles(geometry)
     model = coal.BVHModelOBBRSS()
-    model.beginModel(len(mesh.faces), len(mesh.vertices))  # type: ignore[attr-defined]
-    model.addVertices(np.asarray(mesh.vertices, dtype=float))  # type: ignore[attr-defined]
-    model.addTriangles(np.asarray(mesh.faces, dtype=np.int64))  # type: ignore[attr-defined]
+    model.beginModel(len(faces), len(vertices))
+    model.addVertices(np.asarray(vertices, dtype=float))
+    model.addTriangles(np.asarray(faces, dtype=np.int64))
     model.endModel()
     return model
+
+
+def mesh_triangles(geometry: Geometry) -> Triangles:
+    """The vertices and triangles of a mesh shape, scaled, with its ops; MeshError when its file
+    cannot be read. A mesh file used as it is (every robot's common case) is read without
+    trimesh (core/mesh_arrays.py: trimesh's own numbers): a self-collision test then imports
+    no trimesh or SciPy (half a second)."""
+    from mpc.core.mesh_arrays import decode, scale_matrix, transform
+    from mpc.ir.geometry import Mesh
+
+    path = geometry.source.path if isinstance(geometry, Mesh) else None
+    if isinstance(geometry, Mesh) and not geometry.ops and path is not None and path.is_file():
+        try:
+            arrays = decode(path.read_bytes(), path.suffix)
+        except OSError:
+            arrays = None  # as_trimesh says why
+        if arrays is not None:
+            if geometry.scale is not None:
+                arrays = transform(arrays, scale_matrix(np.asarray(geometry.scale)))
+            return arrays.vertices, arrays.faces
+    from mpc.ir.mesh_props import as_trimesh
+
+    mesh = as_trimesh(geometry)
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
 
 
 def overlap(a: object, X_a: np.ndarray, b: object, X_b: np.ndarray) -> bool:

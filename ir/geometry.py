@@ -164,3 +164,8 @@ class Mesh:
 
 
 Geometry = Box | Cylinder | Sphere | Mesh
+
+
+class MeshError(Exception):
+    """A mesh file cannot be read (the caller turns it into a diagnostic). Here, not beside the
+    readers (ir/mesh_props.py), so that catching it imports no trimesh."""

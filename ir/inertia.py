@@ -49,3 +49,14 @@ def inertial(b: Body) -> Inertial:
     return Inertial(mass=float(b.mass), origin=Pose(tuple(float(x) for x in b.com), (0.0, 0.0, 0.0)),  # type: ignore[arg-type]
                     inertia=Inertia(ixx=float(I_[0, 0]), ixy=float(I_[0, 1]), ixz=float(I_[0, 2]),
                                     iyy=float(I_[1, 1]), iyz=float(I_[1, 2]), izz=float(I_[2, 2])))
+
+
+def placed(b: Body, X: np.ndarray) -> Body:
+    """The body `b` (props in its own frame) placed by the 4×4 pose X of that frame."""
+    R = X[:3, :3]
+    return Body(b.mass, R @ b.com + X[:3, 3], R @ b.I @ R.T)
+
+
+def principal(b: Body) -> np.ndarray:
+    """Principal moments, ascending."""
+    return np.linalg.eigvalsh(b.I)

@@ -22,6 +22,7 @@ from mpc.ir.geometry import (
     JoinShapes,
     MaterialPart,
     Mesh,
+    MeshError,
     ReduceMesh,
     ReflectMesh,
     ScaleMesh,
@@ -30,10 +31,6 @@ from mpc.ir.geometry import (
 
 if TYPE_CHECKING:
     from mpc.ir.solids import Solid
-
-
-class MeshError(Exception):
-    """A mesh file cannot be read (the caller turns it into a diagnostic)."""
 
 
 def as_trimesh(geometry: Geometry, scaled: bool = True, ignored: list[str] | None = None) -> trimesh.Trimesh:

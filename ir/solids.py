@@ -19,23 +19,12 @@ import trimesh
 from manifold3d import Error, Manifold, Mesh64, OpType
 
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
-from mpc.ir.inertia import Body, combine
+from mpc.ir.inertia import Body, combine, placed
 
 SEGMENTS = 128  # circle segments of a cylinder or sphere that overlaps another shape
 RELATIVE = 1e-9  # union volume = sum of the parts' within this: the parts do not overlap
 HULL, REPAIRED = "W0580", "W0581"  # the codes of the notes
 Note = tuple[str, str]  # (diagnostic code, sentence)
-
-
-def placed(b: Body, X: np.ndarray) -> Body:
-    """The body `b` (props in its own frame) placed by the 4×4 pose X of that frame."""
-    R = X[:3, :3]
-    return Body(b.mass, R @ b.com + X[:3, 3], R @ b.I @ R.T)
-
-
-def principal(b: Body) -> np.ndarray:
-    """Principal moments, ascending."""
-    return np.linalg.eigvalsh(b.I)
 
 
 def of_trimesh(mesh: trimesh.Trimesh) -> Body:

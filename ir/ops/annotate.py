@@ -257,7 +257,7 @@ class AutoBitmask(Op):
         from itertools import combinations
 
         from mpc.ir.bitmask import BITS, assign, never_colliding, touching
-        from mpc.ir.mesh_props import MeshError
+        from mpc.ir.geometry import MeshError
 
         owner = {c.name: n for n, lk in robot.links.items() for c in lk.collisions if c.name}
 
