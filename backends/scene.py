@@ -85,7 +85,7 @@ def _drawable(robot: Robot, geometry: Geometry) -> Robot:
     """The robot with a unit inertial on every link (only kinematics run, and MuJoCo compiles
     any model's mass properties then: a massless moving link would be refused), and only the
     shapes `geometry` draws: MuJoCo need not read, hull and upload the others' meshes (TALOS's
-    collision meshes: a third of a picture's time and memory)."""
+    collision meshes: a tenth of a picture's time)."""
     unit = Inertial(mass=1.0, inertia=Inertia(ixx=1e-3, ixy=0.0, ixz=0.0, iyy=1e-3, iyz=0.0, izz=1e-3))
     links = {n: replace(link, inertial=unit,
                         visuals=link.visuals if geometry != "collision" else (),

@@ -468,6 +468,10 @@ def _preload(shared: set[str]) -> None:
     from mpc.compiler.schema.definition import Definition
 
     Definition.model_rebuild()  # built on first use (schema/base.py): once here, not in every worker
+    environment = dict(os.environ)  # what a build is kept by (compiler/build_cache.py): unchanged
     for module in sorted(shared - set(sys.modules)):
         with contextlib.suppress(Exception):  # one that cannot be imported here is imported there
             importlib.import_module(module)
+    if dict(os.environ) != environment:
+        os.environ.clear()
+        os.environ.update(environment)

@@ -51,6 +51,10 @@ SHARED_LIBRARIES = frozenset({"numpy", "pxr", "lxml", "trimesh", "scipy", "mujoc
 
 
 def shareable(module: str) -> bool:
+    """Not mujoco.egl: importing it chooses PyOpenGL's platform for the process (its
+    environment), which a render sets and unsets itself (backends/scene.py)."""
+    if module.startswith("mujoco.egl"):
+        return False
     return module.startswith(SHARED_LAYERS) or module.split(".")[0] in SHARED_LIBRARIES
 
 

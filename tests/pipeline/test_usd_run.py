@@ -96,3 +96,39 @@ def test_later_workers_share_what_the_first_imported(tmp_path: Path) -> None:
     lines = seen.read_text().splitlines()
     assert sorted(line.split()[1:] == ["False", "False"] for line in lines) == [False, False, True]
     assert sorted(line.split()[1:] == ["True", "True"] for line in lines) == [False, True, True]
+
+
+def test_sharing_leaves_the_environment_a_build_is_kept_by(tmp_path: Path) -> None:
+    """A render imports mujoco.egl, which sets PYOPENGL_PLATFORM for its process: the runner
+    shares no such module and keeps its environment (what a build is kept by), so that the
+    next worker starts with the environment the first had."""
+    import subprocess
+    import sys
+
+    project = tmp_path / "project"
+    arm(project)
+    for name in ("one", "two"):
+        write(project / f"{name}.yml", f"""
+            model:
+              robotname: arm
+              modelname: {name}
+              input_models: {{arm: {{basefile: arm.urdf}}}}
+              assemble: {{model: arm}}
+              export_config:
+                - type: render
+                  views: [front]
+            """)
+    pipeline = write(project / "pipeline.yml", """
+        pipeline:
+          model_definitions: [one.yml, two.yml]
+          root: .
+        """)
+    seen = tmp_path / "seen.txt"
+    script = WATCH.replace("'pxr.Sdf' in sys.modules", "'PYOPENGL_PLATFORM' in os.environ").replace(
+        "import sys\n", "import os\nimport sys\n", 1)
+    environ = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
+    environ["MPC_CACHE_DIR"] = str(tmp_path / "cache")
+    done = subprocess.run([sys.executable, "-c", script, str(seen), str(pipeline)], cwd=project,
+                          capture_output=True, text=True, env=environ)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert [line.split()[1] for line in seen.read_text().splitlines()] == ["False", "False"]
