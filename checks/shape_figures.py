@@ -2,10 +2,10 @@
 bounds of the shape in its own frame, and whether it is a closed solid, with its volume and the
 principal moments of its inertia at unit density (ir/solids.py).
 
-The figures of a mesh are kept in the cache (core/cache.py, `shapes/`), keyed by the file's
-bytes, the ops and the scale: a later test of the same meshes (the next commit's CI job) reads
-no mesh and imports neither trimesh nor manifold3d, half a second of `mpc test`. A shape whose
-ops join other shapes (`JoinShapes`) depends on more files than its own and is not kept. An
+The figures of a mesh are kept in the cache (core/cache.py, `shapes/`), keyed by what the
+shape is made of (ir/shape_keys.py: the file's bytes, the ops and the scale): a later test of
+the same meshes (the next commit's CI job) reads no mesh and imports neither trimesh nor
+manifold3d, half a second of `mpc test`. A shape without a key is computed each time. An
 entry is JSON numbers, read back through its hash (`load_entry`); a damaged one is computed
 again. Figures are pose-free: a shape moved or turned keeps its volume and principal moments.
 """
@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mpc.ir.geometry import Geometry, JoinShapes, Mesh
+from mpc.ir.geometry import Geometry, Mesh
+from mpc.ir.shape_keys import shape_key
 
 VERSION = "1"  # changes when what is computed changes, so that old entries go unused
 Vec3 = tuple[float, float, float]
@@ -57,18 +58,8 @@ def figures(geometry: Geometry) -> Figures:
 
 
 def _key(geometry: Geometry) -> str | None:
-    if not isinstance(geometry, Mesh):
-        return hashlib.sha256(f"{VERSION}|{geometry!r}".encode()).hexdigest()
-    if geometry.source.path is None or any(isinstance(op, JoinShapes) for op in geometry.ops):
-        return None
-    from mpc.core.cache import file_digest
-
-    try:
-        digest = file_digest(geometry.source.path)
-    except OSError:
-        return None  # unreadable: computing says so
-    text = f"{VERSION}|{digest}|{geometry.source.path.suffix.lower()}|{geometry.scale!r}|{geometry.ops!r}"
-    return hashlib.sha256(text.encode()).hexdigest()
+    shape = shape_key(geometry)
+    return None if shape is None else hashlib.sha256(f"{VERSION}|{shape}".encode()).hexdigest()
 
 
 def _computed(geometry: Geometry) -> Figures:

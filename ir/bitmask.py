@@ -11,7 +11,11 @@ collide with each other; bits are added greedily until every allowed pair shares
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import json
 from itertools import combinations
+from pathlib import Path
 
 import numpy as np
 
@@ -21,6 +25,7 @@ from mpc.ir.robot import Robot
 from mpc.ir.tree import parent_joint
 
 BITS = 16
+TOUCHING_VERSION = "1"  # changes when what counts as touching changes: old entries go unused
 
 
 Triangles = tuple[np.ndarray, np.ndarray]  # vertices (n, 3), triangles (m, 3)
@@ -82,19 +87,49 @@ def overlap(a: object, X_a: np.ndarray, b: object, X_b: np.ndarray) -> bool:
 
 
 def touching(robot: Robot) -> set[frozenset[str]]:
-    """Pairs of links whose collision shapes touch or overlap at q = 0."""
-    shapes = []
+    """Pairs of links whose collision shapes touch or overlap at q = 0; kept in the cache
+    (`touching/`) by the shapes (ir/shape_keys.py) and their places, so that the next build or
+    test of the same robot (`auto_bitmask` again) tests no pair."""
     X_R = links_in_root(robot)
-    for name, link in robot.links.items():
-        for c in link.collisions:
-            shapes.append((name, coal_object(c.geometry), X_R[name] @ pose_matrix(c.origin)))
+    placed = [(name, c.geometry, X_R[name] @ pose_matrix(c.origin))
+              for name, link in robot.links.items() for c in link.collisions]
+    entry = _touching_entry(placed)
+    if entry is not None:
+        from mpc.core.cache import load_entry
+
+        data, _ = load_entry(entry)
+        if data is not None:
+            with contextlib.suppress(ValueError, TypeError):
+                return {frozenset(pair) for pair in json.loads(data) if len(pair) == 2}
+    shapes = [(name, coal_object(g), X) for name, g, X in placed]
     out: set[frozenset[str]] = set()
     for (a, sa, ta), (b, sb, tb) in combinations(shapes, 2):
         if a == b or frozenset((a, b)) in out:
             continue
         if overlap(sa, ta, sb, tb):
             out.add(frozenset((a, b)))
+    if entry is not None:
+        from mpc.core.cache import store_entry
+
+        with contextlib.suppress(OSError):  # a read-only cache: computed each time
+            store_entry(entry, json.dumps(sorted(sorted(p) for p in out)).encode())
     return out
+
+
+def _touching_entry(placed: list[tuple[str, Geometry, np.ndarray]]) -> Path | None:
+    """The cache entry of the touching pairs of these shapes at these places; None when a
+    shape has no key."""
+    from mpc.core.cache import cache_dir
+    from mpc.ir.shape_keys import shape_key
+
+    h = hashlib.sha256(f"touching {TOUCHING_VERSION}".encode())
+    for name, geometry, X in placed:
+        key = shape_key(geometry)
+        if key is None:
+            return None
+        h.update(f"|{name}|{key}|".encode() + np.ascontiguousarray(X, dtype=np.float64).tobytes())
+    digest = h.hexdigest()
+    return cache_dir("touching") / digest[:2] / f"{digest}.json"
 
 
 def never_colliding(robot: Robot) -> set[frozenset[str]]:

@@ -100,3 +100,36 @@ def test_the_triangles_read_without_trimesh_are_trimeshs(relative: str) -> None:
         reference = as_trimesh(mesh)
         expected = np.asarray(reference.vertices)[np.asarray(reference.faces)]
         assert np.array_equal(vertices[faces], expected)
+
+
+def test_touching_pairs_are_kept_and_follow_a_changed_mesh(tmp_path: Path,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    """auto_bitmask's touching pairs come from the cache the second time (no coal object made),
+    the same pairs; a mesh file changed under the same name is tested again."""
+    import shutil
+
+    from mpc.ir import bitmask
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    robot = read(TALOS, Sink())
+    assert robot is not None
+    first = bitmask.touching(robot)
+    assert len(first) > 20
+    made: list[object] = []
+    real = bitmask.coal_object
+    monkeypatch.setattr(bitmask, "coal_object", lambda g, t=None: made.append(g) or real(g, t))
+    assert bitmask.touching(robot) == first and made == []
+    # the same robot whose torso collision mesh is now a copy of the head's, bigger: tested again
+    link = robot.links["torso_2_link"]
+    mesh = link.collisions[0].geometry
+    assert isinstance(mesh, Mesh) and mesh.source.path is not None
+    copy = tmp_path / "torso.stl"
+    shutil.copyfile(mesh.source.path, copy)
+    from dataclasses import replace
+
+    moved = replace(robot, links={**robot.links, "torso_2_link": replace(link, collisions=(replace(
+        link.collisions[0], geometry=replace(mesh, source=replace(mesh.source, path=copy))),))})
+    assert bitmask.touching(moved) == first and made == []  # the same bytes: the same key
+    copy.write_bytes(copy.read_bytes()[:84] + b"\0" * (len(copy.read_bytes()) - 84))  # its triangles gone
+    changed = bitmask.touching(moved)
+    assert made != [] and changed != first
