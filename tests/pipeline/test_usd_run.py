@@ -65,15 +65,16 @@ sys.exit(mpc_main(["run", sys.argv[2], "-j", "1"]))
 """
 
 
-def test_later_workers_share_what_the_first_imported(tmp_path: Path) -> None:
-    """The runner imports what a finished worker imported (usd-core, the usd backend) before it
-    forks the next: three USD models, one at a time, import usd-core once."""
+def _watched_run(tmp_path: Path, names: tuple[str, ...], exports: tuple[str, ...], script: str,
+                 environ: dict[str, str]) -> list[str]:
+    """`mpc run -j 1` of one arm model per name with these exports, each worker noting what
+    `script` (WATCH or a variant) says it has before it builds; those notes, in build order."""
     import subprocess
     import sys
 
     project = tmp_path / "project"
     arm(project)
-    for name in ("one", "two", "three"):
+    for name in names:
         write(project / f"{name}.yml", f"""
             model:
               robotname: arm
@@ -81,19 +82,24 @@ def test_later_workers_share_what_the_first_imported(tmp_path: Path) -> None:
               input_models: {{arm: {{basefile: arm.urdf}}}}
               assemble: {{model: arm}}
               export_config:
-                - type: usd
-            """)
-    pipeline = write(project / "pipeline.yml", """
+            """.rstrip(" ") + "".join(f"                {line}\n" for line in exports))
+    pipeline = write(project / "pipeline.yml", f"""
         pipeline:
-          model_definitions: [one.yml, two.yml, three.yml]
+          model_definitions: [{", ".join(f"{n}.yml" for n in names)}]
           root: .
         """)
     seen = tmp_path / "seen.txt"
-    environ = {**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
-    done = subprocess.run([sys.executable, "-c", WATCH, str(seen), str(pipeline)], cwd=project,
+    environ = {**environ, "MPC_CACHE_DIR": str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", script, str(seen), str(pipeline)], cwd=project,
                           capture_output=True, text=True, env=environ)
     assert done.returncode == 0, done.stdout + done.stderr
-    lines = seen.read_text().splitlines()
+    return seen.read_text().splitlines()
+
+
+def test_later_workers_share_what_the_first_imported(tmp_path: Path) -> None:
+    """The runner imports what a finished worker imported (usd-core, the usd backend) before it
+    forks the next: three USD models, one at a time, import usd-core once."""
+    lines = _watched_run(tmp_path, ("one", "two", "three"), ("- type: usd",), WATCH, dict(os.environ))
     assert sorted(line.split()[1:] == ["False", "False"] for line in lines) == [False, False, True]
     assert sorted(line.split()[1:] == ["True", "True"] for line in lines) == [False, True, True]
 
@@ -102,33 +108,8 @@ def test_sharing_leaves_the_environment_a_build_is_kept_by(tmp_path: Path) -> No
     """A render imports mujoco.egl, which sets PYOPENGL_PLATFORM for its process: the runner
     shares no such module and keeps its environment (what a build is kept by), so that the
     next worker starts with the environment the first had."""
-    import subprocess
-    import sys
-
-    project = tmp_path / "project"
-    arm(project)
-    for name in ("one", "two"):
-        write(project / f"{name}.yml", f"""
-            model:
-              robotname: arm
-              modelname: {name}
-              input_models: {{arm: {{basefile: arm.urdf}}}}
-              assemble: {{model: arm}}
-              export_config:
-                - type: render
-                  views: [front]
-            """)
-    pipeline = write(project / "pipeline.yml", """
-        pipeline:
-          model_definitions: [one.yml, two.yml]
-          root: .
-        """)
-    seen = tmp_path / "seen.txt"
     script = WATCH.replace("'pxr.Sdf' in sys.modules", "'PYOPENGL_PLATFORM' in os.environ").replace(
         "import sys\n", "import os\nimport sys\n", 1)
     environ = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
-    environ["MPC_CACHE_DIR"] = str(tmp_path / "cache")
-    done = subprocess.run([sys.executable, "-c", script, str(seen), str(pipeline)], cwd=project,
-                          capture_output=True, text=True, env=environ)
-    assert done.returncode == 0, done.stdout + done.stderr
-    assert [line.split()[1] for line in seen.read_text().splitlines()] == ["False", "False"]
+    lines = _watched_run(tmp_path, ("one", "two"), ("- type: render", "  views: [front]"), script, environ)
+    assert [line.split()[1] for line in lines] == ["False", "False"]
