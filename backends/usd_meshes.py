@@ -27,7 +27,6 @@ class Triangles(NamedTuple):
     extent: tuple[tuple[float, ...], tuple[float, ...]]  # the points' least and greatest x, y, z
 
 
-
 _SCALARS = {"char": "i1", "uchar": "u1", "int8": "i1", "uint8": "u1", "short": "<i2", "ushort": "<u2",
             "int16": "<i2", "uint16": "<u2", "int": "<i4", "uint": "<u4", "int32": "<i4",
             "uint32": "<u4", "float": "<f4", "float32": "<f4", "double": "<f8", "float64": "<f8"}
@@ -69,8 +68,9 @@ def read_ply(data: bytes) -> Triangles | None:
         return None
     columns = [vertices[c].astype(np.float32) for c in ("x", "y", "z")]
     # the extent from the columns: a minimum down a contiguous column is ten times one down (n, 3)
-    extent = tuple(float(c.min()) for c in columns), tuple(float(c.max()) for c in columns)
-    return Triangles(np.stack(columns, axis=1), faces["i"].astype(np.int32), extent if nv else ((), ()))
+    extent = ((tuple(float(c.min()) for c in columns), tuple(float(c.max()) for c in columns))
+              if nv else ((), ()))
+    return Triangles(np.stack(columns, axis=1), faces["i"].astype(np.int32), extent)
 
 
 def _read(content: bytes | Path) -> Triangles:

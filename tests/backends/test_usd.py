@@ -424,3 +424,13 @@ def test_mesh_collisions_take_the_approximation_the_definition_implies(tmp_path:
         (0, 0, 0), (0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)}
     assert [op.GetOpName() for op in visual.GetOrderedXformOps()] == ["xformOp:scale"]
     assert tuple(visual.GetPrim().GetAttribute("xformOp:scale").Get()) == (2, 2, 2)
+
+
+def test_a_ply_without_vertices_reads_as_an_empty_mesh() -> None:
+    """The PLY reader of the usd export: a mesh of no vertices has no extent (not an error)."""
+    from mpc.backends.usd_meshes import read_ply
+
+    header = (b"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+              b"property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n")
+    empty = read_ply(header)
+    assert empty is not None and empty.points.shape == (0, 3) and empty.extent == ((), ())
