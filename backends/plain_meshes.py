@@ -12,7 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mpc.ir.geometry import MeshOp, ReflectMesh, ScaleMesh
+from mpc.ir.geometry import MeshOp
+from mpc.ir.mesh_plain import applied, is_plain
 
 _OUTPUTS = {".stl": (".stl",), ".dae": (".stl",)}  # source suffix → what this path writes of it
 _OBJ_SOURCES = (".stl",)  # an OBJ names its object; known here for an STL
@@ -25,7 +26,7 @@ def plain(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> bool:
         return False
     if suffix not in _OUTPUTS[kind] and not (suffix == ".obj" and kind in _OBJ_SOURCES):
         return False
-    return all(isinstance(op, ReflectMesh | ScaleMesh) for op in ops)
+    return is_plain(ops)
 
 
 Job = tuple[Path, tuple[MeshOp, ...], Path]  # source, ops, cache entry (backends/meshes.py)
@@ -58,8 +59,6 @@ def materialise(jobs: list[Job]) -> dict[Path, tuple[str, str]] | None:
 def derive(src: Path, jobs: list[tuple[tuple[MeshOp, ...], Path]]) -> dict[Path, bytes] | None:
     """The bytes of each job's cache entry (ops, entry path) from one read of `src`; None when
     the file is not one this path reproduces."""
-    import numpy as np
-
     from mpc.core import mesh_arrays
     from mpc.core.cache import file_digest, trace
 
@@ -73,15 +72,7 @@ def derive(src: Path, jobs: list[tuple[tuple[MeshOp, ...], Path]]) -> dict[Path,
         return None
     out: dict[Path, bytes] = {}
     for ops, dest in jobs:
-        result = mesh
-        for op in ops:
-            if isinstance(op, ReflectMesh):
-                matrix = np.eye(4)
-                matrix[op.axis, op.axis] = -1.0
-            else:
-                assert isinstance(op, ScaleMesh)
-                matrix = mesh_arrays.scale_matrix(np.asarray(op.scale))
-            result = mesh_arrays.transform(result, matrix)
+        result = applied(mesh, ops)
         if dest.suffix == ".obj":
             name = mesh_arrays.obj_name(data, src.name)
             if name is None:

@@ -55,19 +55,21 @@ def coal_object(geometry: Geometry, triangles: Triangles | None = None) -> objec
 
 def mesh_triangles(geometry: Geometry) -> Triangles:
     """The vertices and triangles of a mesh shape, scaled, with its ops; MeshError when its file
-    cannot be read. A mesh file used as it is (every robot's common case) is read without
-    trimesh (core/mesh_arrays.py: trimesh's own numbers): a self-collision test then imports
-    no trimesh or SciPy (half a second)."""
+    cannot be read. A mesh file used as it is, mirrored or scaled (ir/mesh_plain.py: every
+    robot's common cases) is read without trimesh (core/mesh_arrays.py: trimesh's own numbers):
+    a self-collision test then imports no trimesh or SciPy (half a second)."""
     from mpc.core.mesh_arrays import decode, scale_matrix, transform
     from mpc.ir.geometry import Mesh
+    from mpc.ir.mesh_plain import applied, is_plain
 
     path = geometry.source.path if isinstance(geometry, Mesh) else None
-    if isinstance(geometry, Mesh) and not geometry.ops and path is not None and path.is_file():
+    if isinstance(geometry, Mesh) and is_plain(geometry.ops) and path is not None and path.is_file():
         try:
             arrays = decode(path.read_bytes(), path.suffix)
         except OSError:
             arrays = None  # as_trimesh says why
         if arrays is not None:
+            arrays = applied(arrays, geometry.ops)
             if geometry.scale is not None:
                 arrays = transform(arrays, scale_matrix(np.asarray(geometry.scale)))
             return arrays.vertices, arrays.faces

@@ -94,10 +94,14 @@ def test_the_triangles_read_without_trimesh_are_trimeshs(relative: str) -> None:
 
     path = ERD / relative
     assert path.is_file()
-    for scale in (None, (0.5, 2.0, 1.0), (-1.0, 1.0, 1.0)):
-        mesh = Mesh(source=MeshSource(uri=str(path), path=path), scale=scale)
+    from mpc.ir.geometry import ReflectMesh, ScaleMesh
+
+    mirrored = (ScaleMesh((1.0, 3.0, 1.0)), ReflectMesh(0))
+    for scale, ops in ((None, ()), ((0.5, 2.0, 1.0), ()), ((-1.0, 1.0, 1.0), ()),
+                       (None, (ReflectMesh(axis=1),)), ((2.0, 2.0, 2.0), mirrored)):
+        mesh = Mesh(source=MeshSource(uri=str(path), path=path), scale=scale, ops=ops)
         vertices, faces = mesh_triangles(mesh)
-        reference = as_trimesh(mesh)
+        reference = as_trimesh(mesh)  # a reflection turns the triangles, on both sides alike
         expected = np.asarray(reference.vertices)[np.asarray(reference.faces)]
         assert np.array_equal(vertices[faces], expected)
 
