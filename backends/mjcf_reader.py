@@ -349,18 +349,11 @@ def _fresh(name: str, taken: set[str]) -> str:
     return out
 
 
-def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = (float(v) for v in q / np.linalg.norm(q))
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def _X(pos: np.ndarray, quat: np.ndarray | None = None) -> np.ndarray:
     X = np.eye(4)
     X[:3, 3] = pos
     if quat is not None:
-        X[:3, :3] = _quat_matrix(quat)
+        X[:3, :3] = tf.quat_to_matrix(quat)
     return X
 
 
@@ -546,7 +539,7 @@ class _Builder:
         # the mesh's centre of mass and principal axes (mesh_pos, mesh_quat). In the IR the scale
         # acts in the file's frame: s is permuted to it when R permutes the axes (else unheld).
         spec_mesh = self.spec.mesh(name)
-        R = _quat_matrix(np.asarray(spec_mesh.refquat, dtype=float))
+        R = tf.quat_to_matrix(np.asarray(spec_mesh.refquat, dtype=float))
         scale = np.asarray(m.mesh_scale[mesh], dtype=float)
         in_file = R @ np.diag(scale) @ R.T
         if not np.allclose(in_file, np.diag(np.diag(in_file)), rtol=0, atol=1e-12):

@@ -95,3 +95,11 @@ def matrix_to_quat(R: np.ndarray) -> tuple[float, float, float, float]:
     norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     x, y, z, w = (c / norm for c in q)
     return (w, x, y, z) if w >= 0 else (-w, -x, -y, -z)
+
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """The rotation matrix of a quaternion (w, x, y, z), normalised first (MJCF's convention)."""
+    w, x, y, z = (float(v) for v in q / np.linalg.norm(q))
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])

@@ -15,14 +15,14 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from mpc.backends.mjcf_reader import _quat_matrix  # the reader's own quaternion → matrix
+from mpc.ir.transforms import quat_to_matrix  # the MJCF reader's quaternion → matrix
 
 HINGE, SLIDE, FREE = 3, 2, 0
 
 
 def _X(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
     X = np.eye(4)
-    X[:3, :3], X[:3, 3] = _quat_matrix(np.asarray(quat)), pos
+    X[:3, :3], X[:3, 3] = quat_to_matrix(np.asarray(quat)), pos
     return X
 
 

@@ -41,7 +41,6 @@ SITES: dict[tuple[str, str, str], str] = {
     ("kccd_tools.py", "run_tools", "confined(folder, f'{robot}.cfg')"): PASSED,
     ("kccd_tools.py", "run_tools", "confined(folder, f'{robot}.urdf')"): PASSED,
     ("kccd_tools.py", "_run", "Path(command[0])"): "the tool's name in a message",
-    ("mjcf_reader.py", "_quat_matrix", "q / np.linalg.norm(q)"): MATH,
     ("mjcf_reader.py", "gather_includes", "Path(name)"): READ,
     ("mjcf_reader.py", "gather_includes", "self.base_dir / name"): READ,
     ("mjcf_reader.py", "gather_meshes", "os.path.join(meshdir, mesh.file)"): READ,

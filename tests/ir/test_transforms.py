@@ -58,3 +58,9 @@ def test_matrix_to_quat_has_scipys_digits() -> None:
     for R in matrices:
         x, y, z, w = (float(c) for c in Rotation.from_matrix(R).as_quat())
         assert tf.matrix_to_quat(R) == ((w, x, y, z) if w >= 0 else (-w, -x, -y, -z))
+
+
+@given(angle, angle, angle)
+def test_quat_to_matrix_inverts_matrix_to_quat(r: float, p: float, y: float) -> None:
+    R = tf.rpy_to_matrix((r, p, y))
+    np.testing.assert_allclose(tf.quat_to_matrix(np.array(tf.matrix_to_quat(R))), R, atol=1e-12)
