@@ -34,22 +34,30 @@ def binary_stl_triangles(path: Path) -> int | None:
 
 
 def has_no_triangles(path: Path) -> bool:
-    """Whether the mesh file at `path` surely holds no triangle; False when unsure."""
+    """Whether the mesh file at `path` surely holds no triangle; False when unsure. What a whole
+    file was read for is remembered with its digest (core/cache.py): a warm build reads none."""
+    from mpc.core.cache import remembered
+
     suffix = path.suffix.lower()
     try:
         if suffix == ".stl" and (count := binary_stl_triangles(path)) is not None:
             return count == 0
-        data = path.read_bytes()
+        if suffix not in (".stl", ".obj", ".dae"):
+            return False
+        verdict = remembered(path, "no triangles", lambda f: "1" if _none_in(suffix, f.read()) else "0", 1)
+        return verdict == "1"
     except OSError:
         return False
+
+
+def _none_in(suffix: str, data: bytes) -> bool:
+    """Whether the bytes of a whole mesh file in the format of `suffix` hold no triangle."""
     if suffix == ".stl":
         # ASCII: whole (it ends) but without a facet; a file that is neither is left to reading it
         return data.lstrip().startswith(b"solid") and b"endsolid" in data and b"facet" not in data
     if suffix == ".obj":
         return _OBJ_FACE.search(data) is None
-    if suffix == ".dae":
-        return _DAE_INDICES.search(data) is None
-    return False
+    return _DAE_INDICES.search(data) is None
 
 
 def check_empty(robot: Robot, sink: Sink, span: Span) -> None:

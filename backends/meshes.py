@@ -182,9 +182,14 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
 
 
 def _digest(k: MeshKey) -> str:
-    h = hashlib.sha256(str(k[0]).encode() if _made(k[0]) else k[0].read_bytes())
-    h.update(repr(k[1]).encode())
-    return h.hexdigest()[:10]
+    """Ten hex digits of the source's bytes and the ops, which tell apart meshes of one name;
+    remembered with the file's digest (core/cache.py), so that a warm build does not read them."""
+    from mpc.core.cache import remembered
+
+    ops = repr(k[1]).encode()
+    if _made(k[0]):
+        return hashlib.sha256(str(k[0]).encode() + ops).hexdigest()[:10]
+    return remembered(k[0], f"name {k[1]!r}", lambda f: hashlib.sha256(f.read() + ops).hexdigest()[:10], 10)
 
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
@@ -192,7 +197,12 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     """Write each planned mesh into `out` (`contents`), leaving those already there."""
     from mpc.core.files import confined, copy_file
 
-    found, ok = contents(files, sink, export_span, robot, lambda rel: confined(out, rel).exists())
+    # Written already (by another export of the build): looked at without following the path's
+    # links, which `confined` does for the files written, below; a name that is not inside the
+    # output is never taken as written, and is refused there.
+    found, ok = contents(files, sink, export_span, robot,
+                         lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
+                         and (out / rel).exists())
     for rel, content in found.items():
         dest = confined(out, rel)
         dest.parent.mkdir(parents=True, exist_ok=True)

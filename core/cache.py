@@ -10,8 +10,9 @@ import hashlib
 import os
 import shutil
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 
 def cache_dir(kind: str) -> Path:
@@ -156,23 +157,31 @@ _SETTLED_NS = 2_000_000_000
 
 def file_digest(path: Path) -> str:
     """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
+    return remembered(path, "", lambda f: hashlib.file_digest(f, "sha256").hexdigest())
+
+
+def remembered(path: Path, what: str, compute: Callable[[BinaryIO], str], length: int = 64) -> str:
+    """`compute(file)`: `length` hex digits made of a file's bytes (`what` names which: "" for
+    their sha256), remembered by the file's identity and status as above; raises OSError when
+    the file cannot be read. A remembered value of another form is computed again."""
     with open(path, "rb") as f:
         st = os.fstat(f.fileno())
         identity = (os.path.realpath(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
-        if identity in _digests:
-            return _digests[identity]
-        name = hashlib.sha256(repr(identity).encode()).hexdigest()
+        key = (*identity, what) if what else identity
+        if key in _digests:
+            return _digests[key]
+        name = hashlib.sha256(repr(key).encode()).hexdigest()
         memo = cache_dir("digests") / name[:2] / name
         with contextlib.suppress(OSError, UnicodeDecodeError):
             known = memo.read_text(encoding="ascii").strip()
-            if len(known) == 64 and all(c in "0123456789abcdef" for c in known):
-                _digests[identity] = known
+            if len(known) == length and all(c in "0123456789abcdef" for c in known):
+                _digests[key] = known
                 return known
-        digest = hashlib.file_digest(f, "sha256").hexdigest()
-    _digests[identity] = digest
+        value = compute(f)
+    _digests[key] = value
     if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
         from mpc.core.files import write_atomic
 
         with contextlib.suppress(OSError):
-            write_atomic(memo, digest + "\n")
-    return digest
+            write_atomic(memo, value + "\n")
+    return value

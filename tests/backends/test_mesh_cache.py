@@ -16,6 +16,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -206,6 +207,46 @@ def test_a_file_written_a_moment_ago_is_not_remembered_for_other_processes(
     mesh = tetra_stl(tmp_path / "tetra.stl")
     assert cache.file_digest(mesh) == hashlib.sha256(mesh.read_bytes()).hexdigest()
     assert not (tmp_path / "cache/digests").exists()
+
+
+def _name_digits(path: Path) -> str:
+    from mpc.backends.meshes import _digest
+
+    return _digest((path, ()))
+
+
+def _told_empty(path: Path) -> str:
+    from mpc.backends.empty_meshes import has_no_triangles
+
+    return "1" if has_no_triangles(path) else "0"
+
+
+@pytest.mark.parametrize(("ask", "expected", "other"), [
+    (_name_digits, lambda mesh: hashlib.sha256(mesh.read_bytes() + b"()").hexdigest()[:10], "0123456789"),
+    (_told_empty, lambda mesh: "0", "1"),
+], ids=["name digits", "no triangles"])
+def test_what_a_warm_build_would_read_a_whole_mesh_for_is_remembered(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ask: Any, expected: Any, other: str) -> None:
+    """The ten digits that tell apart meshes of one name, and whether a mesh that is not a binary
+    STL holds triangles, are remembered beside its digest (core/cache.py `remembered`), by the
+    file's status: the next process gives what is remembered without reading the file, and
+    computes again what is remembered in another form."""
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_SETTLED_NS", 0)  # remember files written a moment ago too
+    mesh = tmp_path / "tetra.dae"
+    mesh.write_bytes(b"<COLLADA><mesh><triangles count='1'><p>0 1 2</p></triangles></mesh></COLLADA>")
+    assert ask(mesh) == expected(mesh)
+    [memo] = (tmp_path / "cache/digests").glob("*/*")
+    memo.write_text(other + "\n")
+    monkeypatch.setattr(cache, "_digests", {})  # another process
+    assert ask(mesh) == other  # what is remembered: the file is not read again
+    for damaged in ("", other + "0", "x" * len(other)):
+        memo.write_text(damaged)
+        monkeypatch.setattr(cache, "_digests", {})
+        assert ask(mesh) == expected(mesh)
+        assert memo.read_text() == expected(mesh) + "\n"
 
 
 @pytest.mark.parametrize("same_bytes", [True, False])

@@ -53,6 +53,7 @@ SITES: dict[tuple[str, str, str], str] = {
         "the name MuJoCo looks a file up by among the files handed to it; no file",
     ("mjcf_reader.py", "msh_as_stl", "cache_dir('msh') / f'{hashlib.sha256(data).hexdigest()}.stl'"): CACHE,
     ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
+    ("meshes.py", "copy", "out / rel"): "only whether it is there (a name inside); written through confined",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2] / f'{digest}{suffix}'"): CACHE,
     ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2]"): CACHE,
     ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
