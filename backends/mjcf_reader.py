@@ -132,8 +132,8 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
 
 
 def _mujoco() -> Any:
-    """MuJoCo's module, imported when a file is read (MuJoCo ships no type stubs: Any)."""
-    import mujoco
+    """MuJoCo's module, imported when a file is read."""
+    from mpc.backends.mujoco_module import mujoco
 
     return mujoco
 

@@ -14,9 +14,7 @@ every bit MuJoCo has, so a bitmask without MuJoCo's default bit still meets it).
 
 from __future__ import annotations
 
-from importlib import import_module
 from pathlib import Path
-from typing import Any
 
 from mpc.backends import xml_escape
 from mpc.backends.xml import fmt_float
@@ -34,7 +32,7 @@ def floor_height(robot_xml: Path, collision_group: int) -> float:
     message) when MuJoCo refuses the file."""
     import numpy as np
 
-    mujoco: Any = import_module("mujoco")  # its stubs lack the compiled API's names
+    from mpc.backends.mujoco_module import mujoco
 
     model = mujoco.MjModel.from_xml_path(str(robot_xml))
     data = mujoco.MjData(model)

@@ -158,7 +158,7 @@ class Scene:
     """
 
     def __init__(self, model: Any, geometry: Geometry) -> None:
-        import mujoco
+        from mpc.backends.mujoco_module import mujoco
 
         self.mujoco, self.model, self.geometry = mujoco, model, geometry
         self._gl: tuple[tuple[int, int], Any, Any] | None = None
@@ -177,11 +177,8 @@ class Scene:
         """The scene of `robot` on a `background` colour (a flat skybox), its meshes written as
         OBJ into `workdir`; None after an error (a mesh that cannot be converted, a model MuJoCo
         refuses: E0571)."""
-        import mujoco as loaded
-
-        mujoco: Any = loaded  # its stubs lack the spec and cache functions
-
         from mpc.backends import mjcf
+        from mpc.backends.mujoco_module import mujoco
 
         robot = coloured(_drawable(robot, geometry))
         files = _mesh_files(robot, workdir, sink, span)

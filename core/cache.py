@@ -11,8 +11,8 @@ import os
 import shutil
 import time
 from collections.abc import Callable, Iterator
+from io import BufferedReader
 from pathlib import Path
-from typing import BinaryIO
 
 
 def cache_dir(kind: str) -> Path:
@@ -160,7 +160,7 @@ def file_digest(path: Path) -> str:
     return remembered(path, "", lambda f: hashlib.file_digest(f, "sha256").hexdigest())
 
 
-def remembered(path: Path, what: str, compute: Callable[[BinaryIO], str], length: int = 64) -> str:
+def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], length: int = 64) -> str:
     """`compute(file)`: `length` hex digits made of a file's bytes (`what` names which: "" for
     their sha256), remembered by the file's identity and status as above; raises OSError when
     the file cannot be read. A remembered value of another form is computed again."""
