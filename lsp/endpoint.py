@@ -17,18 +17,15 @@ served.
 
 from __future__ import annotations
 
-import logging
 import time
 from collections import deque
 from collections.abc import Callable, Hashable
 from typing import Any, Protocol
 
+from mpc.lsp import log, protocol
 from mpc.lsp import params as shapes
-from mpc.lsp import protocol
 from mpc.lsp.framing import Frame
 from mpc.lsp.protocol import Message, MessageId
-
-logger = logging.getLogger(__name__)
 
 Handler = Callable[[Any], Any]
 
@@ -100,7 +97,7 @@ class Endpoint:
 
     def _take(self, frame: Frame) -> None:
         if frame.body is not None and frame.problem:
-            logger.warning("served a message despite %s", frame.problem)
+            log.warn(f"served a message despite {frame.problem}")
         item = protocol.parse(frame)
         if isinstance(item, Message) and item.method == "$/cancelRequest" and item.id is None \
                 and not shapes.problems("$/cancelRequest", item.params):
@@ -120,17 +117,17 @@ class Endpoint:
                 try:
                     action()
                 except Exception:
-                    logger.exception("error in a timer's action")
+                    log.fault("error in a timer's action")
 
     # one message
 
     def serve(self, item: Message | dict[str, Any]) -> None:
         """Answer one message, or send the refusal of a frame that was none."""
         if not isinstance(item, Message):
-            logger.warning("%s", item["error"]["message"])
+            log.warn(item["error"]["message"])
             self.write(protocol.encoded(item))
         elif item.method is None:
-            logger.warning("ignored a response to no request of the server's (id %r)", item.id)
+            log.warn(f"ignored a response to no request of the server's (id {item.id!r})")
         elif item.is_request:
             self._request(item.method, item.data["id"], item.params)
         else:
@@ -140,10 +137,10 @@ class Endpoint:
         try:
             answer = protocol.result(message_id, self._answer(method, message_id, params))
         except RequestError as e:
-            logger.warning("%s", e.message)
+            log.warn(e.message)
             answer = protocol.error(message_id, e.code, e.message)
         except Exception as e:
-            logger.exception("error in %s", method)
+            log.fault(f"error in {method}")
             answer = protocol.error(message_id, protocol.INTERNAL_ERROR,
                                     f"internal error in {method}: {type(e).__name__}: {e}")
         self.write(protocol.encoded(answer))
@@ -173,17 +170,16 @@ class Endpoint:
         handler = self.notifications.get(method)
         if handler is None or not self.initialized or self.shut_down:
             if handler is not None:
-                logger.warning("dropped a %s %s", method,
-                               "after shutdown" if self.shut_down else "before initialize")
+                log.warn(f"dropped a {method} {'after shutdown' if self.shut_down else 'before initialize'}")
             return
         problems = shapes.problems(method, params)
         if problems:
-            logger.warning("dropped a %s: %s", method, "; ".join(problems))
+            log.warn(f"dropped a {method}: {'; '.join(problems)}")
             return
         try:
             handler(params)
         except Exception:
-            logger.exception("error in %s", method)
+            log.fault(f"error in {method}")
 
     def _initialize(self, params: Any) -> dict[str, Any]:
         self.initialized = True

@@ -8,16 +8,14 @@ while it is busy. Only the server's own thread parses and writes.
 
 from __future__ import annotations
 
-import logging
 import os
 import queue
 import sys
 import threading
 from typing import BinaryIO
 
+from mpc.lsp import log
 from mpc.lsp.framing import Frame, FrameReader
-
-logger = logging.getLogger(__name__)
 
 _END = None  # queued when the stream has ended
 
@@ -36,7 +34,7 @@ class Inbox:
             while (frame := reader.next()) is not None:
                 self.frames.put(frame)
         except (OSError, ValueError) as e:  # stdin closed under the reader
-            logger.warning("stopped reading: %s", e)
+            log.warn(f"stopped reading: {e}")
         self.frames.put(_END)
 
     def get(self, timeout: float | None) -> Frame | None:
