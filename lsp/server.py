@@ -21,7 +21,7 @@ from mpc.compiler.options import ModelCache, Options
 from mpc.core.cycles import paused_cycle_collection
 from mpc.core.packages import PackageResolver
 from mpc.core.version import mpc_version
-from mpc.lsp import completion, hover, navigation
+from mpc.lsp import completion, heap, hover, navigation
 from mpc.lsp import structures as lsp
 from mpc.lsp.analysis import Analysis, analyse
 from mpc.lsp.diagnostics import convert
@@ -74,12 +74,13 @@ class MpcServer(Endpoint):
         # TALOS check's 50 ms. Its cycles are collected after the diagnostics have gone out.
         with paused_cycle_collection():
             analysis = analyse(path, document.text, self.documents.texts(), self.options)
+            diagnostics = convert(analysis.diagnostics, path, Lines(analysis.text), analysis.readers())
+            self.notify("textDocument/publishDiagnostics",
+                        {"uri": uri, "diagnostics": diagnostics, "version": document.version})
+        heap.give_back()
         self.analyses[uri] = analysis
         if analysis.passed is not None:
             self.named[uri] = analysis
-        diagnostics = convert(analysis.diagnostics, path, Lines(analysis.text), analysis.readers())
-        self.notify("textDocument/publishDiagnostics",
-                    {"uri": uri, "diagnostics": diagnostics, "version": document.version})
         if dependents:
             here = os.path.abspath(path)
             for other, known in list(self.analyses.items()):

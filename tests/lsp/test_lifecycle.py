@@ -7,6 +7,8 @@ import os
 import shutil
 from pathlib import Path
 
+import pytest
+
 from tests.lsp.client import Client
 from tests.lsp.definitions import EXPORT, HEAD
 from tests.lsp.test_malformed_input import body, framed
@@ -92,3 +94,15 @@ def test_a_frame_refused_before_initialize_and_requests_after_shutdown(tmp_path:
         {"code": -32002, "message": "textDocument/hover before initialize"}]
     assert [a["error"] for a in client.answered(8)] == [
         {"code": -32600, "message": "shutdown after shutdown: only exit is served"}]
+
+
+def test_the_heap_is_trimmed_by_glibcs_function() -> None:
+    """lsp/heap.py finds malloc_trim on a glibc system (elsewhere it does nothing)."""
+    import platform
+
+    from mpc.lsp import heap
+
+    if platform.libc_ver()[0] != "glibc":
+        pytest.skip("not glibc")
+    assert heap._malloc_trim() is not None
+    heap.give_back()
