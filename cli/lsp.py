@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -14,7 +15,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    without_openssl_hashes()
     from mpc.lsp.server import serve
 
-    serve(dict(args.package), args.debounce_ms)
-    return 0
+    return serve(dict(args.package), args.debounce_ms)
+
+
+def without_openssl_hashes() -> None:
+    """The server's process hashes with Python's own hash functions, not OpenSSL's.
+
+    pydantic imports `secrets`, which imports `hmac` and so `hashlib`, which loads OpenSSL's
+    libcrypto through `_hashlib`: 3.5 MiB of the server's memory, to hash nothing in a check
+    (mpc's build cache hashes; the server builds nothing). `None` in `sys.modules` makes an
+    import fail, as the import system documents; `hashlib` and `hmac` then give their
+    functions from Python's built-in modules (the same digests, slower on large data). Nothing
+    is changed once `_hashlib` is imported, nor in a program that only imports mpc's modules.
+    """
+    sys.modules.setdefault("_hashlib", None)  # type: ignore[arg-type]

@@ -1,7 +1,7 @@
 """A number written in a definition (int, float, `"-pi/2"`, `[deg, 90]`) → float, or a diagnostic.
 
-Parses with grammar/expr.lark and evaluates with the math module; never Python `eval`.
-It knows only `pi` and the functions in FUNCTIONS: no variables, no user functions.
+Parses by grammar/expr.lark (compiler/expr_syntax.py) and evaluates with the math module;
+never Python `eval`. It knows only `pi` and the functions in FUNCTIONS: no variables, no user functions.
 """
 
 from __future__ import annotations
@@ -10,15 +10,12 @@ import math
 import operator
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache, lru_cache
-from typing import TYPE_CHECKING
+from functools import lru_cache
 
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
+from mpc.compiler.expr_syntax import ExprSyntaxError, parse_text
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.span import Span, source_line
-
-if TYPE_CHECKING:
-    from lark import Lark
 
 CONSTANTS: dict[str, float] = {"pi": math.pi}
 UNITS: dict[str, Callable[[float], float]] = {"deg": math.radians, "rad": float}
@@ -31,21 +28,11 @@ FUNCTIONS: dict[str, tuple[int, int | None, Callable[..., float]]] = {
 }
 
 
-@cache
-def parser() -> Lark:
-    """The expression grammar, loaded once (lark is imported only when a string is parsed)."""
-    from mpc.compiler.expr_syntax import load
-
-    return load()
-
-
 @lru_cache(maxsize=4096)
 def parse(text: str) -> Node:
-    """Expression text → node tree; raises lark's UnexpectedInput on a syntax error. Kept per
-    text: a definition repeats its expressions, and `mpc lsp` parses it on every keystroke."""
-    from mpc.compiler.expr_syntax import ExprTransformer
-
-    return ExprTransformer().transform(parser().parse(text))
+    """Expression text → node tree; raises ExprSyntaxError on a syntax error. Kept per text: a
+    definition repeats its expressions, and `mpc lsp` parses it on every keystroke."""
+    return parse_text(text)
 
 
 def evaluate(value: object, span: Span, sink: Sink, *, what: str = "value") -> float | None:
@@ -142,17 +129,12 @@ def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None
     if not text.strip():
         sink.error(where.span, "E0210", f"empty expression for {what}")
         return None
-    from lark.exceptions import UnexpectedInput
-
-    from mpc.compiler.expr_syntax import syntax_error
-
     try:
         node = parse(text)
         result = _Evaluator(shown, where, sink, what).value(node)
-    except UnexpectedInput as e:
-        at, found, hint = syntax_error(e, text)
-        sink.error(where.at(at, at + 1), "E0210", f"invalid expression '{shown}' for {what}: {found}",
-                   hint=hint)
+    except ExprSyntaxError as e:
+        sink.error(where.at(e.offset, e.offset + 1), "E0210", f"invalid expression '{shown}' for {what}: "
+                   f"{e.found}", hint=e.hint)
         return None
     except RecursionError:  # both the transformer and the evaluator recurse once per operator
         sink.error(where.span, "E0210", f"the expression for {what} has too many operators")

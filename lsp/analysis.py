@@ -13,7 +13,6 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from mpc.backends.xacro_origins import origins
 from mpc.compiler import front_end
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.options import Options
@@ -134,6 +133,9 @@ class Analysis:
             return {}
         key = (absolute, args, stat.st_mtime_ns, stat.st_size)
         if key not in _ORIGINS:
+            # imported here: xml.dom.minidom and the rest are for go to definition in xacro only
+            from mpc.backends.xacro_origins import origins
+
             resolver = self.loader.options.resolver if self.loader is not None else PackageResolver()
             while len(_ORIGINS) >= 8:
                 del _ORIGINS[next(iter(_ORIGINS))]

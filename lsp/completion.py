@@ -11,10 +11,9 @@ import os
 from functools import cache
 from pathlib import Path
 
-from lsprotocol import types as lsp
-
 from mpc.ir.names import Names
 from mpc.lsp import schema_data
+from mpc.lsp import structures as lsp
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.text import Context, Lines, context, utf16_length
 
@@ -37,18 +36,18 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
     of it that got as far as its names, for a buffer being typed)."""
     lines = Lines(analysis.text)
     col = lines.column(position)
-    ctx = context(lines, position.line, col)
-    start = lsp.Position(line=position.line, character=position.character - utf16_length(ctx.word))
+    ctx = context(lines, position["line"], col)
+    start = lsp.Position(line=position["line"], character=position["character"] - utf16_length(ctx.word))
     where = lsp.Range(start=start, end=position)
     named = analysis if analysis.passed is not None or good is None else good
-    indent = len(lines.line(position.line)) - len(lines.line(position.line).lstrip(" -"))
+    indent = len(lines.line(position["line"])) - len(lines.line(position["line"]).lstrip(" -"))
     child = ctx.key == "child" and ctx.keys[-3:] == ("children", "-", "joint")  # an attach's child link
-    names = named.names_at(position.line + 1, col, indent, child)
+    names = named.names_at(position["line"] + 1, col, indent, child)
     items: list[lsp.CompletionItem] = []
     if ctx.key is None and ctx.keys[-1:] == ("-",):  # an item of a block list: a name or a test
         key = ctx.keys[-2] if len(ctx.keys) > 1 else ""
         if ctx.keys[-3:] == ("test", "tests", "-"):
-            items += [_item(t, lsp.CompletionItemKind.EnumMember, where) for t in test_names()]
+            items += [_item(t, lsp.ItemKind.ENUM_MEMBER, where) for t in test_names()]
         if key in VALUE_NAMES and names is not None:
             items += _names(names, VALUE_NAMES[key], where, key=False)
     if ctx.key is None:
@@ -61,10 +60,10 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
         return items
     if ctx.key in _FILES:
         return _files(analysis.path, ctx, where)
-    items += [_item(v, lsp.CompletionItemKind.EnumMember, where)
+    items += [_item(v, lsp.ItemKind.ENUM_MEMBER, where)
               for v in schema_data.values_at((*ctx.keys, ctx.key))]
     if ctx.keys[-1:] == ("test",) and ctx.key == "tests":
-        items += [_item(t, lsp.CompletionItemKind.EnumMember, where) for t in test_names()]
+        items += [_item(t, lsp.ItemKind.ENUM_MEMBER, where) for t in test_names()]
     kind = VALUE_NAMES.get(ctx.key)
     if kind is None and ctx.keys[:2] == ("model", "poses") and len(ctx.keys) == 3:
         kind = "joint"
@@ -73,22 +72,26 @@ def complete(analysis: Analysis, good: Analysis | None, position: lsp.Position) 
     return items
 
 
-def _item(label: str, kind: lsp.CompletionItemKind, where: lsp.Range, text: str | None = None,
+def _item(label: str, kind: int, where: lsp.Range, text: str | None = None,
           detail: str | None = None, doc: str | None = None) -> lsp.CompletionItem:
-    return lsp.CompletionItem(label=label, kind=kind, detail=detail, text_edit=lsp.TextEdit(
-        range=where, new_text=text if text is not None else label),
-        documentation=lsp.MarkupContent(kind=lsp.MarkupKind.Markdown, value=doc) if doc else None)
+    item = lsp.CompletionItem(label=label, kind=kind, textEdit=lsp.TextEdit(
+        range=where, newText=text if text is not None else label))
+    if detail is not None:
+        item["detail"] = detail
+    if doc:
+        item["documentation"] = lsp.MarkupContent(kind=lsp.MARKDOWN, value=doc)
+    return item
 
 
 def _keys(ctx: Context, where: lsp.Range) -> list[lsp.CompletionItem]:
-    return [_item(key, lsp.CompletionItemKind.Property, where, text=f"{key}: ",
+    return [_item(key, lsp.ItemKind.PROPERTY, where, text=f"{key}: ",
                   doc=schema_data.description(ctx.keys, key))
             for key, prop in schema_data.keys_at(ctx.keys).items() if not prop.get("deprecated")]
 
 
 def _names(names: Names, kind: str, where: lsp.Range, key: bool) -> list[lsp.CompletionItem]:
-    icon = {"link": lsp.CompletionItemKind.Class, "joint": lsp.CompletionItemKind.Interface,
-            "material": lsp.CompletionItemKind.Color}.get(kind, lsp.CompletionItemKind.Value)
+    icon = {"link": lsp.ItemKind.CLASS, "joint": lsp.ItemKind.INTERFACE,
+            "material": lsp.ItemKind.COLOR}.get(kind, lsp.ItemKind.VALUE)
     return [_item(name, icon, where, text=f"{name}:" if key else name, detail=kind)
             for name in sorted(names.all(kind))]  # type: ignore[arg-type]
 
@@ -107,9 +110,9 @@ def _files(path: Path, ctx: Context, where: lsp.Range) -> list[lsp.CompletionIte
             continue
         text = f"{prefix}/{entry.name}" if prefix else entry.name
         if entry.is_dir():
-            out.append(_item(text + "/", lsp.CompletionItemKind.Folder, where))
+            out.append(_item(text + "/", lsp.ItemKind.FOLDER, where))
         elif entry.name.endswith(_FILES[ctx.key]) and entry.resolve() != path.resolve():
-            out.append(_item(text, lsp.CompletionItemKind.File, where))
+            out.append(_item(text, lsp.ItemKind.FILE, where))
     return out
 
 

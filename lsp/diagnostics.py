@@ -13,14 +13,13 @@ import re
 from collections.abc import Mapping
 from pathlib import Path
 
-from lsprotocol import types as lsp
-
 from mpc.core.diagnostics import Diagnostic, Severity
 from mpc.core.span import Span, source_line
+from mpc.lsp import structures as lsp
 from mpc.lsp.text import Lines
 
-_SEVERITY = {Severity.ERROR: lsp.DiagnosticSeverity.Error, Severity.WARNING: lsp.DiagnosticSeverity.Warning,
-             Severity.NOTE: lsp.DiagnosticSeverity.Information}
+_SEVERITY = {Severity.ERROR: lsp.Severity.ERROR, Severity.WARNING: lsp.Severity.WARNING,
+             Severity.NOTE: lsp.Severity.INFORMATION}
 DID_YOU_MEAN = re.compile(r"did you mean '([^']+)'\?")
 
 
@@ -63,6 +62,9 @@ def convert(diagnostics: list[Diagnostic], path: Path, lines: Lines,
             reader = (readers or {}).get(os.path.abspath(d.span.file))
             where = lines.range(reader) if reader is not None else lsp.Range(
                 start=lsp.Position(line=0, character=0), end=lsp.Position(line=0, character=0))
-        out.append(lsp.Diagnostic(range=where, message=message, severity=_SEVERITY[d.severity], code=d.code,
-                                  source="mpc", related_information=related or None))
+        diagnostic = lsp.Diagnostic(range=where, message=message, severity=_SEVERITY[d.severity], code=d.code,
+                                    source="mpc")
+        if related:
+            diagnostic["relatedInformation"] = related
+        out.append(diagnostic)
     return out

@@ -1,6 +1,7 @@
 """The base protocol of LSP on a byte stream: `Content-Length: N` header blocks, each followed
-by N bytes of body. This reader replaces pygls's (`pygls.server.aio_readline` and
-`JsonRPCProtocol.data_received`), which lost its place for good after one bad frame: it passed
+by N bytes of body. This reader replaced pygls 1.x's (`pygls.server.aio_readline` and
+`JsonRPCProtocol.data_received`; the server no longer uses pygls at all, lsp/endpoint.py), which
+lost its place for good after one bad frame: it passed
 on only bodies that start with `{`, so after a `null` body it kept waiting for the rest of a
 message that never came; a header without a usable Content-Length (missing, `abc`, `-2`) made
 it gather every following line into one endless header; a huge length made it wait for bytes

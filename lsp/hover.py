@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import math
 
-from lsprotocol import types as lsp
-
 from mpc.compiler.expr import evaluate
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
@@ -18,13 +16,14 @@ from mpc.ir.tree import joints_up
 from mpc.lsp import schema_data
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.lookup import element, target, written_at
+from mpc.lsp.structures import MARKDOWN, Hover, MarkupContent, Position
 from mpc.lsp.text import Lines, contains
 
 
-def hover(analysis: Analysis, position: lsp.Position) -> lsp.Hover | None:
+def hover(analysis: Analysis, position: Position) -> Hover | None:
     lines = Lines(analysis.text)
     col = lines.column(position)
-    found = target(analysis, position.line, col)
+    found = target(analysis, position["line"], col)
     if found is None:
         return None
     text: str | None = None
@@ -36,11 +35,10 @@ def hover(analysis: Analysis, position: lsp.Position) -> lsp.Hover | None:
         text = schema_data.description(found.keys, found.word)
         text = f"**{found.word}**\n\n{text}" if text else None
     if text is None and not found.on_key:
-        text = _value(analysis, position.line + 1, col)
+        text = _value(analysis, position["line"] + 1, col)
     if text is None:
         return None
-    return lsp.Hover(contents=lsp.MarkupContent(kind=lsp.MarkupKind.Markdown, value=text),
-                     range=lines.range(found.span))
+    return Hover(contents=MarkupContent(kind=MARKDOWN, value=text), range=lines.range(found.span))
 
 
 def describe(robot: Robot, thing: Link | Joint, span: Span | None) -> str:

@@ -9,9 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from lsprotocol import types as lsp
-
 from mpc.core.span import Span
+from mpc.lsp import structures as lsp
 from mpc.lsp.analysis import Analysis
 from mpc.lsp.diagnostics import DID_YOU_MEAN, location, uri_of
 from mpc.lsp.lookup import element, target, written_at
@@ -22,7 +21,7 @@ _FILE_KEYS = ("derived_base", "defaults", "basefile")
 
 def definition(analysis: Analysis, position: lsp.Position) -> lsp.Location | None:
     lines = Lines(analysis.text)
-    found = target(analysis, position.line, lines.column(position))
+    found = target(analysis, position["line"], lines.column(position))
     if found is None:
         return None
     if not found.on_key and found.key in _FILE_KEYS:
@@ -69,29 +68,29 @@ def symbols(analysis: Analysis) -> list[lsp.DocumentSymbol]:
         key_span = doc.keys[path]
         value = doc.values.get(path, key_span)
         whole = Span(key_span.file, key_span.line, key_span.col, value.end_line, value.end_col)
-        kind = lsp.SymbolKind.Namespace if isinstance(doc.data_at(path), dict) else lsp.SymbolKind.Field
+        kind = lsp.SymbolKind.NAMESPACE if isinstance(doc.data_at(path), dict) else lsp.SymbolKind.FIELD
         symbol = lsp.DocumentSymbol(name=str(path[-1]), kind=kind, range=lines.range(whole),
-                                    selection_range=lines.range(key_span),
-                                    children=by_parent.pop(path, None))
+                                    selectionRange=lines.range(key_span))
+        children = by_parent.pop(path, None)
+        if children:
+            symbol["children"] = children
         by_parent.setdefault(path[:-1], []).insert(0, symbol)
     out = by_parent.get((), [])
-    out.sort(key=lambda s: (s.range.start.line, s.range.start.character))
-    for symbol in out:
-        _sort(symbol)
+    _sort(out)
     return out
 
 
-def _sort(symbol: lsp.DocumentSymbol) -> None:
-    if symbol.children:
-        symbol.children.sort(key=lambda s: (s.range.start.line, s.range.start.character))
-        for child in symbol.children:
-            _sort(child)
+def _sort(symbols: list[lsp.DocumentSymbol]) -> None:
+    """In the order of the text, at every level."""
+    symbols.sort(key=lambda s: (s["range"]["start"]["line"], s["range"]["start"]["character"]))
+    for symbol in symbols:
+        _sort(symbol.get("children", []))
 
 
 def rename(analysis: Analysis, position: lsp.Position, new_name: str) -> lsp.WorkspaceEdit | None:
     """Every place of the definition that names the same link or joint, renamed."""
     lines = Lines(analysis.text)
-    found = target(analysis, position.line, lines.column(position))
+    found = target(analysis, position["line"], lines.column(position))
     if found is None or not set(found.kinds) & {"link", "joint"}:
         return None
     edits = []
@@ -101,9 +100,9 @@ def rename(analysis: Analysis, position: lsp.Position, new_name: str) -> lsp.Wor
         written = lines.line(site.span.line - 1)[site.span.col - 1:site.span.end_col - 1]
         quote = written[:1] if written[:1] in "'\"" and written[-1:] == written[:1] else ""
         if written.strip("'\"") == found.word:
-            edits.append(lsp.TextEdit(range=lines.range(site.span), new_text=f"{quote}{new_name}{quote}"))
-    if not any(e.range == lines.range(found.span) for e in edits):
-        edits.append(lsp.TextEdit(range=lines.range(found.span), new_text=new_name))
+            edits.append(lsp.TextEdit(range=lines.range(site.span), newText=f"{quote}{new_name}{quote}"))
+    if not any(e["range"] == lines.range(found.span) for e in edits):
+        edits.append(lsp.TextEdit(range=lines.range(found.span), newText=new_name))
     return lsp.WorkspaceEdit(changes={uri_of(str(analysis.path)): edits})
 
 
@@ -111,10 +110,11 @@ def code_actions(uri: str, diagnostics: list[lsp.Diagnostic]) -> list[lsp.CodeAc
     """A quick fix for every diagnostic that says 'did you mean …?': write that instead."""
     out = []
     for d in diagnostics:
-        match = DID_YOU_MEAN.search(d.message)
-        if match is None or d.range.start.line != d.range.end.line:
+        match = DID_YOU_MEAN.search(d["message"])
+        if match is None or d["range"]["start"]["line"] != d["range"]["end"]["line"]:
             continue
-        out.append(lsp.CodeAction(title=f"Change to '{match.group(1)}'", kind=lsp.CodeActionKind.QuickFix,
-                                  diagnostics=[d], is_preferred=True, edit=lsp.WorkspaceEdit(
-                                      changes={uri: [lsp.TextEdit(range=d.range, new_text=match.group(1))]})))
+        fix = lsp.TextEdit(range=d["range"], newText=match.group(1))
+        out.append(lsp.CodeAction(title=f"Change to '{match.group(1)}'", kind=lsp.QUICK_FIX,
+                                  diagnostics=[d], isPreferred=True,
+                                  edit=lsp.WorkspaceEdit(changes={uri: [fix]})))
     return out

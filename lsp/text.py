@@ -11,9 +11,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from lsprotocol import types as lsp
-
 from mpc.core.span import Span
+from mpc.lsp.structures import Position, Range
 
 
 def utf16_length(text: str) -> int:
@@ -30,20 +29,20 @@ class Lines:
         """Line `number` (0-based), or ''."""
         return self.lines[number] if 0 <= number < len(self.lines) else ""
 
-    def position(self, line: int, col: int) -> lsp.Position:
+    def position(self, line: int, col: int) -> Position:
         """The LSP position of a 1-based (line, column in code points)."""
         text = self.line(line - 1)
-        return lsp.Position(line=max(line - 1, 0), character=utf16_length(text[:max(col - 1, 0)]))
+        return Position(line=max(line - 1, 0), character=utf16_length(text[:max(col - 1, 0)]))
 
-    def column(self, position: lsp.Position) -> int:
+    def column(self, position: Position) -> int:
         """The 1-based column in code points of an LSP position."""
-        text, units, col = self.line(position.line), 0, 0
-        while col < len(text) and units < position.character:
+        text, units, col = self.line(position["line"]), 0, 0
+        while col < len(text) and units < position["character"]:
             units += 2 if ord(text[col]) > 0xFFFF else 1
             col += 1
         return col + 1
 
-    def range(self, span: Span) -> lsp.Range:
+    def range(self, span: Span) -> Range:
         """The range of a span; a span without an end covers the word it starts at."""
         end_line, end_col = span.end_line, span.end_col
         if (end_line, end_col) == (span.line, span.col):
@@ -52,7 +51,7 @@ class Lines:
             end_col = span.col + (len(match.group()) if match else 0)
             if end_col == span.col:
                 end_col = len(text) + 1
-        return lsp.Range(start=self.position(span.line, span.col), end=self.position(end_line, end_col))
+        return Range(start=self.position(span.line, span.col), end=self.position(end_line, end_col))
 
 
 def contains(span: Span, line: int, col: int) -> bool:

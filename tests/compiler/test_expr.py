@@ -12,7 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import mpc.compiler.expr
-from mpc.compiler.expr import Binary, Call, Name, Num, Unary, evaluate, parse, parser
+from mpc.compiler.expr import Binary, Call, Name, Num, Unary, evaluate, parse
 from mpc.core.diagnostics import Sink
 from mpc.core.span import Span
 from mpc.core.yaml_source import load
@@ -80,7 +80,8 @@ def test_tree() -> None:
     assert parse("-2**x") == Unary("-", Binary("**", Num(2.0, 1, 2), Name("x", 4, 5), 1, 5), 0, 5)
     assert parse("f(1, (2))") == Call("f", (Num(1.0, 2, 3), Num(2.0, 6, 7)), 0, 9)
     assert parse("g()") == Call("g", (), 0, 3)
-    assert parser() is parser()
+    one_two = Binary("+", Num(1.0, 1, 2), Num(2.0, 3, 4), 1, 4)  # its parentheses are the product's
+    assert parse("(1+2)*3") == Binary("*", one_two, Num(3.0, 6, 7), 0, 7)
 
 
 # E0210 syntax errors: the column of the offending character inside the string

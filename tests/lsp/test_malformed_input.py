@@ -87,6 +87,7 @@ def served(tmp_path_factory: pytest.TempPathFactory) -> tuple[Client, str]:
     shutil.copytree(EXAMPLES / "meshes", work / "meshes")
     (work / "arm.yml").write_text(DEFINITION, encoding="utf-8")
     client = Client(env={**os.environ, "MPC_CACHE_DIR": str(work / "cache")}, cwd=work)
+    client.next_id = 1000  # the client's own requests never take the ids of the frames below
     client.initialize(work)
     uri = client.open(work / "arm.yml")
     assert client.diagnostics(uri, 1) == []

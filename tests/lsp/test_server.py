@@ -122,6 +122,18 @@ def test_change_is_checked_again(server: Client, folder: Path) -> None:
         "uri": uri, "range": {"start": {"line": 1, "character": 2}, "end": {"line": 1, "character": 11}}}}]
 
 
+def test_an_incremental_change(server: Client, folder: Path) -> None:
+    """The server syncs incrementally (textDocumentSync.change 2): a change may give a range."""
+    assert server.capabilities["textDocumentSync"]["change"] == 2
+    uri, diagnostics = opened(server, folder / "incremental.yml", DEFINITION)
+    assert [d["range"]["end"] for d in diagnostics] == [{"line": 18, "character": 8}]  # after 'elbo'
+    after = {"line": 18, "character": 8}
+    server.notify("textDocument/didChange", {"textDocument": {"uri": uri, "version": 2},
+                                             "contentChanges": [{"range": {"start": after, "end": after},
+                                                                 "text": "w"}]})
+    assert server.diagnostics(uri, 2) == []
+
+
 def test_code_action_applies_the_did_you_mean(server: Client, folder: Path) -> None:
     uri, diagnostics = opened(server, folder / "action.yml", DEFINITION)
     (action,) = server.request("textDocument/codeAction", {

@@ -15,9 +15,9 @@ from mpc.lsp.text import Context, Lines, context
 def test_columns_are_utf16_code_units() -> None:
     lines = Lines("a: x\nname: \"😀é\" # b: elbo\n")
     span = Span("f", 2, 12, 2, 14)  # 'b:' after an emoji (2 units) and é (1)
-    assert lines.range(span).start.character == 12
-    assert lines.column(lines.range(span).start) == 12
-    assert lines.position(2, 9).character == 9  # after 😀: one code point, two units
+    assert lines.range(span)["start"]["character"] == 12
+    assert lines.column(lines.range(span)["start"]) == 12
+    assert lines.position(2, 9)["character"] == 9  # after 😀: one code point, two units
 
 
 def test_context_of_keys_and_list_items() -> None:
