@@ -18,12 +18,12 @@ import random
 from collections.abc import Callable
 from pathlib import Path
 
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 from lxml import etree
 
 from mpc.backends import sdf, urdf_reader
-from mpc.backends.xml import XmlError, XmlSource, parse_floats
+from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, parse_floats
 from mpc.core.diagnostics import Sink
 from mpc.core.packages import PackageResolver
 from mpc.ir.robot import Robot
@@ -200,6 +200,23 @@ def _numbers(text: str) -> tuple[float, ...] | None:
 def test_numbers_are_read_as_urdf_means(text: str) -> None:
     """parse_floats's shortcut for one number (float() alone) against split() and float()."""
     assert repr(parse_floats(text)) == repr(_numbers(text))  # repr: nan != nan
+
+
+@given(_NUMBER_TEXT | st.text(max_size=12) | st.floats().map(repr))
+@example('1_0')
+@example('-inf')
+@example('1e400')
+@example('nan')
+@example(' 1')
+@example('1\x1c')
+@example('0x1')
+@example('')
+@example('1 2')
+def test_one_number_is_read_as_finite_floats_reads_it(text: str) -> None:
+    """The reader's shortcut for the text of one number (urdf_reader._one_number) against
+    finite_floats, whatever the text: the same numbers, refusals and NOT_FINITE."""
+    ours, theirs = urdf_reader._one_number(text), finite_floats(text)
+    assert (ours is NOT_FINITE) == (theirs is NOT_FINITE) and repr(ours) == repr(theirs)
 
 
 def test_numbers_examples() -> None:
