@@ -69,7 +69,7 @@ _set_file, _set_line, _set_col, _set_end_line, _set_end_col = (
 class Locator(Protocol):
     """What finds the span of a node of a parsed file (backends/xml.py: XmlSource)."""
 
-    def span(self, node: Any, attr: str | None = None) -> Span: ...
+    def span(self, node: Any, attr: str | None = None, /) -> Span: ...
 
 
 class LazySpan(Span):
