@@ -168,7 +168,10 @@ class _Reader:
         """The attributes with each namespaced name (lxml's `{uri}name`, which no XML file
         may hold) written `prefix:name` as the file wrote it, and the declaration of each
         prefix that `<robot>` does not declare: the URDF written keeps them well-formed."""
-        if not any(key[0] == "{" for key, _ in attrs):
+        for key, _ in attrs:  # most hold none: a loop, not any() over a generator
+            if key[0] == "{":
+                break
+        else:
             return attrs
         out: list[tuple[str, str]] = []
         declare: dict[str, str] = {}
