@@ -267,3 +267,23 @@ def test_refusals_are_as_recorded(tmp_path: Path) -> None:
             for path, outcome in outcomes:
                 found[stable(f"{path} in {base}", tmp_path)] = stable(str(outcome), tmp_path)
     check_text("reader/refusals", "".join(f"{k}: {v}\n" for k, v in sorted(found.items())))
+
+
+def test_a_fragment_names_each_link_and_joint_by_its_kind(tmp_path: Path) -> None:
+    """A fragment's refs (backends/urdf_fragments.py), in document order: a name only a link or
+    only a joint has is of that kind; one that both have is a joint's where the attribute or
+    tag says joint, else a link's; nested places by their child indices."""
+    data = b"""<robot name="r">
+  <link name="a"/>
+  <link name="b"/>
+  <joint name="b" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <gazebo reference="b"><joint_of>b</joint_of><x link=" a " joint="b"/><!-- a --><t> b </t></gazebo>
+  <transmission name="t"><joint name="b"/><actuator> b</actuator></transmission>
+</robot>
+"""
+    robot = urdf_reader.read_text(data, "r.urdf", tmp_path, Sink(), PackageResolver())
+    assert robot is not None
+    assert [[(r.path, r.attr, r.kind, r.name) for r in f.refs] for f in robot.fragments] == [
+        [((), "reference", "link", "b"), ((0,), None, "joint", "b"), ((1,), "link", "link", "a"),
+         ((1,), "joint", "joint", "b"), ((3,), None, "link", "b")],
+        [((0,), "name", "joint", "b"), ((1,), None, "link", "b")]]
