@@ -18,9 +18,9 @@ from mpc.ir.fragments import Fragment, FragmentRef, RefKind
 class Fragments:
     """The fragments of one URDF file, made as the reader meets them.
 
-    names: every link and joint name of the file (`link_names`, `joint_names`: each kind),
-    set before the first fragment is made. make, make_ref: the makers of the records
-    (core/record.py maker).
+    names: every link and joint name of the file (`link_names`, `joint_names`: each kind;
+    `both`: those of a link and a joint), set before the first fragment is made. make,
+    make_ref: the makers of the records (core/record.py maker).
     """
 
     def __init__(self, src: XmlSource, make: Callable[..., Fragment],
@@ -29,6 +29,7 @@ class Fragments:
         self.link_names: set[str] = set()
         self.joint_names: set[str] = set()
         self.names: set[str] = set()
+        self.both: set[str] = set()  # the names of a link and of a joint (kind_of decides)
         # What tostring adds to a fragment's start tag for the namespaces <robot> declares,
         # each and (as it writes them, right after the tag's name) all together. When only
         # <robot> declares any, those no element uses are dropped from the tree first: tostring
@@ -62,17 +63,19 @@ class Fragments:
         """Every attribute or text in the fragment that equals a link or joint name, in
         document order (each element's attributes, then its text)."""
         out: list[FragmentRef] = []
-        names = self.names
+        names, both, links, make_ref = self.names, self.both, self.link_names, self.make_ref
         for node in el.iter(etree.Element):
             items = node.items()
             if items:
                 for attr, value in items:
                     if (name := value.strip()) in names:
-                        kind = self.kind_of(name, node.tag + attr)
-                        out.append(self.make_ref(_path(el, node), attr, kind, name))
+                        kind = (self.kind_of(name, node.tag + attr) if name in both
+                                else "link" if name in links else "joint")
+                        out.append(make_ref(() if node is el else _path(el, node), attr, kind, name))
             text = node.text
             if text and (name := text.strip()) and name in names:
-                out.append(self.make_ref(_path(el, node), None, self.kind_of(name, node.tag), name))
+                kind = self.kind_of(name, node.tag) if name in both else "link" if name in links else "joint"
+                out.append(make_ref(() if node is el else _path(el, node), None, kind, name))
         return tuple(out) if out else ()
 
     def kind_of(self, name: str, hint: str) -> RefKind:

@@ -48,6 +48,8 @@ NONE_MATERIAL = "None"  # Phobos's name for no material
 
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 _UNREAD = object()  # _Reader.numbers: a text not read yet
+# Pose.written: one tuple of each kind for all poses (a read makes hundreds).
+_WRITTEN = {(x, r): (x, r) for x in (False, True) for r in (False, True)}
 _NAME, _NAME_TYPE, _POSE, _MESH = ("name",), ("name", "type"), ("xyz", "rpy"), ("filename", "scale")
 _LIMIT, _DYNAMICS = ("lower", "upper", "effort", "velocity"), ("damping", "friction")
 # The children of a joint that are no fragments.
@@ -110,6 +112,18 @@ def _robot(src: XmlSource, sink: Sink, resolver: PackageResolver | None, base_di
 _XML_NAMESPACE = "http://www.w3.org/XML/1998/namespace"  # the `xml:` prefix's, never declared
 
 
+def _one_number(text: str) -> tuple[float, ...] | None:
+    """finite_floats(text), for the text of one number without calling it: most of a URDF's
+    numbers stand alone in their attribute, and a read parses hundreds (two calls each)."""
+    if "_" not in text and " " not in text:
+        try:
+            x = float(text)
+        except ValueError:
+            return finite_floats(text)
+        return (x,) if x - x == 0.0 else NOT_FINITE  # inf - inf and nan - nan are nan
+    return finite_floats(text)
+
+
 class _Reader:
     def __init__(self, src: XmlSource, sink: Sink, resolver: PackageResolver,
                  base_dir: Path) -> None:
@@ -154,7 +168,10 @@ class _Reader:
         """The attributes with each namespaced name (lxml's `{uri}name`, which no XML file
         may hold) written `prefix:name` as the file wrote it, and the declaration of each
         prefix that `<robot>` does not declare: the URDF written keeps them well-formed."""
-        if not any(key[0] == "{" for key, _ in attrs):
+        for key, _ in attrs:  # most hold none: a loop, not any() over a generator
+            if key[0] == "{":
+                break
+        else:
             return attrs
         out: list[tuple[str, str]] = []
         declare: dict[str, str] = {}
@@ -194,7 +211,7 @@ class _Reader:
             return None
         values = self.numbers.get(text, _UNREAD)
         if values is _UNREAD:
-            values = self.numbers[text] = finite_floats(text)
+            values = self.numbers[text] = _one_number(text)
         if values is NOT_FINITE or not isinstance(values, tuple) or len(values) != 1:
             self.not_numbers(el, attr, 1, where, text, values is NOT_FINITE)
             return None
@@ -223,7 +240,7 @@ class _Reader:
             self.warn_unknown_attrs(el, _POSE, where)
         xyz = self.floats(el, "xyz", 3, where) if has_xyz else None
         rpy = self.floats(el, "rpy", 3, where) if has_rpy else None
-        pose = self.new.pose(xyz or ZERO, rpy or ZERO, (has_xyz, has_rpy))
+        pose = self.new.pose(xyz or ZERO, rpy or ZERO, _WRITTEN[has_xyz, has_rpy])
         if len(keys) == has_xyz + has_rpy and (xyz or not has_xyz) and (rpy or not has_rpy):
             self.poses[items] = pose
         return pose
@@ -288,7 +305,7 @@ class _Reader:
                 names.link_names.add(el.get("name", ""))
             elif el.tag == "joint":
                 names.joint_names.add(el.get("name", ""))
-        names.names = names.link_names | names.joint_names
+        names.names, names.both = names.link_names | names.joint_names, names.link_names & names.joint_names
 
         links: dict[str, Link] = {}
         joints: dict[str, Joint] = {}

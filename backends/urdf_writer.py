@@ -40,6 +40,7 @@ class _Writer:
         self.texts: dict[float, str] = {}
         self.tuple_texts: dict[tuple[float, ...], str] = {}
         self.escaped: dict[str, str] = {}
+        self.origins: dict[int, str] = {}  # `origin`: the text of each Pose, by its id
 
     def text(self, x: float) -> str:
         text = self.texts.get(x)
@@ -100,10 +101,15 @@ class _Writer:
         self.out.extend((ind + ln) if ln else ln for ln in rest)
 
     def origin(self, ind: str, pose: Pose) -> str:
-        xyz, rpy = pose.written
-        xyz_text = f' xyz="{self.nums(pose.xyz, "xyz")}"' if xyz else ""
-        rpy_text = f' rpy="{self.nums(pose.rpy, "rpy")}"' if rpy else ""
-        return f"{ind}<origin{xyz_text}{rpy_text}/>"
+        # A reader shares a Pose among the elements that wrote it alike (most of a URDF's
+        # <origin>s): its text is made once, by the identity of the Pose (alive while written).
+        text = self.origins.get(id(pose))
+        if text is None:
+            xyz, rpy = pose.written
+            xyz_text = f' xyz="{self.nums(pose.xyz, "xyz")}"' if xyz else ""
+            rpy_text = f' rpy="{self.nums(pose.rpy, "rpy")}"' if rpy else ""
+            text = self.origins[id(pose)] = f"<origin{xyz_text}{rpy_text}/>"
+        return ind + text
 
     def geometry(self, ind: str, geometry: Geometry, attrs: Attrs) -> str:
         """The <geometry> element's lines, as one text."""

@@ -20,7 +20,7 @@ from lxml import etree
 
 from mpc.core.diagnostics import Sink
 from mpc.core.record import maker
-from mpc.core.span import Span, hardened_parser, lazy_span
+from mpc.core.span import Span, hardened_parser, located_span
 
 # Comments, CDATA, processing instructions, doctype and start tags (`<` and the name), in
 # document order: the start tags among them are those outside the others.
@@ -118,7 +118,7 @@ class XmlSource:
     def lazy_span(self, el: etree._Element, attr: str | None = None) -> Span:
         """`span(el, attr)`, found when first asked for (core/span.py: LazySpan): for the
         spans of what a reader makes, which only a diagnostic or the language server reads."""
-        return lazy_span(self.file, functools.partial(self.span, el, attr))
+        return located_span(self.file, self, el, attr)
 
     def _on_lines(self, el: etree._Element) -> tuple[int, str, int, int, int] | None:
         """Where `el`'s start tag begins, read from the line where it ends (lxml's sourceline)

@@ -42,7 +42,7 @@ class Sphere:
     extra_attrs: Attrs = ()
 
 
-@record(slots=True, kw_only=True)
+@record(slots=True, kw_only=True, bulk=True)
 class MeshSource:
     """Where a mesh file comes from.
 

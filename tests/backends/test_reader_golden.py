@@ -18,12 +18,12 @@ import random
 from collections.abc import Callable
 from pathlib import Path
 
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 from lxml import etree
 
 from mpc.backends import sdf, urdf_reader
-from mpc.backends.xml import XmlError, XmlSource, parse_floats
+from mpc.backends.xml import NOT_FINITE, XmlError, XmlSource, finite_floats, parse_floats
 from mpc.core.diagnostics import Sink
 from mpc.core.packages import PackageResolver
 from mpc.ir.robot import Robot
@@ -202,6 +202,23 @@ def test_numbers_are_read_as_urdf_means(text: str) -> None:
     assert repr(parse_floats(text)) == repr(_numbers(text))  # repr: nan != nan
 
 
+@given(_NUMBER_TEXT | st.text(max_size=12) | st.floats().map(repr))
+@example('1_0')
+@example('-inf')
+@example('1e400')
+@example('nan')
+@example(' 1')
+@example('1\x1c')
+@example('0x1')
+@example('')
+@example('1 2')
+def test_one_number_is_read_as_finite_floats_reads_it(text: str) -> None:
+    """The reader's shortcut for the text of one number (urdf_reader._one_number) against
+    finite_floats, whatever the text: the same numbers, refusals and NOT_FINITE."""
+    ours, theirs = urdf_reader._one_number(text), finite_floats(text)
+    assert (ours is NOT_FINITE) == (theirs is NOT_FINITE) and repr(ours) == repr(theirs)
+
+
 def test_numbers_examples() -> None:
     assert parse_floats(" 1\t-2.5\n1e3 ") == (1.0, -2.5, 1000.0)
     assert parse_floats("1_0") is None and parse_floats("1 x") is None and parse_floats(None) is None
@@ -250,3 +267,23 @@ def test_refusals_are_as_recorded(tmp_path: Path) -> None:
             for path, outcome in outcomes:
                 found[stable(f"{path} in {base}", tmp_path)] = stable(str(outcome), tmp_path)
     check_text("reader/refusals", "".join(f"{k}: {v}\n" for k, v in sorted(found.items())))
+
+
+def test_a_fragment_names_each_link_and_joint_by_its_kind(tmp_path: Path) -> None:
+    """A fragment's refs (backends/urdf_fragments.py), in document order: a name only a link or
+    only a joint has is of that kind; one that both have is a joint's where the attribute or
+    tag says joint, else a link's; nested places by their child indices."""
+    data = b"""<robot name="r">
+  <link name="a"/>
+  <link name="b"/>
+  <joint name="b" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <gazebo reference="b"><joint_of>b</joint_of><x link=" a " joint="b"/><!-- a --><t> b </t></gazebo>
+  <transmission name="t"><joint name="b"/><actuator> b</actuator></transmission>
+</robot>
+"""
+    robot = urdf_reader.read_text(data, "r.urdf", tmp_path, Sink(), PackageResolver())
+    assert robot is not None
+    assert [[(r.path, r.attr, r.kind, r.name) for r in f.refs] for f in robot.fragments] == [
+        [((), "reference", "link", "b"), ((0,), None, "joint", "b"), ((1,), "link", "link", "a"),
+         ((1,), "joint", "joint", "b"), ((3,), None, "link", "b")],
+        [((0,), "name", "joint", "b"), ((1,), None, "link", "b")]]

@@ -123,7 +123,7 @@ def test_a_robot_read_holds_its_parsed_file_no_longer_than_itself(tmp_path: Path
     path.write_bytes(URDF.replace(b'  <link\n      name="arm"/>\n', b""))
     robot = urdf.read(path, Sink())
     assert robot is not None
-    source = weakref.ref(object.__getattribute__(robot.links["arm"].span, "_find").func.__self__)
+    source = weakref.ref(object.__getattribute__(robot.links["arm"].span, "_find"))
     gc.collect()
     assert isinstance(source(), XmlSource)  # the spans not yet found hold it
     del robot

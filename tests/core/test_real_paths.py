@@ -72,3 +72,37 @@ def test_a_mesh_outside_the_roots_is_refused_through_a_link(tmp_path: Path) -> N
     assert resolver.refusal(package / "meshes" / "ok.stl", folder) is None
     for leak in (package / "meshes" / "leak.stl", package / "linked" / "key.stl"):
         assert "outside the model's package roots" in (resolver.refusal(leak, folder) or "")
+
+
+def test_a_located_file_is_its_folder_joined_with_what_the_model_wrote(tmp_path: Path) -> None:
+    """locate joins each filename's folder once and then its name (`_below`): the same Path as
+    pathlib's join of the whole, whatever slashes, dots and `..` the name holds."""
+    resolver = PackageResolver(search_path=[], package_map={"pkg": tmp_path / "pkg"})
+    written = ["a.stl", "m/a.stl", "m/a.stl", "m/b.stl", "m//n/./a.stl", "m/../a.stl", "m/", "m/.",
+               "/abs/a.stl", "//net/a.stl", "/", "", ".", "..", "m/n/", "./m/a.stl", "m/a.stl/"]
+    for _ in range(2):  # the second time from the folders joined the first
+        for name in written:
+            for uri, folder in ((f"package://pkg/{name}", tmp_path / "pkg"), (name, tmp_path / "urdf")):
+                found, why = resolver.locate(uri, tmp_path / "urdf")
+                assert (found, str(found), why) == (folder / name, str(folder / name), ""), uri
+
+
+def test_the_roots_a_refusal_asks_for_follow_every_package_found_between_two_meshes(tmp_path: Path) -> None:
+    """_package_roots keeps the roots of each set of folders by their identities: a package
+    found (or a model folder's parent) since the last mesh still counts."""
+    for name in ("pkg", "other", "urdf"):
+        (tmp_path / name / "meshes").mkdir(parents=True)
+        (tmp_path / name / "meshes" / "a.stl").write_bytes(b"solid\n")
+    (tmp_path / "pkg" / "meshes" / "to_other.stl").symlink_to(tmp_path / "other" / "meshes" / "a.stl")
+    resolver = PackageResolver(search_path=[], package_map={"pkg": tmp_path / "pkg"})
+    base = resolver.resolved(tmp_path / "pkg")
+    leak = tmp_path / "pkg" / "meshes" / "to_other.stl"
+    assert "outside the model's package roots" in (resolver.refusal(leak, base) or "")
+    resolver.package_map["other"] = tmp_path / "other"
+    assert resolver.refusal(leak, base) is None
+    model = resolver.resolved(tmp_path / "urdf")  # a model folder: its parent is a root too
+    assert resolver.refusal(tmp_path / "pkg" / "meshes" / "a.stl", model) is None
+    assert resolver.refusal(tmp_path / "pkg" / "meshes" / "a.stl", model) is None
+    fresh = PackageResolver(search_path=[], package_map=dict(resolver.package_map))
+    for folder in (base, model, tmp_path):
+        assert resolver._package_roots(folder) == fresh._package_roots(folder), folder

@@ -146,10 +146,11 @@ def test_only_records_made_in_bulk_read_dataclass_internals() -> None:
 
 
 # The opt-in list: what the URDF reader makes by the thousand (backends/urdf_reader.py
-# _makers) and the spans of every file read (backends/xml.py).
+# _makers), the sources of the meshes it names (ir/geometry.py mesh_source) and the spans of
+# every file read (backends/xml.py).
 BULK = {"Pose", "Fragment", "FragmentRef", "Robot", "Link", "Inertial", "Inertia", "Box", "Cylinder",
-        "Sphere", "Mesh", "Visual", "Collision", "Material", "Joint", "Limit", "Dynamics", "Mimic",
-        "Calibration", "SafetyController", "Span"}
+        "Sphere", "Mesh", "MeshSource", "Visual", "Collision", "Material", "Joint", "Limit", "Dynamics",
+        "Mimic", "Calibration", "SafetyController", "Span"}
 
 
 def test_every_class_made_in_bulk_gets_its_fast_init_and_maker_on_this_python() -> None:

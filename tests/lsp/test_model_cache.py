@@ -52,7 +52,7 @@ def test_a_model_entering_the_cache_lets_its_parse_go_and_keeps_its_places(tmp_p
         assert robot is not None
         span = robot.links["upper"].span
         assert type(span) is LazySpan  # the reader's spans are lazy: each holds the parse
-        parses.append(weakref.ref(object.__getattribute__(span, "_find").func.__self__))
+        parses.append(weakref.ref(object.__getattribute__(span, "_find")))
         return robot
 
     robot = ModelCache().read(urdf, (), Sink(), reader)
