@@ -197,9 +197,9 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     """Write each planned mesh into `out` (`contents`), leaving those already there."""
     from mpc.core.files import confined, copy_file
 
-    # Written already (by another export of the build): looked at without following the path's
-    # links, which `confined` does for the files written, below; a name that is not inside the
-    # output is never taken as written, and is refused there.
+    # Written already (by another export of the build): asked without resolving the path, which
+    # `confined` does for each file written, below; a name that is not inside the output is
+    # never taken as written, and is refused there.
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
                          and (out / rel).exists())
