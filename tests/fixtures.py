@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import io
 import struct
+import tarfile
 from pathlib import Path
 
 from tests.conftest import write
@@ -132,3 +134,20 @@ def reference_robot(path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(out) + "\n")
     return path
+
+
+def tar_archive(*members: tuple[str, bytes | str]) -> tarfile.TarFile:
+    """A tar, open for reading, of files (bytes: their data) and symbolic links (str: the
+    link's target), each by its name in the archive."""
+    buffer = io.BytesIO()
+    with tarfile.open(fileobj=buffer, mode="w") as tar:
+        for name, content in members:
+            info = tarfile.TarInfo(name)
+            if isinstance(content, str):
+                info.type, info.linkname = tarfile.SYMTYPE, content
+                tar.addfile(info)
+            else:
+                info.size = len(content)
+                tar.addfile(info, io.BytesIO(content))
+    buffer.seek(0)
+    return tarfile.open(fileobj=buffer)

@@ -3,29 +3,13 @@ Debian 12's Python 3.11.2, whose tarfile has no filters yet."""
 
 from __future__ import annotations
 
-import io
 import tarfile
 from pathlib import Path
 
 import pytest
 
 from mpc.deploy.submodules import extract_data
-
-
-def _archive(*members: tuple[str, bytes | str]) -> tarfile.TarFile:
-    """A tar of files (bytes) and symbolic links (str: the link's target)."""
-    buffer = io.BytesIO()
-    with tarfile.open(fileobj=buffer, mode="w") as tar:
-        for name, content in members:
-            info = tarfile.TarInfo(name)
-            if isinstance(content, str):
-                info.type, info.linkname = tarfile.SYMTYPE, content
-                tar.addfile(info)
-            else:
-                info.size = len(content)
-                tar.addfile(info, io.BytesIO(content))
-    buffer.seek(0)
-    return tarfile.open(fileobj=buffer)
+from tests.fixtures import tar_archive
 
 
 # tarfile's own filter where this Python has it (3.11.4 and later), and mpc's rules by hand always
@@ -37,7 +21,7 @@ def python(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> s
 
 
 def test_files_and_links_inside_are_extracted(tmp_path: Path, python: str) -> None:
-    extract_data(_archive(("lua/knee.lua", b"-- lua\n"), ("lua/link.lua", "knee.lua"), ("/abs", b"a")),
+    extract_data(tar_archive(("lua/knee.lua", b"-- lua\n"), ("lua/link.lua", "knee.lua"), ("/abs", b"a")),
                   tmp_path / "out")
     assert (tmp_path / "out/lua/knee.lua").read_bytes() == b"-- lua\n"
     assert (tmp_path / "out/lua/link.lua").readlink() == Path("knee.lua")
@@ -49,5 +33,5 @@ def test_files_and_links_inside_are_extracted(tmp_path: Path, python: str) -> No
 def test_nothing_is_written_or_linked_outside(tmp_path: Path, python: str,
                                               member: tuple[str, bytes | str]) -> None:
     with pytest.raises(tarfile.TarError):
-        extract_data(_archive(member), tmp_path / "out")
+        extract_data(tar_archive(member), tmp_path / "out")
     assert sorted(p.name for p in tmp_path.rglob("*")) in ([], ["out"])
