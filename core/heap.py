@@ -2,21 +2,21 @@
 
 glibc keeps what a program frees in its heap for the next allocation; after a library freed a
 large working set (MuJoCo compiling a model of many meshes frees three times the model's
-size), the process's resident size stays at its peak until `malloc_trim` returns the free pages.
+size; a check of `mpc lsp` frees libxml2's parse and pydantic's validation), the process's
+resident size stays at its peak until `malloc_trim` returns the free pages.
 """
 
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import functools
 
 
 @functools.cache
 def _trim() -> ctypes._CFuncPtr | None:  # type: ignore[name-defined]
-    name = ctypes.util.find_library("c")
+    # glibc by its soname: `ctypes.util.find_library` would run `ldconfig -p` to find it
     try:
-        return ctypes.CDLL(name).malloc_trim if name else None
+        return ctypes.CDLL("libc.so.6").malloc_trim
     except (OSError, AttributeError):  # not glibc (musl, macOS): nothing to give back this way
         return None
 

@@ -19,9 +19,10 @@ from typing import Any
 
 from mpc.compiler.options import ModelCache, Options
 from mpc.core.cycles import paused_cycle_collection
+from mpc.core.heap import give_back
 from mpc.core.packages import PackageResolver
 from mpc.core.version import mpc_version
-from mpc.lsp import completion, heap, hover, navigation
+from mpc.lsp import completion, hover, navigation
 from mpc.lsp import structures as lsp
 from mpc.lsp.analysis import Analysis, analyse
 from mpc.lsp.diagnostics import convert
@@ -77,7 +78,7 @@ class MpcServer(Endpoint):
             diagnostics = convert(analysis.diagnostics, path, Lines(analysis.text), analysis.readers())
             self.notify("textDocument/publishDiagnostics",
                         {"uri": uri, "diagnostics": diagnostics, "version": document.version})
-        heap.give_back()
+        give_back()  # what the check freed outside Python's allocator (0.8 MiB of TALOS's)
         self.analyses[uri] = analysis
         if analysis.passed is not None:
             self.named[uri] = analysis
