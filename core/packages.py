@@ -27,22 +27,12 @@ import sys
 import sysconfig
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import ModuleType
 from typing import TYPE_CHECKING
 
 from mpc.core.reads import note_package
 
 if TYPE_CHECKING:
     from mpc.core.files import Roots
-
-
-@functools.cache
-def _files() -> ModuleType:
-    """core/files.py, imported when first needed (`mpc check` imports this module on every
-    save) and then without an import statement on each call (every mesh of a model asks)."""
-    from mpc.core import files
-
-    return files
 
 
 @functools.cache
@@ -178,7 +168,6 @@ def _path_list(variable: str) -> list[str]:
 # The folders of a model's files in the layout mpc and Phobos write (`urdf/robot.urdf`,
 # `meshes/stl/…`): a file in one may name the files of the folder above (PackageResolver.refusal).
 MODEL_FOLDERS = frozenset({"urdf", "sdf", "smurf", "mjcf"})
-_IDENTITIES = 64  # PackageResolver._package_roots: the keys kept at most
 
 
 @dataclass
@@ -202,10 +191,6 @@ class PackageResolver:
     # The search path's folders that are crawled as rospack does (ROS_PACKAGE_PATH's); the
     # others are share/ folders, with their packages right below them.
     _crawled: frozenset[Path] = frozenset()
-    # _package_roots' memos: the parent of each base_dir; the roots by the folders' identities.
-    _parents: dict[Path, Path] = field(default_factory=dict)
-    _child_folders: dict[tuple[Path, str], Path] = field(default_factory=dict)  # _below's
-    _by_identity: dict[tuple[int, ...], tuple[tuple[Path, ...], Roots]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.search_path is None:
@@ -294,45 +279,30 @@ class PackageResolver:
         command line) may also name the files of its model folder: the folder above
         `base_dir` when that is one of the format folders mpc and Phobos write side by side
         (`urdf/`, `sdf/`, `smurf/` beside `meshes/`)."""
-        files = _files()
-        found = files.plain_stat(path, self._real_dirs)
+        from mpc.core.files import input_problem, plain_stat
+
+        found = plain_stat(path, self._real_dirs)
         if found is False or (found is True and not path.exists()):
             return None
-        return files.input_problem(path, self._package_roots(base_dir), self._real_dirs,
-                                   None if found is True else found)
+        return input_problem(path, self._package_roots(base_dir), self._real_dirs,
+                             None if found is True else found)
 
     def _package_roots(self, base_dir: Path | None) -> Roots:
         """The package roots and `base_dir`, resolved once for every mesh of a model (their
         folders through the resolved folders of its meshes: `_real_dirs`)."""
+        from mpc.core.files import Roots, package_roots
+
         assert self.search_path is not None
         # A package found on the search path is a root wherever its folder links to: the
         # environment named it, as `--package` names one. One found above the model is a root
         # when its package.xml names it (`_above`).
         found = (*(f for f in self._cache.values() if f is not None), *sorted(self._named_above))
-        if not base_dir:
-            own: tuple[Path, ...] = ()
-        elif not self.projects and base_dir.name in MODEL_FOLDERS:
-            parent = self._parents.get(base_dir)  # the same object each time: see below
-            if parent is None:
-                parent = self._parents[base_dir] = base_dir.parent
-            own = (base_dir, parent)
-        else:
-            own = (base_dir,)
+        own = (base_dir, base_dir.parent) if base_dir and not self.projects and base_dir.name in \
+            MODEL_FOLDERS else (base_dir,) if base_dir else ()
         folders = (*self.package_map.values(), *self.search_path, *found, *self.roots, *self.projects, *own)
-        # Every mesh of a model asks with the same folders, the same objects: their identities
-        # are the key (a Path hashes in Python code); `_by_identity` keeps each key's folders
-        # alive, so that no identity is another object's while its key is kept.
-        key = tuple(map(id, folders))
-        kept = self._by_identity.get(key)
-        if kept is not None:
-            return kept[1]
         roots = self._real_roots.get(folders)
         if roots is None:
-            files = _files()
-            roots = self._real_roots[folders] = files.Roots(files.package_roots(folders, self._real_dirs))
-        if len(self._by_identity) >= _IDENTITIES:  # a resolver that lives long: callers' new Paths
-            self._by_identity.clear()
-        self._by_identity[key] = folders, roots
+            roots = self._real_roots[folders] = Roots(package_roots(folders, self._real_dirs))
         return roots
 
     def resolved(self, path: Path) -> Path:
@@ -354,20 +324,7 @@ class PackageResolver:
                 return None, (f"package '{package}' was not found (searched the package map, "
                               "ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, the Python environment and the "
                               "folders above the model)")
-            return self._below(folder, rest), ""
+            return folder / rest, ""
         if uri.startswith("file://"):
             return Path(uri[len("file://"):]), ""
-        return self._below(base_dir, uri), ""
-
-    def _below(self, folder: Path, rest: str) -> Path:
-        """`folder / rest`, the Path of rest's own folder made once: a model's meshes are the
-        files of a few folders, and pathlib parses (and interns) each component of what it
-        joins ((folder / "a/b") / "c" is folder / "a/b/c", component by component)."""
-        head, _, name = rest.rpartition("/")
-        if not head:
-            return folder / rest
-        key = (folder, head)
-        parent = self._child_folders.get(key)
-        if parent is None:
-            parent = self._child_folders[key] = folder / head
-        return parent / name
+        return base_dir / uri, ""

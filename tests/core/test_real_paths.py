@@ -75,12 +75,12 @@ def test_a_mesh_outside_the_roots_is_refused_through_a_link(tmp_path: Path) -> N
 
 
 def test_a_located_file_is_its_folder_joined_with_what_the_model_wrote(tmp_path: Path) -> None:
-    """locate joins each filename's folder once and then its name (`_below`): the same Path as
-    pathlib's join of the whole, whatever slashes, dots and `..` the name holds."""
+    """locate gives the Path of pathlib's join of the whole, whatever slashes, dots and `..` the
+    name holds, each time it is asked."""
     resolver = PackageResolver(search_path=[], package_map={"pkg": tmp_path / "pkg"})
     written = ["a.stl", "m/a.stl", "m/a.stl", "m/b.stl", "m//n/./a.stl", "m/../a.stl", "m/", "m/.",
                "/abs/a.stl", "//net/a.stl", "/", "", ".", "..", "m/n/", "./m/a.stl", "m/a.stl/"]
-    for _ in range(2):  # the second time from the folders joined the first
+    for _ in range(2):
         for name in written:
             for uri, folder in ((f"package://pkg/{name}", tmp_path / "pkg"), (name, tmp_path / "urdf")):
                 found, why = resolver.locate(uri, tmp_path / "urdf")
@@ -88,8 +88,8 @@ def test_a_located_file_is_its_folder_joined_with_what_the_model_wrote(tmp_path:
 
 
 def test_the_roots_a_refusal_asks_for_follow_every_package_found_between_two_meshes(tmp_path: Path) -> None:
-    """_package_roots keeps the roots of each set of folders by their identities: a package
-    found (or a model folder's parent) since the last mesh still counts."""
+    """_package_roots answers from the folders known at each ask: a package found (or a model
+    folder's parent) since the last mesh still counts."""
     for name in ("pkg", "other", "urdf"):
         (tmp_path / name / "meshes").mkdir(parents=True)
         (tmp_path / name / "meshes" / "a.stl").write_bytes(b"solid\n")
