@@ -18,6 +18,7 @@ import re
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -61,7 +62,7 @@ def _tracked_files(to: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def team(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def team(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """A definitions repository that pins this mpc (a wheel built from this checkout)."""
     top = tmp_path_factory.mktemp("team")
     fleet(top / "fleet")
@@ -90,7 +91,8 @@ def team(tmp_path_factory: pytest.TempPathFactory) -> Path:
     _git(top, "commit", "-qm", "the fleet")
     done = mpc("ci", "gitlab", "fleet/pipeline.yml", "-o", "child.yml", cwd=top)
     assert (done.returncode, done.stdout) == (0, "wrote child.yml: 4 models, 5 jobs\n"), done.stderr
-    return top
+    yield top
+    shutil.rmtree(top / ".gitlab-ci-local", ignore_errors=True)  # its jobs' venvs: 1.8 GB
 
 
 @pytest.fixture(scope="module")
