@@ -194,27 +194,33 @@ def _digest(k: MeshKey) -> str:
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
          robot: Robot | None = None) -> bool:
-    """Write each planned mesh into `out` (`contents`), leaving those already there."""
+    """Write each planned mesh into `out` (`contents`), leaving those already there. The digest
+    of each one written from the cache is noted (core/cache.note_written): keeping the build
+    (compiler/build_cache.py) need not read it again."""
+    from mpc.core.cache import note_written
     from mpc.core.files import confined, copy_file
 
     # Written already (by another export of the build): asked without resolving the path, which
     # `confined` does for each file written, below; a name that is not inside the output is
     # never taken as written, and is refused there.
+    digests: dict[str, str] = {}
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
-                         and (out / rel).exists())
+                         and (out / rel).exists(), digests)
     for rel, content in found.items():
         dest = confined(out, rel)
         dest.parent.mkdir(parents=True, exist_ok=True)
         if isinstance(content, bytes):
             dest.write_bytes(content)
+            note_written(dest, digests[rel])
         else:
             copy_file(content, dest)  # a regular file, checked when the model was read
     return ok
 
 
 def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Robot | None = None,
-             skip: Callable[[str], bool] = lambda rel: False) -> tuple[dict[str, bytes | Path], bool]:
+             skip: Callable[[str], bool] = lambda rel: False, digests: dict[str, str] | None = None,
+             ) -> tuple[dict[str, bytes | Path], bool]:
     """What each planned mesh is, by its file name: the bytes of the result of its ops, or the
     source file to copy as it is; and whether none failed. A mesh that fails is reported and
     left out; one for which `skip(name)` holds is left out silently.
@@ -223,13 +229,14 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     the source's bytes, the ops and the format, and computed in parallel (a process pool)
     when several are missing; a later build with the same inputs only reads them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
+    digests: filled with the SHA-256 of each mesh given as bytes, by its file name.
     """
-    from mpc.core.cache import load_entry, notes_file, remove_entry, touch_entry
+    from mpc.core.cache import notes_file, read_entry, remove_entry, touch_entry
     from mpc.core.files import describe
 
     ok = True
     todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
-    entries: dict[Path, bytes] = {}
+    entries: dict[Path, tuple[bytes, str]] = {}
     plan_: list[tuple[Path, str]] = []
     found: dict[str, bytes | Path] = {}
     users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
@@ -256,7 +263,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             continue
         try:
             cached = _cached_path(src, ops, os.path.splitext(name)[1])
-            data, bad = load_entry(cached)
+            data, bad, digest = read_entry(cached)
             if bad is not None:
                 sink.warning(where(src, ops)[0], "W0650", f"the cache entry '{cached}' of mesh '{rel}' "
                              f"is unusable ({bad}); it is removed and computed again")
@@ -268,7 +275,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
         if data is None:
             todo[cached] = (src, ops, cached)
         else:
-            entries[cached] = data
+            entries[cached] = data, digest
             touch_entry(cached)
         plan_.append((cached, rel))
     problems = _compute(list(todo.values()))
@@ -281,13 +288,13 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             ok = False
             continue
         if source in todo:
-            data, bad = load_entry(source)
+            data, bad, digest = read_entry(source)
             if data is None:  # written a moment ago: only a cache changed under us gets here
                 sink.error(where(*todo[source][:2])[0], "E0652", f"mesh '{rel}': the cache entry "
                            f"'{source}' cannot be read back ({bad or 'it is gone'})")
                 ok = False
                 continue
-            entries[source] = data
+            entries[source] = data, digest
         ignored = notes_file(source)
         if source in entries and ignored.is_file():  # the entry records what computing it ignored
             src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
@@ -295,7 +302,12 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
-        found[rel] = entries.get(source, source)
+        if source in entries:
+            found[rel], digest = entries[source]
+            if digests is not None:
+                digests[rel] = digest
+        else:
+            found[rel] = source
     return found, ok
 
 

@@ -16,10 +16,11 @@ from typing import Any
 
 from mpc.backends.xml import fmt_float
 
-# Strings PyYAML writes plain: a letter or '_' first, then names, paths and numbers, single
-# spaces inside; no indicator, no ': ' or ' #', nothing YAML 1.1 reads as another type.
+# Strings PyYAML writes plain: a letter or '_' first (after any '../', a relative path's), then
+# names, paths and numbers, single spaces inside; no indicator, no ': ' or ' #', nothing YAML
+# 1.1 reads as another type.
 _PLAIN_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_./-]*(?: [A-Za-z0-9_./-]+)*")
-_PLAIN = re.compile(r"[A-Za-z_](?:[A-Za-z0-9_./-]|:(?=[^ ]))*(?: (?:[A-Za-z0-9_./-]|:(?=[^ ]))+)*")
+_PLAIN = re.compile(r"(?:\.\./)*[A-Za-z_](?:[A-Za-z0-9_./-]|:(?=[^ ]))*(?: (?:[A-Za-z0-9_./-]|:(?=[^ ]))+)*")
 _NOT_STR = frozenset(w for word in ("yes", "no", "true", "false", "on", "off", "null", "y", "n")
                      for w in (word, word.capitalize(), word.upper()))
 _LONGEST_KEY, _LONGEST_TEXT = 60, 1000
@@ -58,7 +59,7 @@ def _scalar(value: Any) -> str:
     if type(value) is float:
         return float_text(value)
     if type(value) is str:
-        return _text(value, _LONGEST_TEXT)
+        return _text(value, _LONGEST_TEXT) if value else "''"
     if value == {}:
         return "{}"
     if value == []:

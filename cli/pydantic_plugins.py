@@ -18,7 +18,6 @@ from __future__ import annotations
 import sys
 import types
 from collections.abc import Iterable
-from importlib.abc import Loader, MetaPathFinder
 from importlib.machinery import ModuleSpec
 
 PRIVATE = "pydantic.plugin._loader"
@@ -32,9 +31,11 @@ def _get_plugins() -> Iterable[object]:
 REPLACED = {"get_plugins": _get_plugins}
 
 
-class _StandIn(MetaPathFinder, Loader):
+class _StandIn:
     """Finds and makes the stand-in when pydantic imports its loader (a finder first on
-    `sys.meta_path`): a run that never validates a definition imports nothing of pydantic."""
+    `sys.meta_path`): a run that never validates a definition imports nothing of pydantic.
+    The finder and loader protocols without importlib.abc's classes, whose import (through
+    importlib.resources) every `mpc` process would pay."""
 
     def find_spec(self, name: str, path: object = None, target: object = None) -> ModuleSpec | None:
         return ModuleSpec(name, self, origin=None) if name == PRIVATE else None

@@ -38,7 +38,8 @@ def load_model(path: Path, sink: Sink, package: dict[str, Path] | None = None) -
                    "built folder")
         return None
     from mpc.compiler.driver import Options
-    from mpc.compiler.front_end import InputLoader, apply, load_program
+    from mpc.compiler.front_end import InputLoader, load_program
+    from mpc.compiler.ops_run import apply
     from mpc.core.packages import PackageResolver
 
     options = Options(resolver=PackageResolver(package_map=dict(package or {})))

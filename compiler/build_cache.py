@@ -97,13 +97,19 @@ class KeptBuild:
         self.folder, self.key, self.options = folder, key, options
         self.entry = folder / "entry"
         self.header: dict[str, Any] | None = None  # the kept build, its model's dependencies hold
-        self.outputs_hold = False  # … and those of its outputs
+        self.outputs_hold = False  # … and those of its outputs (never for --force)
         self.model_used = False  # this build took the kept program and robot
+        self.program_used = False  # … the kept program alone (--force)
         self.refused: str | None = None  # why the entry found was not read (W0650), if it was not
-        self._model_json = b""  # the kept program and robot as the entry holds them, and read:
+        # the kept program and robot as the entry holds them, and read:
+        self._program_json, self._robot_json = b"", b""
+        self._program: Program | None = None
         self._model: tuple[Program, Robot] | None = None
         self.recorder = ReadRecorder(ignore=[cache.cache_dir("")])  # derived data, commits' checkouts
-        self.front_reads: int | None = None  # how many of the files recorded the front end opened
+        self.front_reads: int | None = None  # how many of the files recorded the model's reads
+        self.front_said = 0  # how many of the model's diagnostics the front end said
+        self._sink: Sink | None = None  # where this build reports, from `recording`
+        self._said_before = 0
         self.started = time.time_ns()
 
     @classmethod
@@ -127,8 +133,7 @@ class KeptBuild:
         name = hashlib.sha256(json.dumps(where).encode()).hexdigest()
         kept = cls(cache.cache_dir("builds") / name[:2] / name, hashlib.sha256(key.encode()).hexdigest(),
                    options)
-        if not options.force:
-            kept._load()
+        kept._load()
         return kept
 
     def report_refused(self, sink: Sink, span: Span) -> None:
@@ -150,25 +155,41 @@ class KeptBuild:
         assert self.header is not None
         return self.header["span"]  # type: ignore[no-any-return]
 
+    @property
+    def force(self) -> bool:
+        """`--force`: the kept program may be used, the robot and the outputs are built anew."""
+        return self.options.force
+
+    def program(self) -> Program:
+        """The kept program, read when first asked for; raises BadValue when the entry does not
+        hold one."""
+        assert self.header is not None
+        if self._program is None:
+            from mpc.ir.program import Program
+
+            program = loads(self._program_json)
+            _check(isinstance(program, Program), "program")
+            self._program = program
+        return self._program
+
     def model(self) -> tuple[Program, Robot]:
         """The kept program and robot, read when first asked for (a build that writes its kept
         outputs seldom needs them); raises BadValue when the entry does not hold them."""
-        assert self.header is not None
         if self._model is None:
-            model = loads(self._model_json)
-            from mpc.ir.program import Program
+            program = self.program()
             from mpc.ir.robot import Robot
 
-            _check(type(model) is tuple and len(model) == 2 and isinstance(model[0], Program)
-                   and isinstance(model[1], Robot), "program and robot")
-            self._model = model
+            robot = loads(self._robot_json)
+            _check(isinstance(robot, Robot), "robot")
+            self._model = program, robot
         return self._model
 
     def model_holds(self, sink: Sink, span: Span) -> bool:
-        """Whether the kept program and robot can be read; when not, the entry is refused
-        (W0650 into `sink`, at `span`) and forgotten: the front end runs."""
+        """Whether what this build may take from the entry can be read (the program and robot,
+        the program alone for --force); when not, the entry is refused (W0650 into `sink`, at
+        `span`) and forgotten: the front end runs."""
         try:
-            self.model()
+            self.program() if self.force else self.model()
         except BadValue as e:
             self._refuse(f"it is not a kept build: {e}")
             self.header, self.outputs_hold = None, False
@@ -179,10 +200,18 @@ class KeptBuild:
     def replay_model(self, sink: Sink) -> tuple[Program, Robot] | tuple[None, None]:
         """The kept program and robot (`model_holds` said they can be read), their diagnostics
         reported into `sink` again; (None, None) when `sink` makes one of them an error (--werror)."""
-        assert self.header is not None
+        assert self.header is not None and not self.force
         self.model_used = True
         _report(sink, self.header["diagnostics"])
         return (None, None) if sink.has_errors() else self.model()
+
+    def replay_program(self, sink: Sink) -> Program | None:
+        """The kept program (--force; `model_holds` said it can be read), the front end's
+        diagnostics reported into `sink` again; None when `sink` makes one an error (--werror)."""
+        assert self.header is not None and self.force
+        self.program_used = True
+        _report(sink, self.header["diagnostics"][:self.header["front"]])
+        return None if sink.has_errors() else self.program()
 
     def write_outputs(self, staging: Path) -> bool:
         """Copy the kept outputs into `staging`; False (nothing reported) when one is not the
@@ -227,9 +256,16 @@ class KeptBuild:
     # -- keeping ---------------------------------------------------------------------------------
 
     @contextlib.contextmanager
-    def recording(self) -> Iterator[None]:
+    def recording(self, sink: Sink) -> Iterator[None]:
+        """Record what the build reads, and (`program_done`) what its front end says into `sink`."""
+        self._sink, self._said_before = sink, len(sink.diagnostics)
         with recording(self.recorder):
             yield
+
+    def program_done(self) -> None:
+        """The front end has made the program: what it said so far is the front end's."""
+        assert self._sink is not None
+        self.front_said = len(self._sink.diagnostics) - self._said_before
 
     def front_end_done(self) -> None:
         """What was opened so far is what the program and the robot depend on."""
@@ -244,23 +280,29 @@ class KeptBuild:
         header: dict[str, Any]
         if self.header is not None and self.model_used:
             header = {**self.header, "outputs": None}
-            model_json = self._model_json
+            model_json = self._program_json, self._robot_json
         else:
             model_files = _digests(self.recorder.inputs(first=self.front_reads), self.started)
             if model_files is None:
                 return
+            packages = {(p, n): f for (p, n), f in self.recorder.packages.items()}
+            if self.header is not None and self.program_used:
+                # the program's dependencies, read by the build that made it, still hold
+                model_files = list({**dict(self.header["files"]), **dict(model_files)}.items())
+                packages = {(p, n): f for p, n, f in self.header["packages"]} | packages
             paths = list[PurePath]()
             try:
-                model_json = dumps((program, robot), paths)
+                model_json = dumps(program, paths), dumps(robot, paths)
                 diagnostics = _kept_diagnostics(model_diagnostics)
             except (TypeError, ValueError, RecursionError):
                 return  # a value that cannot be kept: the next build runs in full
+            front = len(_kept_diagnostics(model_diagnostics[:self.front_said]))
             opened = {f for f, _ in model_files}
             header = {"key": self.key, "files": model_files,
                       "named": [(p, *_where(p)) for p in sorted(set(map(str, paths)) - opened)],
-                      "packages": sorted((p, n, f) for (p, n), f in self.recorder.packages.items()),
-                      "diagnostics": diagnostics, "modelname": program.modelname, "span": program.span,
-                      "outputs": None}
+                      "packages": sorted((p, n, f) for (p, n), f in packages.items()),
+                      "diagnostics": diagnostics, "front": front, "modelname": program.modelname,
+                      "span": program.span, "outputs": None}
         from mpc.backends.formats import FORMATS
 
         with contextlib.suppress(OSError):
@@ -299,8 +341,11 @@ class KeptBuild:
                     shutil.rmtree(copy, ignore_errors=True)
                     return None
                 copy_file(source, target)
-                with open(target, "rb") as f:
-                    names.append((str(rel / name), hashlib.file_digest(f, "sha256").hexdigest()))
+                digest = cache.written_digest(source)  # a mesh out of the cache, unchanged since
+                if digest is None:
+                    with open(target, "rb") as f:
+                        digest = hashlib.file_digest(f, "sha256").hexdigest()
+                names.append((str(rel / name), digest))
         return {"folder": copy.name, "files": sorted(names), "folders": sorted(folders), "read": files,
                 "diagnostics": _kept_diagnostics(diagnostics)}
 
@@ -318,7 +363,7 @@ class KeptBuild:
                 self._refuse(why)
             return
         try:
-            header, self._model_json = _read_entry(data)
+            header, self._program_json, self._robot_json = _read_entry(data)
         except BadValue as e:
             self._refuse(f"it is not a kept build: {e}")
             return
@@ -326,8 +371,9 @@ class KeptBuild:
             return
         self.header = header
         outputs = header["outputs"]
-        self.outputs_hold = outputs is not None and _files_hold(outputs["read"])
-        cache.trace(f"reuse build {self.folder.name}" + (" with its outputs" if self.outputs_hold else ""))
+        self.outputs_hold = not self.force and outputs is not None and _files_hold(outputs["read"])
+        cache.trace(f"reuse build {self.folder.name}" + (" with its outputs" if self.outputs_hold else
+                                                         " for its program" if self.force else ""))
 
     def _refuse(self, why: str) -> None:
         """The entry must not be used: say why (`report_refused`) and remove it."""
@@ -347,34 +393,36 @@ class KeptBuild:
 
 
 # -- the entry's form ----------------------------------------------------------------------------
-# Three lines of JSON (JSON escapes every newline in a string): the header, as JSON's own
-# values; the span and the diagnostics of the header, and the program and the robot, each
-# written by compiler/kept_values.py. The program and the robot are read when first asked for.
-_FORM = "mpc kept build 2"
-_HEADER_KEYS = frozenset({"form", "key", "files", "named", "packages", "modelname", "outputs"})
+# Four lines of JSON (JSON escapes every newline in a string): the header, as JSON's own
+# values; the span and the diagnostics of the header, the program, and the robot, each written
+# by compiler/kept_values.py. The program and the robot are read when first asked for. `front`
+# counts the diagnostics (the first ones) that the front end said.
+_FORM = "mpc kept build 3"
+_HEADER_KEYS = frozenset({"form", "key", "files", "named", "packages", "front", "modelname", "outputs"})
 _OUTPUT_KEYS = frozenset({"folder", "files", "folders", "read"})
 _VALUES = ("span", "diagnostics")  # of the header, on the second line
 
 
-def _entry_bytes(header: dict[str, Any], model_json: bytes) -> bytes:
+def _entry_bytes(header: dict[str, Any], model_json: tuple[bytes, bytes]) -> bytes:
     out = header["outputs"]
     plain = {**{k: header[k] for k in _HEADER_KEYS - {"form"}}, "form": _FORM,
              "outputs": None if out is None else {k: out[k] for k in _OUTPUT_KEYS}}
     values = [*(header[k] for k in _VALUES), None if out is None else out["diagnostics"]]
-    return json.dumps(plain, separators=(",", ":")).encode() + b"\n" + dumps(values) + b"\n" + model_json
+    return b"\n".join([json.dumps(plain, separators=(",", ":")).encode(), dumps(values), *model_json])
 
 
-def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes]:
-    """The header (its values read) and the model's JSON of an entry; raises BadValue when it is
-    not an entry of this form, each part of the shape `keep` writes."""
+def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes, bytes]:
+    """The header (its values read), the program's JSON and the robot's of an entry; raises
+    BadValue when it is not an entry of this form, each part of the shape `keep` writes."""
     first, _, rest = data.partition(b"\n")
     second, newline, model_json = rest.partition(b"\n")
+    program_json, newline_, robot_json = model_json.partition(b"\n")
     try:
         header = json.loads(first)
     except (ValueError, RecursionError):  # a pickle of an earlier mpc, say: never unpickled
         raise BadValue("not JSON") from None
     if (type(header) is not dict or header.get("form") != _FORM or header.keys() != _HEADER_KEYS
-            or not newline):
+            or not newline or not newline_):
         raise BadValue("not the header of a kept build")
     _check(type(header["key"]) is str and type(header["modelname"]) is str, "key, model name")
     _check_files(header["files"])
@@ -394,10 +442,11 @@ def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes]:
     _check(type(values) is list and len(values) == 3 and isinstance(values[0], Span)
            and _are_diagnostics(values[1])
            and (values[2] is None if out is None else _are_diagnostics(values[2])), "span and diagnostics")
+    _check(type(header["front"]) is int and 0 <= header["front"] <= len(values[1]), "front end's diagnostics")
     header["span"], header["diagnostics"] = values[0], values[1]
     if out is not None:
         out["diagnostics"] = values[2]
-    return header, model_json
+    return header, program_json, robot_json
 
 
 def _check(holds: bool, what: str) -> None:

@@ -28,6 +28,7 @@ from mpc.core.span import Span
 
 if TYPE_CHECKING:  # a build that writes its kept outputs reads no model (compiler/build_cache.py)
     from mpc.compiler.build_cache import KeptBuild
+    from mpc.compiler.inputs import InputLoader
     from mpc.ir.program import Export, Program
     from mpc.ir.robot import Robot
 
@@ -243,13 +244,18 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         if done is not None:
             return done
     before = len(sink.diagnostics)
-    with kept.recording() if kept is not None else contextlib.nullcontext():
+    with kept.recording(sink) if kept is not None else contextlib.nullcontext():
         with stage("lower"):
             definition = Span.of_file(str(path))
             if kept is not None and kept.header is not None and kept.model_holds(sink, definition):
-                program, robot = kept.replay_model(sink)       # its program and robot
+                if kept.force:                                 # its program, the ops run anew
+                    program, robot = _robot(kept.replay_program(sink), path, sink, options)
+                    kept.front_end_done()
+                else:
+                    program, robot = kept.replay_model(sink)   # its program and robot
             else:
-                program, robot = _program_and_robot(path, sink, options)  # front end, ops
+                program, robot = _program_and_robot(path, sink, options,
+                                                    kept.program_done if kept is not None else None)
                 if kept is not None:
                     kept.front_end_done()
         if program is None or robot is None:
@@ -305,24 +311,56 @@ def _out(options: Options, modelname: str) -> Path:
     return options.out or Path("build") / modelname
 
 
-def _program_and_robot(path: Path, sink: Sink, options: Options) -> tuple[Program | None, Robot | None]:
-    """The front end and the ops: (program, robot), either None after errors."""
-    from mpc.compiler.front_end import apply, input_loader, load_program
+def _program_and_robot(path: Path, sink: Sink, options: Options,
+                       program_done: Callable[[], None] | None = None,
+                       ) -> tuple[Program | None, Robot | None]:
+    """The front end and the ops: (program, robot), either None after errors. `program_done`
+    is called when the front end has said all it says."""
+    from mpc.compiler.front_end import load_program
+    from mpc.compiler.ops_run import input_loader
 
     try:
         loader = input_loader(sink, options, (resolved(path),))
         program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
-        if program is None:
-            return None, None
-        if not options.post_processing:  # --no-post-processing
-            from dataclasses import replace
+    except OSError as e:
+        return _unreadable(path, sink, e)
+    if program_done is not None:
+        program_done()
+    if program is not None and not options.post_processing:  # --no-post-processing
+        from dataclasses import replace
 
-            from mpc.ir.program import CommandExport
+        from mpc.ir.program import CommandExport
 
-            program = replace(program, exports=tuple(e for e in program.exports
-                                                     if not isinstance(e, CommandExport)))
-        with stage("apply ops"):
-            return program, apply(program, sink, loader)                  # read inputs, apply ops
-    except OSError as e:  # what the readers do not report themselves (a name too long, say)
-        sink.error(Span.of_file(str(path)), "E0661", describe(e, "read an input of the model"))
+        program = replace(program, exports=tuple(e for e in program.exports
+                                                 if not isinstance(e, CommandExport)))
+    return _robot(program, path, sink, options, loader)
+
+
+def _robot(program: Program | None, path: Path, sink: Sink, options: Options,
+           loader: InputLoader | None = None) -> tuple[Program | None, Robot | None]:
+    """The program's inputs read and its ops run: (program, robot), either None after errors.
+
+    loader: the front end's, which read the inputs for their names and said what their readers
+    say. Without it (the program is a kept build's, whose diagnostics were said again) the
+    inputs are read anew, and what their readers say is said only with an error: the front end
+    that made the program said it."""
+    from mpc.compiler.ops_run import apply, input_loader
+
+    if program is None:
         return None, None
+    quiet = Sink()
+    try:
+        with stage("apply ops"):                                          # read inputs, apply ops
+            robot = apply(program, sink, loader or input_loader(quiet, options, (resolved(path),)))
+    except OSError as e:
+        return _unreadable(path, sink, e)
+    if quiet.has_errors():
+        for diagnostic in quiet.diagnostics:
+            sink.report(diagnostic)
+    return program, robot
+
+
+def _unreadable(path: Path, sink: Sink, error: OSError) -> tuple[None, None]:
+    """What the readers do not report themselves (a name too long, say)."""
+    sink.error(Span.of_file(str(path)), "E0661", describe(error, "read an input of the model"))
+    return None, None

@@ -1,20 +1,20 @@
-"""A definition (or an IR file) → its program and its robot; nothing is written.
+"""A definition (or an IR file) → its program; nothing is written.
 
 The front end loads the YAML, merges its defaults, validates it against the schema, lowers
-it and runs the passes (compiler/passes/); `apply` reads the input models and runs the
-program's ops on them. `mpc check` and `mpc lsp` stop after the front end; compiling
+it and runs the passes (compiler/passes/); compiler/ops_run.py reads the input models and runs
+the program's ops on them. `mpc check` and `mpc lsp` stop after the front end; compiling
 (compiler/driver.py) goes on to write the outputs, and imports this module only when its
-build cache (compiler/build_cache.py) holds no build of the same inputs.
+build cache (compiler/build_cache.py) holds no program of the same inputs.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 from mpc.compiler import inherit, schema
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.lower import lower
+from mpc.compiler.ops_run import input_loader
 from mpc.compiler.options import Options
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
@@ -22,11 +22,8 @@ from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Severity, Sink
 from mpc.core.files import describe, resolved
 from mpc.core.span import Span
-from mpc.ir.names import Names
-from mpc.ir.ops import ROOT, Attach, Effects, LoadModel
-from mpc.ir.ops.assembly import r2r_origin
+from mpc.ir.ops import LoadModel
 from mpc.ir.program import Program
-from mpc.ir.robot import Robot
 
 
 def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
@@ -130,59 +127,6 @@ def check_output_names(program: Program, sink: Sink) -> bool:
             sink.error(span, "E0250", f"'{field_}': cannot name a file in the output: {why}")
             ok = False
     return ok
-
-
-def input_loader(sink: Sink, options: Options, stack: tuple[Path, ...],
-                 symbolic: bool = False) -> InputLoader:
-    """The loader of one compilation's inputs, which builds derived_base definitions (or finds
-    their names, `symbolic`) with this module's front end."""
-    return InputLoader(sink, options, stack, symbolic, build=build, names_of=names_of)
-
-
-def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
-    """The names of another definition's output, found without building it."""
-    loader = input_loader(sink, options, stack, symbolic=True)
-    program = front_end(path, sink, options, Severity.WARNING, loader)
-    return symbolic(program, PassContext(sink, loader.names, Severity.WARNING)) if program else None
-
-
-def apply(program: Program, sink: Sink, loader: InputLoader) -> Robot | None:
-    """Read the inputs and run the ops; the robot or None."""
-    parts: dict[str, Robot] = {}
-    originals: dict[str, Robot] = {}
-    for op in program.ops:
-        if isinstance(op, LoadModel):
-            inp = program.inputs[op.input]
-            robot = loader.robot(inp)
-            if robot is None:
-                return None
-            if not inp.smurf_data:
-                from mpc.ir.smurf_data import without_smurf_data
-
-                robot = without_smurf_data(robot)
-            parts[op.part] = originals[op.part] = robot
-        elif isinstance(op, Attach):
-            op = op.resolved(Names.of(parts[op.part]), Names.of(parts[op.child]))
-            if op.r2r is not None:
-                op = replace(op, origin=r2r_origin(op, originals[op.part], originals[op.child]))
-            from mpc.ir.reroot import RerootError
-
-            try:
-                parts[op.part] = op.attach(parts[op.part], parts.pop(op.child))
-            except RerootError as error:
-                sink.error(op.span_of("child_link"), "E0551", f"cannot re-root the child model at "
-                           f"'{op.child_link}' to attach it there: {error}")
-                return None
-        else:
-            parts[op.part] = op.apply(parts[op.part], Effects(sink, op))
-    return None if sink.has_errors() else parts[ROOT]
-
-
-def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
-    """The robot another definition describes, built in memory (for derived_base)."""
-    loader = input_loader(sink, options, stack)
-    program = front_end(path, sink, options, Severity.ERROR, loader)
-    return apply(program, sink, loader) if program else None
 
 
 def check_file(path: Path, sink: Sink, options: Options, doc: source.Document | None = None) -> None:

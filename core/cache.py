@@ -59,20 +59,43 @@ def store_entry(entry: Path, data: bytes) -> None:
 def load_entry(entry: Path) -> tuple[bytes | None, str | None]:
     """(bytes, None) for a sound entry; (None, None) when there is none; (None, why) for an
     entry that must not be used (remove it with `remove_entry`, then compute it again)."""
+    data, why, _ = read_entry(entry)
+    return data, why
+
+
+def read_entry(entry: Path) -> tuple[bytes | None, str | None, str]:
+    """`load_entry`'s answer, with the SHA-256 (hex) of a sound entry's bytes ("" otherwise)."""
     if not entry.exists() and not entry.is_symlink():
-        return None, None
+        return None, None, ""
     try:
         if entry.is_symlink() or not entry.is_file():
-            return None, "it is not a regular file"
+            return None, "it is not a regular file", ""
         data = entry.read_bytes()
         expected = _hash_file(entry).read_text(encoding="ascii").strip()
     except FileNotFoundError:  # an unfinished write (or an older mpc's): no entry yet
-        return None, None
+        return None, None, ""
     except (OSError, UnicodeDecodeError) as e:
-        return None, f"it cannot be read ({e})"
+        return None, f"it cannot be read ({e})", ""
     if hashlib.sha256(data).hexdigest() != expected:
-        return None, "its bytes do not match their hash"
-    return data, None
+        return None, "its bytes do not match their hash", ""
+    return data, None, expected
+
+
+def note_written(path: Path, digest: str) -> None:
+    """Remember that `path`, just written by this process, holds bytes of SHA-256 `digest`:
+    `written_digest` answers without reading it while it is the same file, unchanged."""
+    st = os.stat(path)
+    _written[(st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)] = digest
+
+
+def written_digest(path: Path) -> str | None:
+    """The SHA-256 noted for `path` (`note_written`) if it is still that file, unchanged (any
+    write changes its status time); else None."""
+    st = os.stat(path)
+    return _written.get((st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns))
+
+
+_written: dict[tuple[int, int, int, int, int], str] = {}
 
 
 def touch_entry(entry: Path) -> None:

@@ -13,7 +13,7 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from mpc.compiler import front_end
+from mpc.compiler import front_end, ops_run
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.options import Options
 from mpc.compiler.passes import PassContext, run_passes
@@ -153,7 +153,7 @@ class Analysis:
         """The robot the definition describes (its ops applied), built once when asked."""
         if self._built is None and self.ran is not None and self.loader is not None:
             sink = Sink()
-            self._built = front_end.apply(self.ran, sink, replace(self.loader, sink=sink))
+            self._built = ops_run.apply(self.ran, sink, replace(self.loader, sink=sink))
         return self._built
 
 
@@ -183,7 +183,7 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
 def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, options: Options) -> None:
     """The front end and passes of front_end.front_end, keeping the program and the names per op."""
     path = analysis.path
-    loader = front_end.input_loader(sink, options, (resolved(path),), symbolic=True)
+    loader = ops_run.input_loader(sink, options, (resolved(path),), symbolic=True)
     lowered = front_end.front_end(path, sink, options, Severity.WARNING, loader, doc=doc, passes=False)
     if lowered is None:
         return

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mpc.backends import smurf, urdf
+from mpc.backends import smurf, smurf_reader, urdf
 from mpc.core.diagnostics import Severity, Sink
 from mpc.core.span import Span
 from mpc.ir.extras import CutJoint, Motor, Sensor, Submechanism
@@ -83,7 +83,7 @@ def test_round_trip_is_byte_identical(model: str, tmp_path: Path, diags: Diags) 
     assert robot is not None
     robot = annotated(robot)
     first = emitted(robot, tmp_path / "a", diags)
-    back = smurf.read(tmp_path / f"a/smurf/{robot.name}.smurf", diags)
+    back = smurf_reader.read(tmp_path / f"a/smurf/{robot.name}.smurf", diags)
     assert back is not None
     second = emitted(back, tmp_path / "b", diags)
     assert first.keys() == second.keys()
@@ -116,7 +116,7 @@ def test_smurf_linking_an_sdf_reads_back(tmp_path: Path, diags: Diags) -> None:
     sdf.emit(robot, SdfExport(mesh_format="input_type", span=SPAN), tmp_path, diags)
     diags.take("W0500", Severity.WARNING)  # mimic joints, motors, … (SDF cannot hold them)
     smurf.emit(robot, SmurfExport(span=SPAN, model_file="sdf/talos.sdf"), tmp_path, diags)
-    back = smurf.read(tmp_path / "smurf/talos.smurf", diags)
+    back = smurf_reader.read(tmp_path / "smurf/talos.smurf", diags)
     assert back is not None
     assert back.motors == robot.motors and back.poses == robot.poses
     for name, link in robot.links.items():
@@ -365,7 +365,7 @@ def test_renaming_in_a_derived_model_renames_what_the_smurf_names(tmp_path: Path
         "    model: ur5\n", "    model: ur5\n    name_editing: {prefix: r_}\n"))
     run = mpc("compile", tmp_path / "right.yml", "-o", tmp_path / "out")
     assert run.returncode == 0, run.stderr
-    robot = smurf.read(tmp_path / "out/smurf/ur5.smurf", diags)
+    robot = smurf_reader.read(tmp_path / "out/smurf/ur5.smurf", diags)
     assert robot is not None
     assert {m.joint for m in robot.motors.values()} == {"r_shoulder_pan_joint", "r_elbow_joint"}
     assert robot.sensors["wrist_imu"].link == "r_wrist_3_link"

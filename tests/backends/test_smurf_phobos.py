@@ -9,7 +9,7 @@ from pathlib import Path
 
 import yaml
 
-from mpc.backends import smurf, urdf
+from mpc.backends import smurf, smurf_reader, urdf
 from mpc.core.span import Span
 from mpc.ir.program import SmurfExport, UrdfExport
 from tests.conftest import Diags, write
@@ -94,7 +94,7 @@ def test_read_write_read_is_stable_for_phobos_files_and_for_mpcs(tmp_path: Path,
     outputs = []
     source = tmp_path / "release/smurf/fourbar.smurf"
     for i in range(3):
-        robot = smurf.read(source, diags)
+        robot = smurf_reader.read(source, diags)
         assert robot is not None
         out = tmp_path / f"round{i}"
         urdf.emit(robot, UrdfExport(mesh_format="input_type", span=span), out, diags)

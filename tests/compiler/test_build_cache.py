@@ -3,7 +3,7 @@ build_cache.py); anything the build depends on that changed makes it build again
 
 Each test compiles in a cache of its own and counts what the cache did through MPC_CACHE_TRACE:
 `keep build` when a build is kept, `reuse build` when its program and robot are taken, `… with
-its outputs` when its outputs are.
+its outputs` when its outputs are, `… for its program` when its program alone is (--force).
 """
 
 from __future__ import annotations
@@ -69,7 +69,8 @@ def _build(spec: Path, out: Path, trace: Path, sink: Sink | None = None) -> tupl
 
 def _events(trace: Path) -> list[str]:
     lines = trace.read_text().splitlines() if trace.exists() else []
-    return [" ".join(line.split()[1:3]) + (" with its outputs" if line.endswith("outputs") else "")
+    return [" ".join(line.split()[1:3]) + (" with its outputs" if line.endswith("outputs") else
+                                           " for its program" if line.endswith("program") else "")
             for line in lines if " build " in line]
 
 
@@ -311,12 +312,68 @@ def test_a_build_whose_files_changed_as_it_ran_is_not_kept(tmp_path: Path, trace
     assert _build(spec, tmp_path / "out", trace)[2] == ["keep build"]
 
 
-def test_force_builds_anew_and_keeps_that_build(tmp_path: Path, trace: Path) -> None:
+def test_force_builds_anew_from_the_kept_program_and_keeps_that_build(
+        tmp_path: Path, trace: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """--force reads the inputs, runs the ops and writes every output again; the program (what
+    the front end made of the unchanged definition) is the kept one, its diagnostics said once."""
     spec = _model(tmp_path / "model")
-    _build(spec, tmp_path / "out1", trace)
+    first, said, _ = _build(spec, tmp_path / "out1", trace)
+    built = _files(tmp_path / "out1")
+    (tmp_path / "out1/urdf/arm.urdf").write_text("changed by hand\n")
+    (tmp_path / "out1/extra.txt").write_text("not an output\n")
+
+    def no_front_end(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the front end ran")
+
+    read = []
+    from mpc.compiler import inputs
+
+    parse = inputs.InputLoader._parse
     sink = Sink()
+    with monkeypatch.context() as patch:
+        patch.setattr(front_end, "load_program", no_front_end)
+        patch.setattr(inputs.InputLoader, "_parse", lambda self, path, *a: read.append(path.name)
+                      or parse(self, path, *a))
+        result = compile_model(spec, sink, Options(out=tmp_path / "out1", force=True))
+    assert result.out is not None and _events(trace)[1:] == ["reuse build for its program", "keep build"]
+    assert read == ["arm.urdf"]  # the input model, read anew
+    assert _files(tmp_path / "out1") == built  # every output written anew, and only those
+    assert _said(sink) == _said(said)  # W0401 of the input model, once
+    assert result.program == first.program and result.robot == first.robot
+    _, _, events = _build(spec, tmp_path / "out2", trace)  # the build it kept
+    assert events == ["reuse build with its outputs"] and _files(tmp_path / "out2") == built
+
+
+def test_force_runs_the_front_end_on_a_changed_definition(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    spec.write_text(spec.read_text().replace("robotname: arm", "robotname: limb"))
+    _settle()
+    result = compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
+    assert _events(trace)[1:] == ["keep build"]
+    assert result.out is not None and sorted(p.name for p in (result.out / "urdf").iterdir()) == ["limb.urdf"]
+
+
+def test_werror_with_force_fails_on_the_kept_programs_warnings(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    sink = Sink(werror=True)
     result = compile_model(spec, sink, Options(out=tmp_path / "out2", force=True))
-    assert result.out is not None and _events(trace)[1:] == ["keep build"]
+    assert result.out is None and not (tmp_path / "out2").exists()
+    assert [(d.severity, d.code) for d in sink.diagnostics] == [(Severity.ERROR, "W0401")]
+
+
+def test_a_forced_compile_in_a_new_process_imports_no_schema(tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    assert _build(spec, tmp_path / "out1", trace)[2] == ["keep build"]
+    code = ("import sys; from mpc.cli.main import main; code = main(['compile', sys.argv[1], '-o', "
+            "sys.argv[2], '--force']); print('pydantic' in sys.modules, "
+            "'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
+    done = subprocess.run([sys.executable, "-c", code, str(spec), str(tmp_path / "out2")],
+                          capture_output=True, text=True, env=os.environ, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "False False"
+    assert _events(trace)[-2:] == ["reuse build for its program", "keep build"]
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
 
 
