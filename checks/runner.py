@@ -39,7 +39,8 @@ ALWAYS = ("topological_self_consistency", "file_consistency", "physical_validity
 def apply_program(program: Program, sink: Sink) -> Robot | None:
     """The robot the program describes (its inputs read, its ops run), or None."""
     from mpc.compiler.driver import Options
-    from mpc.compiler.ops_run import apply, input_loader
+    from mpc.compiler.front_end import input_loader
+    from mpc.compiler.ops_run import apply
 
     loader = input_loader(sink, Options(), (resolved(program.span.file),))
     return apply(program, sink, loader)

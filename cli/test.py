@@ -16,8 +16,8 @@ def run(args: argparse.Namespace) -> int:
     """1 when a test failed and was not waived, or nothing could be tested."""
     from mpc.checks import run_model_tests
     from mpc.compiler.driver import Options, compile_model
-    from mpc.compiler.front_end import load_program
-    from mpc.compiler.ops_run import apply, input_loader
+    from mpc.compiler.front_end import input_loader, load_program
+    from mpc.compiler.ops_run import apply
 
     sink = sink_of(args)
     options = Options(out=args.out, resolver=resolver_of(args))

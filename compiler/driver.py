@@ -316,8 +316,7 @@ def _program_and_robot(path: Path, sink: Sink, options: Options,
                        ) -> tuple[Program | None, Robot | None]:
     """The front end and the ops: (program, robot), either None after errors. `program_done`
     is called when the front end has said all it says."""
-    from mpc.compiler.front_end import load_program
-    from mpc.compiler.ops_run import input_loader
+    from mpc.compiler.front_end import input_loader, load_program
 
     try:
         loader = input_loader(sink, options, (resolved(path),))
@@ -344,20 +343,29 @@ def _robot(program: Program | None, path: Path, sink: Sink, options: Options,
     say. Without it (the program is a kept build's, whose diagnostics were said again) the
     inputs are read anew, and what their readers say is said only with an error: the front end
     that made the program said it."""
-    from mpc.compiler.ops_run import apply, input_loader
+    from mpc.compiler.inputs import InputLoader
+    from mpc.compiler.ops_run import apply
 
     if program is None:
         return None, None
     quiet = Sink()
+    loader = loader or InputLoader(quiet, options, (resolved(path),), build=_derived_base)
     try:
         with stage("apply ops"):                                          # read inputs, apply ops
-            robot = apply(program, sink, loader or input_loader(quiet, options, (resolved(path),)))
+            robot = apply(program, sink, loader)
     except OSError as e:
         return _unreadable(path, sink, e)
     if quiet.has_errors():
         for diagnostic in quiet.diagnostics:
             sink.report(diagnostic)
     return program, robot
+
+
+def _derived_base(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
+    """A derived_base definition built by the front end, for a loader made without it."""
+    from mpc.compiler.front_end import build
+
+    return build(path, sink, options, stack)
 
 
 def _unreadable(path: Path, sink: Sink, error: OSError) -> tuple[None, None]:

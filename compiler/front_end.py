@@ -14,7 +14,7 @@ from pathlib import Path
 from mpc.compiler import inherit, schema
 from mpc.compiler.inputs import InputLoader
 from mpc.compiler.lower import lower
-from mpc.compiler.ops_run import input_loader
+from mpc.compiler.ops_run import apply
 from mpc.compiler.options import Options
 from mpc.compiler.passes import PassContext, run_passes
 from mpc.compiler.passes.check_names import symbolic
@@ -22,8 +22,10 @@ from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Severity, Sink
 from mpc.core.files import describe, resolved
 from mpc.core.span import Span
+from mpc.ir.names import Names
 from mpc.ir.ops import LoadModel
 from mpc.ir.program import Program
+from mpc.ir.robot import Robot
 
 
 def front_end(path: Path, sink: Sink, options: Options, later: Severity = Severity.ERROR,
@@ -127,6 +129,27 @@ def check_output_names(program: Program, sink: Sink) -> bool:
             sink.error(span, "E0250", f"'{field_}': cannot name a file in the output: {why}")
             ok = False
     return ok
+
+
+def input_loader(sink: Sink, options: Options, stack: tuple[Path, ...],
+                 symbolic: bool = False) -> InputLoader:
+    """The loader of one compilation's inputs, which builds derived_base definitions (or finds
+    their names, `symbolic`) with this module's front end."""
+    return InputLoader(sink, options, stack, symbolic, build=build, names_of=names_of)
+
+
+def names_of(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Names | None:
+    """The names of another definition's output, found without building it."""
+    loader = input_loader(sink, options, stack, symbolic=True)
+    program = front_end(path, sink, options, Severity.WARNING, loader)
+    return symbolic(program, PassContext(sink, loader.names, Severity.WARNING)) if program else None
+
+
+def build(path: Path, sink: Sink, options: Options, stack: tuple[Path, ...]) -> Robot | None:
+    """The robot another definition describes, built in memory (for derived_base)."""
+    loader = input_loader(sink, options, stack)
+    program = front_end(path, sink, options, Severity.ERROR, loader)
+    return apply(program, sink, loader) if program else None
 
 
 def check_file(path: Path, sink: Sink, options: Options, doc: source.Document | None = None) -> None:

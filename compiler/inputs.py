@@ -20,7 +20,7 @@ from mpc.ir.names import Names
 from mpc.ir.program import Input
 from mpc.ir.robot import Robot
 
-# How a derived_base definition is built, or its names found (compiler/ops_run.py's `build`
+# How a derived_base definition is built, or its names found (compiler/front_end.py's `build`
 # and `names_of`, handed to the loader so that loading inputs does not import the front end).
 Build = Callable[[Path, Sink, Options, tuple[Path, ...]], Robot | None]
 FindNames = Callable[[Path, Sink, Options, tuple[Path, ...]], Names | None]
@@ -33,7 +33,7 @@ class InputLoader:
     stack: the definitions being compiled, outermost first (to find cycles).
     symbolic: find the names of derived_base inputs without building them (`mpc check`).
     build, names_of: how a derived_base definition is built or its names found
-        (compiler/ops_run.py `input_loader` gives them).
+        (compiler/front_end.py `input_loader` gives them).
     """
 
     sink: Sink

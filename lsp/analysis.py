@@ -183,7 +183,7 @@ def analyse(path: Path, text: str, open_texts: dict[str, str], options: Options)
 def _check_definition(analysis: Analysis, doc: source.Document, sink: Sink, options: Options) -> None:
     """The front end and passes of front_end.front_end, keeping the program and the names per op."""
     path = analysis.path
-    loader = ops_run.input_loader(sink, options, (resolved(path),), symbolic=True)
+    loader = front_end.input_loader(sink, options, (resolved(path),), symbolic=True)
     lowered = front_end.front_end(path, sink, options, Severity.WARNING, loader, doc=doc, passes=False)
     if lowered is None:
         return

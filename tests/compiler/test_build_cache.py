@@ -354,6 +354,27 @@ def test_force_runs_the_front_end_on_a_changed_definition(tmp_path: Path, trace:
     assert result.out is not None and sorted(p.name for p in (result.out / "urdf").iterdir()) == ["limb.urdf"]
 
 
+def test_force_builds_a_derived_base_from_the_kept_program(tmp_path: Path, trace: Path) -> None:
+    _model(tmp_path / "model")
+    spec = write(tmp_path / "model/derived.yml", """
+        model:
+          robotname: derived
+          modelname: derived-model
+          input_models:
+            base: {derived_base: arm.yml}
+          assemble: {model: base}
+          export_config:
+            - {type: urdf, mesh_format: stl}
+        """)
+    _settle()
+    first, said, _ = _build(spec, tmp_path / "out1", trace)
+    sink = Sink()
+    forced = compile_model(spec, sink, Options(out=tmp_path / "out2", force=True))
+    assert _events(trace)[1:] == ["reuse build for its program", "keep build"]
+    assert forced.robot == first.robot and _files(tmp_path / "out2") == _files(tmp_path / "out1")
+    assert _said(sink) == _said(said)
+
+
 def test_werror_with_force_fails_on_the_kept_programs_warnings(tmp_path: Path, trace: Path) -> None:
     spec = _model(tmp_path / "model")
     _build(spec, tmp_path / "out", trace)
