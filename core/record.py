@@ -1,23 +1,22 @@
-"""`@record`: a frozen dataclass whose repr, == and hash are written once, here.
+"""`@record`: a frozen dataclass whose methods are written once, here, or when first needed.
 
 `@dataclass` compiles each method it generates with exec() when the class is created:
 six for a frozen class, 0.5–0.8 ms a class on our machines. The IR has over a hundred
-classes, and `mpc check` imports most of them on every editor save (issue 3: 250 ms
-cold). A record lets dataclass generate only `__init__` and the frozen `__setattr__`
-and `__delattr__`; the three methods below behave as dataclass's own would (fields in
-order, the class's qualified name, equal only to the same class, tuple hash), so
-`dataclasses.fields`, `replace` and `asdict` and every repr-based digest are unchanged.
+classes, and every mpc process imports most of them (issue 3: `mpc check` on each editor
+save; issue 34: a warm rebuild, 30 ms of its 0.35 s). So dataclass writes no method of a
+record: repr, == and hash are the functions below (fields in order, the class's qualified
+name, equal only to the same class, tuple hash), and so are the frozen `__setattr__` and
+`__delattr__`; `__init__` is compiled when the first record of the class is made (most classes
+are never made in a process), from the class's fields as dataclass would write it (the same
+parameters, defaults, default_factory, keyword-only fields, `__post_init__`), each field set
+through its slot's own setter where it has one (twice as fast as object.__setattr__, which
+dataclass's frozen `__init__` goes through). `dataclasses.fields`, `replace` and `asdict` and
+every repr-based digest are unchanged. A record with an InitVar or a field left out of
+`__init__` keeps dataclass's own frozen class, and so do its subclasses.
 
-Two things read dataclass's internals (the parameters and defaults of the `__init__` it
-generates), for the classes a reader makes by the thousand, and only for those: the classes
-that opt in with `@record(slots=True, bulk=True)` (`bulk_records()`: the URDF reader's IR
-values and Span). Such a class gets, when it is first made, an `__init__` that sets each slot
-through the slot's own setter (`_fast_init`): dataclass's frozen one goes through
-object.__setattr__ for every field, which takes twice as long. And code that makes thousands
-of them (a reader) asks for a `maker`, which skips the class call too: a quarter of its time.
-Every other record keeps dataclass's own `__init__`, and `maker` refuses it. Where the
-internals are not as expected (another Python), both fall back to dataclass's `__init__`;
-tests/core/test_record.py fails then, on each supported Python it runs on. A record with
+Code that makes records by the thousand (a reader) asks for a `maker`, which skips the class
+call too: a quarter of its time. Only classes that opt in with `@record(slots=True,
+bulk=True)` have one (`bulk_records()`: the URDF reader's IR values and Span). A record with
 slots also pickles its fields as a tuple, in order, as dataclass's own `__getstate__` does,
 without looking the fields up for each object. The build cache writes records as their field
 values (`record_values`) and reads them back without running their code (`from_values`:
@@ -26,9 +25,10 @@ compiler/kept_values.py); only classes made here (`is_record`) are read back.
 
 from __future__ import annotations
 
+import inspect
 import types
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, fields
+from dataclasses import MISSING, Field, FrozenInstanceError, dataclass, fields
 from operator import attrgetter
 from typing import Any, TypeVar, dataclass_transform, overload
 
@@ -39,6 +39,8 @@ _NAMES: dict[type, tuple[str, ...]] = {}
 _VALUES: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
 _RECORDS: set[type] = set()  # every class made by @record
 _BULK: set[type] = set()  # those made in bulk: @record(slots=True, bulk=True)
+_OWN_INIT: set[type] = set()  # those whose __init__ record writes
+_CLASSIC: set[type] = set()  # those that keep dataclass's frozen class (an InitVar, say)
 
 
 def _names(cls: type) -> tuple[str, ...]:
@@ -136,34 +138,38 @@ def _setstate(self: Any, state: tuple[Any, ...]) -> None:
         object.__setattr__(self, name, value)
 
 
-def _parameters(cls: type, slow: Callable[..., None], env: dict[str, Any]
-                ) -> tuple[list[str], dict[str, str]] | None:
-    """What generated code needs of dataclass's `__init__` (`slow`) of `cls`: its parameters
-    as source, their defaults bound in `env` (as `_d_NAME`), and for each field the expression
-    of its value (a default_factory, as `_f_NAME`, called for dataclass's sentinel); None when
-    the fields are not the parameters (InitVar or init=False fields)."""
-    code, own = slow.__code__, fields(cls)  # type: ignore[arg-type]
-    params = code.co_varnames[1:code.co_argcount + code.co_kwonlyargcount]
-    if sorted(params) != sorted(f.name for f in own) or not all(f.init for f in own):
-        return None
-    positional, keyword = params[:code.co_argcount - 1], params[code.co_argcount - 1:]
-    defaults = dict(zip(positional[len(positional) - len(slow.__defaults__ or ()):],
-                        slow.__defaults__ or (), strict=True))
-    defaults.update(slow.__kwdefaults__ or {})
+class _Factory:
+    """The default of a parameter whose field has a default_factory (dataclass's sentinel)."""
 
-    def param(name: str) -> str:
-        if name not in defaults:
-            return name
-        env[f"_d_{name}"] = defaults[name]
-        return f"{name}=_d_{name}"
+    def __repr__(self) -> str:
+        return "<factory>"
 
+
+_FACTORY = _Factory()
+
+
+def _parameters(cls: type, env: dict[str, Any]) -> tuple[list[str], dict[str, str]]:
+    """What an `__init__` of `cls` needs, from its fields as dataclass would make it: its
+    parameters as source (positional ones first, then `*` and the keyword-only ones), their
+    defaults bound in `env` (as `_d_NAME`), and for each field the expression of its value (a
+    default_factory, as `_f_NAME`, called for the sentinel)."""
+    own = fields(cls)  # type: ignore[arg-type]
     values = {}
-    for f in own:
+
+    def param(f: Any) -> str:
         values[f.name] = f.name
-        if f.default_factory is not MISSING:  # its parameter's default is dataclass's sentinel
-            env[f"_f_{f.name}"] = f.default_factory
+        if f.default_factory is not MISSING:
+            env[f"_d_{f.name}"], env[f"_f_{f.name}"] = _FACTORY, f.default_factory
             values[f.name] = f"_f_{f.name}() if {f.name} is _d_{f.name} else {f.name}"
-    return [*map(param, positional), *(["*", *map(param, keyword)] if keyword else [])], values
+        elif f.default is MISSING:
+            return f.name
+        else:
+            env[f"_d_{f.name}"] = f.default
+        return f"{f.name}=_d_{f.name}"
+
+    positional = [param(f) for f in own if not f.kw_only]
+    keyword = [param(f) for f in own if f.kw_only]
+    return [*positional, *(["*", *keyword] if keyword else [])], values
 
 
 def _compiled(source: str, env: dict[str, Any], name: str) -> Callable[..., Any]:
@@ -172,42 +178,54 @@ def _compiled(source: str, env: dict[str, Any], name: str) -> Callable[..., Any]
     return namespace[name]  # type: ignore[no-any-return]
 
 
-def _fast_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
-    """dataclass's `__init__` of the slots record `cls` (`slow`), written with the slots'
-    setters: the same parameters and defaults (taken from `slow`), each default_factory
-    called for its sentinel, the fields set in order, then `__post_init__`. `slow` itself
-    for what it does not cover (InitVar or init=False fields, fields kept in a __dict__)."""
-    own = fields(cls)  # type: ignore[arg-type]
-    setters = [getattr(cls, f.name, None) for f in own]
-    env: dict[str, Any] = {}
-    found = _parameters(cls, slow, env)
-    if found is None or not all(isinstance(s, types.MemberDescriptorType) for s in setters):
-        return slow
-    params, values = found
+def _init(cls: type) -> Callable[..., None]:
+    """The `__init__` dataclass would write for the record `cls` (the same parameters, defaults
+    and annotations; each default_factory called for its sentinel; the fields set in order, then
+    `__post_init__`), each field set through its slot's own setter where it has one (twice as
+    fast as object.__setattr__, which the others are set with)."""
+    env: dict[str, Any] = {"_set": object.__setattr__}
+    params, values = _parameters(cls, env)
     body = []
-    for f, setter in zip(own, setters, strict=True):
-        env[f"_s_{f.name}"] = setter.__set__  # type: ignore[union-attr]
-        body.append(f"    _s_{f.name}(self, {values[f.name]})\n")
+    for f in fields(cls):  # type: ignore[arg-type]
+        setter = getattr(cls, f.name, None)
+        if isinstance(setter, types.MemberDescriptorType):
+            env[f"_s_{f.name}"] = setter.__set__
+            body.append(f"    _s_{f.name}(self, {values[f.name]})\n")
+        else:
+            body.append(f"    _set(self, {f.name!r}, {values[f.name]})\n")
     if hasattr(cls, "__post_init__"):
         body.append("    self.__post_init__()\n")
-    fast = _compiled(f"def __init__({', '.join(['self', *params])}):\n{''.join(body) or '    pass'}",
+    init = _compiled(f"def __init__({', '.join(['self', *params])}):\n{''.join(body) or '    pass'}",
                      env, "__init__")
-    # inspect.signature shows slow's
-    fast.__qualname__, fast.__wrapped__ = slow.__qualname__, slow  # type: ignore[attr-defined]
-    return fast
+    init.__qualname__ = f"{cls.__qualname__}.__init__"
+    init.__annotations__ = {**{f.name: f.type for f in fields(cls)}, "return": None}  # type: ignore[arg-type]
+    return init
 
 
-def _first_init(cls: type, slow: Callable[..., None]) -> Callable[..., None]:
-    """An `__init__` that puts `_fast_init` in its place when the first record is made: most
+def _first_init(cls: type) -> Callable[..., None]:
+    """An `__init__` that puts `_init`'s in its place when the first record is made: most
     records of mpc are never made in a process, and each exec costs 0.1 ms."""
 
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        fast = _fast_init(cls, slow)
-        cls.__init__ = fast  # type: ignore[misc]
-        fast(self, *args, **kwargs)
+        init = _init(cls)
+        cls.__init__ = init  # type: ignore[misc]
+        init(self, *args, **kwargs)
 
-    __init__.__qualname__, __init__.__wrapped__ = slow.__qualname__, slow  # type: ignore[attr-defined]
+    __init__.__qualname__ = f"{cls.__qualname__}.__init__"
     return __init__
+
+
+def _frozen_setattr(self: Any, name: str, value: Any) -> None:
+    """dataclass's frozen `__setattr__`, one for every record."""
+    if type(self) in _RECORDS or name in _names(type(self)):
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+    object.__setattr__(self, name, value)
+
+
+def _frozen_delattr(self: Any, name: str) -> None:
+    if type(self) in _RECORDS or name in _names(type(self)):
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+    object.__delattr__(self, name)
 
 
 _MAKERS: dict[type, Callable[..., Any]] = {}
@@ -219,8 +237,8 @@ def maker(cls: type[R]) -> Callable[..., R]:
     (the readers): it fills an unfrozen twin of `cls` (the same slots, so each assignment is
     the interpreter's direct slot store) and then makes it a `cls`; no class call, whose
     keyword arguments go through a dict. Only for a record made in bulk (`bulk=True`; a
-    TypeError for any other); `cls` itself for one it does not cover (a base class, InitVar
-    or init=False fields, an __init__ of its own)."""
+    TypeError for any other); `cls` itself for one it does not cover (a base class, one whose
+    `__init__` is dataclass's or its own)."""
     make = _MAKERS.get(cls)
     if make is None:
         if cls not in _BULK:
@@ -231,17 +249,12 @@ def maker(cls: type[R]) -> Callable[..., R]:
 
 
 def _maker(cls: Any) -> Callable[..., Any]:
-    init = cls.__init__
-    slow = getattr(init, "__wrapped__", None)  # dataclass's, behind _first_init or _fast_init
     own = fields(cls)
-    if (slow is None or cls.__bases__ != (object,)
+    if (cls not in _OWN_INIT or cls.__bases__ != (object,)
             or getattr(cls, "__slots__", None) != tuple(f.name for f in own)):
         return cls  # type: ignore[no-any-return]
     env: dict[str, Any] = {"_cls": cls, "_twin": type(cls.__name__, (), {"__slots__": cls.__slots__})}
-    found = _parameters(cls, slow, env)
-    if found is None:
-        return cls  # type: ignore[no-any-return]
-    params, values = found
+    params, values = _parameters(cls, env)
     lines = [f"def make({', '.join(params)}):\n", "    self = _twin()\n"]
     lines += [f"    self.{f.name} = {values[f.name]}\n" for f in own]
     lines.append("    self.__class__ = _cls\n")
@@ -253,6 +266,29 @@ def _maker(cls: Any) -> Callable[..., Any]:
     return make
 
 
+def _needs_dataclass_init(cls: type) -> bool:
+    """Whether the class needs dataclass's own frozen `__init__`: an InitVar or a field left
+    out of `__init__` (record's covers neither), or a base that has it."""
+    if any(base in _CLASSIC for base in cls.__mro__[1:]):
+        return True
+    annotations = inspect.get_annotations(cls)  # dataclasses imports inspect
+    if any("InitVar" in (a if isinstance(a, str) else repr(a)) for a in annotations.values()):
+        return True
+    return any(isinstance(v, Field) and not v.init for v in cls.__dict__.values())
+
+
+def _check_defaults(cls: type) -> None:
+    """dataclass's check, which it makes only when it writes `__init__`."""
+    default = None
+    for f in fields(cls):  # type: ignore[arg-type]
+        if f.kw_only:
+            continue
+        if f.default is not MISSING or f.default_factory is not MISSING:
+            default = f.name
+        elif default is not None:
+            raise TypeError(f"non-default argument {f.name!r} follows default argument")
+
+
 @overload
 def record(cls: T, /) -> T: ...
 @overload
@@ -261,22 +297,31 @@ def record(*, slots: bool = False, kw_only: bool = False, bulk: bool = False) ->
 
 @dataclass_transform(frozen_default=True)
 def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bulk: bool = False) -> Any:
-    """`@dataclass(frozen=True, …)` with repr, == and hash from this module. bulk: a class a
-    reader makes by the thousand, given the fast `__init__` and a `maker` (needs slots)."""
+    """`@dataclass(frozen=True, …)` with its methods from this module. bulk: a class a reader
+    makes by the thousand, given a `maker` (needs slots)."""
     if bulk and not slots:
         raise TypeError("@record(bulk=True) needs slots=True")
 
     def wrap(c: T) -> T:
         written = "__init__" in c.__dict__
-        out = dataclass(c, frozen=True, repr=False, eq=False, slots=slots, kw_only=kw_only)
+        classic = _needs_dataclass_init(c)
+        # dataclass writes no method, but a classic record's __init__, __setattr__ and __delattr__
+        out = dataclass(c, frozen=classic, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
         methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
+        if not classic:
+            methods += [("__setattr__", _frozen_setattr), ("__delattr__", _frozen_delattr)]
         if slots:  # dataclass's own look each field up anew for every object pickled
             methods += [("__getstate__", _values), ("__setstate__", _setstate)]
         for name, method in methods:
             if name not in c.__dict__:
                 setattr(out, name, method)
-        if bulk and not written:  # dataclass wrote it
-            out.__init__ = _first_init(out, out.__init__)  # type: ignore[misc]
+        if not classic and not written:
+            _check_defaults(out)
+            out.__init__ = _first_init(out)  # type: ignore[misc]
+            _OWN_INIT.add(out)
+        if classic:
+            _CLASSIC.add(out)
+        if bulk:
             _BULK.add(out)
         _RECORDS.add(out)
         return out

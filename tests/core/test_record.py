@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from mpc.core import record as record_module
-from mpc.core.record import bulk_records, maker, record
+from mpc.core.record import bulk_records, maker, record, record_values
 from mpc.core.span import Span
 from mpc.ir.geometry import Box
 
@@ -84,9 +84,9 @@ class WithInitVar:
 
 
 def test_slots_records_are_made_as_dataclass_would() -> None:
-    """The slots' own setters (record's _fast_init) give what dataclass's __init__ gives:
-    defaults, a fresh default_factory value each time, keyword-only fields, __post_init__,
-    inherited fields; and the same errors. A record it does not cover keeps dataclass's."""
+    """Record's __init__ (the slots' own setters) gives what dataclass's would give: defaults, a
+    fresh default_factory value each time, keyword-only fields, __post_init__, inherited fields;
+    and the same errors. A record with an InitVar keeps dataclass's."""
     for _ in range(2):  # the first record made puts the fast __init__ in place
         assert repr(Mixed(1)) == "Mixed(a=1, b='b', c=[], d=())"
         assert Mixed(1, "x", [2], d=(3,)) == Mixed(a=1, b="x", c=[2], d=(3,))
@@ -134,15 +134,35 @@ class Plain:
     b: str = "b"
 
 
-def test_only_records_made_in_bulk_read_dataclass_internals() -> None:
-    """A record that did not opt in (bulk=True) keeps dataclass's own __init__, and has no maker."""
+@record
+class Loose:  # no slots: its fields are set as dataclass's frozen __init__ sets them
+    a: int
+    b: list[int] = dataclasses.field(default_factory=list)
+
+
+def test_only_records_made_in_bulk_have_a_maker() -> None:
     assert Plain(1) == Plain(a=1, b="b") and Plain(1) != Plain(2)
-    assert Plain.__init__.__code__.co_filename == "<string>"  # dataclass's, not record's
-    for cls in (Plain, One):
+    assert Loose(1) == Loose(1, []) and Loose(1).b is not Loose(1).b
+    assert Loose(2).__dict__ == {"a": 2, "b": []}
+    for cls in (Plain, One, Loose):
         with pytest.raises(TypeError, match="is not made in bulk"):
             maker(cls)
     with pytest.raises(TypeError, match="needs slots"):
         record(bulk=True)
+
+
+def test_records_are_frozen_as_dataclass_s_are() -> None:
+    loose = Loose(1)
+    for set_it in (lambda: setattr(loose, "a", 2), lambda: setattr(loose, "other", 2),
+                   lambda: delattr(loose, "a")):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            set_it()
+    assert loose == Loose(1) and dataclasses.replace(loose, a=3) == Loose(3)
+    with pytest.raises(TypeError, match="non-default argument 'b' follows default argument"):
+        @record
+        class Wrong:
+            a: int = 1
+            b: int  # type: ignore[misc]
 
 
 # The opt-in list: what the URDF reader makes by the thousand (backends/urdf_reader.py
@@ -153,25 +173,36 @@ BULK = {"Pose", "Fragment", "FragmentRef", "Robot", "Link", "Inertial", "Inertia
         "Mimic", "Calibration", "SafetyController", "Span"}
 
 
-def test_every_class_made_in_bulk_gets_its_fast_init_and_maker_on_this_python() -> None:
-    """What reads dataclass's internals still understands them on this Python (run this file on
-    each supported version: it needs only lxml and pytest, `--noconftest`): each class of the
-    opt-in list gets record's __init__ and a maker, not the fallback to dataclass's."""
+def test_every_class_made_in_bulk_gets_a_maker_with_dataclass_s_parameters() -> None:
+    """Each class of the opt-in list gets a maker, not the fallback to the class; its
+    parameters, and those of record's __init__, are those of dataclass's __init__ for the same
+    fields (run this file on each supported version: it needs only lxml and pytest,
+    `--noconftest`)."""
     from mpc.backends import urdf_reader
 
     urdf_reader._makers()  # the reader's makers: every class it asks for must be on the list
     ours = {cls for cls in bulk_records() if cls.__module__.startswith("mpc.")}
     assert {cls.__qualname__ for cls in ours} == BULK
     for cls in sorted(ours, key=lambda c: c.__qualname__):
-        slow = cls.__init__.__wrapped__
-        assert record_module._fast_init(cls, slow) is not slow, cls
         make = maker(cls)
         assert make is not cls and make.__qualname__ == f"{cls.__qualname__}.make", cls
-        assert _parameters(make) == _parameters(slow)[1:], cls  # the same, less `self`
+        theirs = _parameters(_dataclass_twin(cls).__init__)[1:]
+        assert _parameters(make) == _parameters(record_module._init(cls))[1:] == theirs, cls
 
 
 def _parameters(function: object) -> list[tuple[str, object, object]]:
-    return [(p.name, p.kind, p.default) for p in inspect.signature(function).parameters.values()]  # type: ignore[arg-type]
+    return [(p.name, p.kind, repr(p.default)) for p in inspect.signature(function).parameters.values()]  # type: ignore[arg-type]
+
+
+def _dataclass_twin(cls: type) -> type:
+    """A frozen dataclass of the record's fields (and its __post_init__): what dataclass makes."""
+    space: dict[str, object] = {"__annotations__": {f.name: f.type for f in dataclasses.fields(cls)}}
+    for f in dataclasses.fields(cls):
+        space[f.name] = dataclasses.field(default=f.default, default_factory=f.default_factory,
+                                          kw_only=f.kw_only)
+    if hasattr(cls, "__post_init__"):
+        space["__post_init__"] = cls.__post_init__
+    return dataclasses.dataclass(frozen=True)(type(cls.__name__, (), space))
 
 
 FULL = """<robot name="r" xmlns:x="urn:x">
@@ -204,7 +235,8 @@ FULL = """<robot name="r" xmlns:x="urn:x">
 
 def test_what_the_reader_makes_is_what_dataclass_s_init_makes(tmp_path: Path) -> None:
     """Every record of a URDF read (made by the makers) equals the same record made by the
-    class call (record's __init__) and by dataclass's own __init__, for every class listed."""
+    class call (record's __init__), and holds what dataclass's own __init__ makes of the same
+    values, for every class listed."""
     from mpc.backends import urdf_reader
     from mpc.core.diagnostics import Sink
 
@@ -223,9 +255,34 @@ def test_what_the_reader_makes_is_what_dataclass_s_init_makes(tmp_path: Path) ->
         elif type(item) in bulk_records():
             cls = type(item)
             values = {f.name: getattr(item, f.name) for f in dataclasses.fields(item)}
-            by_dataclass = object.__new__(cls)
-            cls.__init__.__wrapped__(by_dataclass, **values)
-            assert item == cls(**values) == by_dataclass and repr(item) == repr(by_dataclass)
+            by_dataclass = _dataclass_twin(cls)(**values)
+            theirs = tuple(getattr(by_dataclass, f.name) for f in dataclasses.fields(by_dataclass))
+            assert item == cls(**values) and record_values(item) == theirs
             seen.add(cls.__qualname__)
             stack += values.values()
     assert seen == BULK
+
+
+@record
+class OwnInit:
+    a: int
+
+    def __init__(self, text: str) -> None:
+        object.__setattr__(self, "a", int(text))
+
+
+@record
+class FromOwnInit(OwnInit):
+    b: int = 0
+
+
+@record(slots=True)
+class FromInitVar(WithInitVar):
+    b: int = 0
+
+
+def test_subclasses_of_records_with_their_own_or_dataclass_s_init() -> None:
+    assert OwnInit("3").a == 3 and FromOwnInit(1, 2) == FromOwnInit(a=1, b=2)
+    assert FromInitVar(2, 3).a == 6 and FromInitVar(2, 3, 4).b == 4
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        FromInitVar(1).b = 2  # type: ignore[misc]
