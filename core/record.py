@@ -305,11 +305,14 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bu
     def wrap(c: T) -> T:
         written = "__init__" in c.__dict__
         classic = _needs_dataclass_init(c)
-        # dataclass writes no method, but a classic record's __init__, __setattr__ and __delattr__
-        out = dataclass(c, frozen=classic, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
+        # dataclass writes no method, but a classic record's __init__, and the frozen __setattr__
+        # and __delattr__ of a record with a dataclass base (which dataclass requires frozen)
+        frozen = classic or any(hasattr(base, "__dataclass_fields__") for base in c.__mro__[1:])
+        out = dataclass(c, frozen=frozen, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
         methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
-        if not classic:
+        if not frozen:
             methods += [("__setattr__", _frozen_setattr), ("__delattr__", _frozen_delattr)]
+            out.__dataclass_params__.frozen = True  # as it is: a frozen dataclass may subclass it
         if slots:  # dataclass's own look each field up anew for every object pickled
             methods += [("__getstate__", _values), ("__setstate__", _setstate)]
         for name, method in methods:

@@ -281,8 +281,20 @@ class FromInitVar(WithInitVar):
     b: int = 0
 
 
+@dataclasses.dataclass(frozen=True)
+class PlainFromRecord(One):
+    y: float = 0.0
+
+
 def test_subclasses_of_records_with_their_own_or_dataclass_s_init() -> None:
     assert OwnInit("3").a == 3 and FromOwnInit(1, 2) == FromOwnInit(a=1, b=2)
+    assert PlainFromRecord(1.0, 2.0).y == 2.0 and dataclasses.fields(PlainFromRecord)[0].name == "x"
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        PlainFromRecord(1.0).x = 2.0  # type: ignore[misc]
+    with pytest.raises(TypeError, match="cannot inherit non-frozen dataclass from a frozen one"):
+        @dataclasses.dataclass
+        class Unfrozen(One):
+            y: float = 0.0
     assert FromInitVar(2, 3).a == 6 and FromInitVar(2, 3, 4).b == 4
     with pytest.raises(dataclasses.FrozenInstanceError):
         FromInitVar(1).b = 2  # type: ignore[misc]
