@@ -52,8 +52,10 @@ def store_entry(entry: Path, data: bytes) -> None:
     """Keep `data` as `entry`, atomically; raises OSError (a read-only cache, a file in the way)."""
     from mpc.core.files import write_atomic
 
+    digest = hashlib.sha256(data).hexdigest()
     write_atomic(entry, data)
-    write_atomic(_hash_file(entry), hashlib.sha256(data).hexdigest() + "\n")
+    write_atomic(_hash_file(entry), digest + "\n")
+    note_written(entry, digest)  # read back by this build: not hashed again
 
 
 def load_entry(entry: Path) -> tuple[bytes | None, str | None]:
@@ -72,6 +74,8 @@ def read_entry(entry: Path) -> tuple[bytes | None, str | None, str]:
             return None, "it is not a regular file", ""
         data = entry.read_bytes()
         expected = _hash_file(entry).read_text(encoding="ascii").strip()
+        if written_digest(entry) == expected:  # stored by this process, unchanged since
+            return data, None, expected
     except FileNotFoundError:  # an unfinished write (or an older mpc's): no entry yet
         return None, None, ""
     except (OSError, UnicodeDecodeError) as e:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
+import json
 import os
 import shutil
 import subprocess
@@ -21,6 +22,7 @@ from typing import Any
 import pytest
 
 from mpc.backends.meshes import _cached_path
+from mpc.compiler.driver import Options, compile_model
 from mpc.core.diagnostics import Sink
 from tests.conftest import ERD, compile_file, definition, write
 from tests.fixtures import ARM_URDF, tetra_stl
@@ -309,3 +311,43 @@ def test_a_build_whose_meshes_are_cached_imports_no_numpy(tmp_path: Path,
                           capture_output=True, text=True, check=True)
     assert done.stdout.splitlines()[-1].split(" [")[0] == "0"
     assert "numpy" not in done.stdout.splitlines()[-1]
+
+
+def test_a_noted_digest_holds_only_while_the_file_is_unchanged(tmp_path: Path) -> None:
+    """What mpc wrote and knows the digest of (a mesh out of the cache, an entry it stored) is
+    not hashed again in the same process (core/cache.py `note_written`), until it changes."""
+    from mpc.core import cache
+
+    mesh = tetra_stl(tmp_path / "tetra.stl")
+    digest = hashlib.sha256(mesh.read_bytes()).hexdigest()
+    cache.note_written(mesh, digest)
+    assert cache.written_digest(mesh) == digest
+    assert cache.written_digest(tetra_stl(tmp_path / "other.stl")) is None
+    st = os.stat(mesh)
+    while time.time_ns() < st.st_ctime_ns + 20_000_000:  # file times tick coarsely: let one pass
+        time.sleep(0.005)
+    data = bytearray(mesh.read_bytes())
+    data[-1] ^= 1
+    mesh.write_bytes(bytes(data))  # in place: the same file, the same size
+    assert cache.written_digest(mesh) is None
+
+
+def test_a_forced_build_keeps_the_digests_of_what_it_wrote(tmp_path: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    """The kept copy of each output, meshes out of the cache included, has the digest the entry
+    records: a third build writes them out."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
+    spec = _arm(tmp_path / "model")
+    time.sleep(0.05)
+    for force in (False, True):
+        assert compile_model(spec, Sink(), Options(out=tmp_path / "out", force=force)).out is not None
+
+    [entry] = (tmp_path / "cache/builds").glob("*/*/entry")
+    outputs = json.loads(entry.read_bytes().split(b"\n", 1)[0])["outputs"]
+    kept = entry.parent / outputs["folder"]
+    assert any(name.endswith(".stl") for name, _ in outputs["files"])
+    for name, digest in outputs["files"]:
+        assert hashlib.sha256((kept / name).read_bytes()).hexdigest() == digest, name
+    assert compile_file(spec, tmp_path / "out2", Sink()).out is not None
+    assert (tmp_path / "trace").read_text().splitlines()[-1].endswith("with its outputs")
