@@ -49,6 +49,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Iterator
+from io import BufferedReader
 from pathlib import Path, PurePath
 from typing import TYPE_CHECKING, Any
 
@@ -225,14 +226,9 @@ class KeptBuild:
             return False  # a link put into the cache: never read through
         inside = os.path.realpath(kept) + os.sep
         for name, digest in self.header["outputs"]["files"]:
-            source = kept / name
             try:
-                if not os.path.realpath(source).startswith(inside):
-                    return False  # a link put into the cache: never read through
-                # not through a link, and without waiting on a FIFO put in a file's place
-                fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
-                with open(fd, "rb") as f:
-                    if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                with _opened_kept(kept / name, inside) as f:
+                    if f is None:
                         return False
                     data = f.read()
             except OSError:
@@ -323,31 +319,55 @@ class KeptBuild:
     def _keep_outputs(self, out: Path, diagnostics: list[Diagnostic],
                       model_files: set[str]) -> dict[str, Any] | None:
         """A copy of the outputs in `out`: clones where the file system makes them (they share
-        no storage: a write into one leaves the other as it was), else copies."""
+        no storage: a write into one leaves the other as it was), else copies. The copy kept
+        before is kept again when it holds the same files, each with its digest (a rebuild
+        with --force of what did not change need not write the outputs twice more)."""
         files = _digests([p for p in self.recorder.inputs() if str(p) not in model_files], self.started)
         if files is None:
             return None
-        self.folder.mkdir(parents=True, exist_ok=True)
-        copy = Path(tempfile.mkdtemp(prefix="outputs-", dir=self.folder))
-        names, folders = [], []
+        names: list[tuple[str, str]] = []
+        folders: list[str] = []
         for here, dirs, found in os.walk(out):
             rel = Path(here).relative_to(out)
-            for name in dirs:
-                folders.append(str(rel / name))
-                (copy / rel / name).mkdir()
+            folders += (str(rel / name) for name in dirs)
             for name in found:
-                source, target = Path(here) / name, copy / rel / name
+                source = Path(here) / name
                 if source.is_symlink() or not source.is_file():
-                    shutil.rmtree(copy, ignore_errors=True)
                     return None
-                copy_file(source, target)
                 digest = cache.written_digest(source)  # a mesh out of the cache, unchanged since
                 if digest is None:
-                    with open(target, "rb") as f:
+                    with open(source, "rb") as f:
                         digest = hashlib.file_digest(f, "sha256").hexdigest()
                 names.append((str(rel / name), digest))
-        return {"folder": copy.name, "files": sorted(names), "folders": sorted(folders), "read": files,
+        kept = {"files": sorted(names), "folders": sorted(folders), "read": files,
                 "diagnostics": _kept_diagnostics(diagnostics)}
+        before = self.header["outputs"] if self.header is not None else None
+        if (before is not None and [list(f) for f in kept["files"]] == before["files"]
+                and kept["folders"] == before["folders"] and self._intact(before)):
+            return {**kept, "folder": before["folder"]}
+        self.folder.mkdir(parents=True, exist_ok=True)
+        copy = Path(tempfile.mkdtemp(prefix="outputs-", dir=self.folder))
+        for folder in kept["folders"]:
+            (copy / folder).mkdir()
+        for name, _ in kept["files"]:
+            copy_file(out / name, copy / name)  # a file changed since is found when written out
+        return {**kept, "folder": copy.name}
+
+    def _intact(self, outputs: dict[str, Any]) -> bool:
+        """Whether the kept copy of `outputs` holds each file with its digest (remembered by the
+        file's status, core/cache.py: a copy settled in the cache is not read again)."""
+        folder = self.folder / outputs["folder"]
+        if folder.is_symlink() or not folder.is_dir():
+            return False
+        inside = os.path.realpath(folder) + os.sep
+        for name, digest in outputs["files"]:
+            try:
+                with _opened_kept(folder / name, inside) as f:
+                    if f is None or cache.digest_of(f) != digest:
+                        return False
+            except OSError:
+                return False
+        return True
 
     def _remove_old_outputs(self, kept: dict[str, Any] | None) -> None:
         for folder in self.folder.glob("outputs-*"):
@@ -447,6 +467,19 @@ def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes, bytes]:
     if out is not None:
         out["diagnostics"] = values[2]
     return header, program_json, robot_json
+
+
+@contextlib.contextmanager
+def _opened_kept(path: Path, inside: str) -> Iterator[BufferedReader | None]:
+    """A kept output opened to be read, or None when it is not a regular file inside the kept
+    folder (`inside`: its real path and a separator): a link put into the cache is never read
+    through, and a FIFO put in a file's place is not waited on. Raises OSError."""
+    if not os.path.realpath(path).startswith(inside):
+        yield None
+        return
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    with open(fd, "rb") as f:
+        yield f if stat.S_ISREG(os.fstat(f.fileno()).st_mode) else None
 
 
 def _check(holds: bool, what: str) -> None:

@@ -344,6 +344,22 @@ def test_force_builds_anew_from_the_kept_program_and_keeps_that_build(
     assert events == ["reuse build with its outputs"] and _files(tmp_path / "out2") == built
 
 
+def test_force_keeps_the_kept_copy_of_unchanged_outputs_unless_it_is_damaged(
+        tmp_path: Path, trace: Path) -> None:
+    spec = _model(tmp_path / "model")
+    _build(spec, tmp_path / "out", trace)
+    [kept] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
+    compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
+    assert list((tmp_path / "cache/builds").glob("*/*/outputs-*")) == [kept]  # the same files
+    (kept / "urdf/arm.urdf").write_text("damaged\n")
+    compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
+    [again] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
+    assert again != kept and _files(again) == _files(tmp_path / "out")
+    _, _, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs"]
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out")
+
+
 def test_force_runs_the_front_end_on_a_changed_definition(tmp_path: Path, trace: Path) -> None:
     spec = _model(tmp_path / "model")
     _build(spec, tmp_path / "out", trace)
