@@ -49,7 +49,6 @@ import sys
 import tempfile
 import time
 from collections.abc import Iterator
-from io import BufferedReader
 from pathlib import Path, PurePath
 from typing import TYPE_CHECKING, Any
 
@@ -226,9 +225,14 @@ class KeptBuild:
             return False  # a link put into the cache: never read through
         inside = os.path.realpath(kept) + os.sep
         for name, digest in self.header["outputs"]["files"]:
+            source = kept / name
             try:
-                with _opened_kept(kept / name, inside) as f:
-                    if f is None:
+                if not os.path.realpath(source).startswith(inside):
+                    return False  # a link put into the cache: never read through
+                # not through a link, and without waiting on a FIFO put in a file's place
+                fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+                with open(fd, "rb") as f:
+                    if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
                         return False
                     data = f.read()
             except OSError:
@@ -245,7 +249,10 @@ class KeptBuild:
         _report(sink, self.header["outputs"]["diagnostics"])
 
     def drop_outputs(self) -> None:
+        """The kept outputs are damaged: not written out, nor kept again by this build."""
         self.outputs_hold = False
+        if self.header is not None:
+            self.header["outputs"] = None
         with contextlib.suppress(OSError):
             cache.remove_entry(self.entry)
 
@@ -343,7 +350,7 @@ class KeptBuild:
                 "diagnostics": _kept_diagnostics(diagnostics)}
         before = self.header["outputs"] if self.header is not None else None
         if (before is not None and [list(f) for f in kept["files"]] == before["files"]
-                and kept["folders"] == before["folders"] and self._intact(before)):
+                and kept["folders"] == before["folders"] and self._intact(before, out)):
             return {**kept, "folder": before["folder"]}
         self.folder.mkdir(parents=True, exist_ok=True)
         copy = Path(tempfile.mkdtemp(prefix="outputs-", dir=self.folder))
@@ -353,18 +360,20 @@ class KeptBuild:
             copy_file(out / name, copy / name)  # a file changed since is found when written out
         return {**kept, "folder": copy.name}
 
-    def _intact(self, outputs: dict[str, Any]) -> bool:
-        """Whether the kept copy of `outputs` holds each file with its digest (remembered by the
-        file's status, core/cache.py: a copy settled in the cache is not read again)."""
+    def _intact(self, outputs: dict[str, Any], out: Path) -> bool:
+        """Whether the kept copy of `outputs` (the same files as in `out`, by their digests) is
+        still there: each file a regular file of the cache, of the size of its twin in `out`. Its
+        bytes are checked against their digests when they are written out (`write_outputs`); a
+        damaged copy is then dropped (`drop_outputs`), and the build that runs instead keeps a
+        new one."""
         folder = self.folder / outputs["folder"]
         if folder.is_symlink() or not folder.is_dir():
             return False
-        inside = os.path.realpath(folder) + os.sep
-        for name, digest in outputs["files"]:
+        for name, _ in outputs["files"]:
             try:
-                with _opened_kept(folder / name, inside) as f:
-                    if f is None or cache.digest_of(f) != digest:
-                        return False
+                st = os.lstat(folder / name)
+                if not stat.S_ISREG(st.st_mode) or st.st_size != os.stat(out / name).st_size:
+                    return False
             except OSError:
                 return False
         return True
@@ -467,19 +476,6 @@ def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes, bytes]:
     if out is not None:
         out["diagnostics"] = values[2]
     return header, program_json, robot_json
-
-
-@contextlib.contextmanager
-def _opened_kept(path: Path, inside: str) -> Iterator[BufferedReader | None]:
-    """A kept output opened to be read, or None when it is not a regular file inside the kept
-    folder (`inside`: its real path and a separator): a link put into the cache is never read
-    through, and a FIFO put in a file's place is not waited on. Raises OSError."""
-    if not os.path.realpath(path).startswith(inside):
-        yield None
-        return
-    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
-    with open(fd, "rb") as f:
-        yield f if stat.S_ISREG(os.fstat(f.fileno()).st_mode) else None
 
 
 def _check(holds: bool, what: str) -> None:

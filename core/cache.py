@@ -184,13 +184,7 @@ _SETTLED_NS = 2_000_000_000
 
 def file_digest(path: Path) -> str:
     """The sha256 (hex) of the file's bytes; raises OSError when it cannot be read."""
-    with open(path, "rb") as f:
-        return digest_of(f)
-
-
-def digest_of(f: BufferedReader) -> str:
-    """`file_digest` of a file opened already (by a caller that opens it with care)."""
-    return remembered_of(f, "", lambda f: hashlib.file_digest(f, "sha256").hexdigest())
+    return remembered(path, "", lambda f: hashlib.file_digest(f, "sha256").hexdigest())
 
 
 def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], length: int = 64) -> str:
@@ -198,25 +192,19 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
     their sha256), remembered by the file's identity and status as above; raises OSError when
     the file cannot be read. A remembered value of another form is computed again."""
     with open(path, "rb") as f:
-        return remembered_of(f, what, compute, length)
-
-
-def remembered_of(f: BufferedReader, what: str, compute: Callable[[BufferedReader], str],
-                  length: int = 64) -> str:
-    """`remembered` of a file opened already."""
-    st = os.fstat(f.fileno())
-    identity = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
-    key = (*identity, what) if what else identity
-    if key in _digests:
-        return _digests[key]
-    name = hashlib.sha256(repr(key).encode()).hexdigest()
-    memo = cache_dir("digests") / name[:2] / name
-    with contextlib.suppress(OSError, UnicodeDecodeError):
-        known = memo.read_text(encoding="ascii").strip()
-        if len(known) == length and all(c in "0123456789abcdef" for c in known):
-            _digests[key] = known
-            return known
-    value = compute(f)
+        st = os.fstat(f.fileno())
+        identity = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+        key = (*identity, what) if what else identity
+        if key in _digests:
+            return _digests[key]
+        name = hashlib.sha256(repr(key).encode()).hexdigest()
+        memo = cache_dir("digests") / name[:2] / name
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            known = memo.read_text(encoding="ascii").strip()
+            if len(known) == length and all(c in "0123456789abcdef" for c in known):
+                _digests[key] = known
+                return known
+        value = compute(f)
     _digests[key] = value
     if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
         from mpc.core.files import write_atomic

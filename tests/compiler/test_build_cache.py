@@ -344,20 +344,27 @@ def test_force_builds_anew_from_the_kept_program_and_keeps_that_build(
     assert events == ["reuse build with its outputs"] and _files(tmp_path / "out2") == built
 
 
-def test_force_keeps_the_kept_copy_of_unchanged_outputs_unless_it_is_damaged(
+def test_force_keeps_the_kept_copy_of_unchanged_outputs_and_damage_is_found_when_written_out(
         tmp_path: Path, trace: Path) -> None:
     spec = _model(tmp_path / "model")
     _build(spec, tmp_path / "out", trace)
+    built = _files(tmp_path / "out")
     [kept] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
     assert list((tmp_path / "cache/builds").glob("*/*/outputs-*")) == [kept]  # the same files
-    (kept / "urdf/arm.urdf").write_text("damaged\n")
+    urdf = kept / "urdf/arm.urdf"
+    urdf.write_text("damaged\n")  # another size: a new copy
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
-    [again] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
-    assert again != kept and _files(again) == _files(tmp_path / "out")
-    _, _, events = _build(spec, tmp_path / "out2", trace)
-    assert events == ["reuse build with its outputs"]
-    assert _files(tmp_path / "out2") == _files(tmp_path / "out")
+    [kept] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
+    assert _files(kept) == built
+    urdf = kept / "urdf/arm.urdf"
+    urdf.write_bytes(urdf.read_bytes().upper())  # the same size: kept, and found when written out
+    compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
+    assert list((tmp_path / "cache/builds").glob("*/*/outputs-*")) == [kept]
+    # the damaged copy is not written out: the build runs from the kept model and keeps a new copy
+    assert _build(spec, tmp_path / "out2", trace)[2] == ["reuse build with its outputs", "keep build"]
+    assert _build(spec, tmp_path / "out3", trace)[2] == ["reuse build with its outputs"]
+    assert _files(tmp_path / "out2") == _files(tmp_path / "out3") == built
 
 
 def test_force_runs_the_front_end_on_a_changed_definition(tmp_path: Path, trace: Path) -> None:
