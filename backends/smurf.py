@@ -129,7 +129,7 @@ def _pyyaml_dumps(data: Any) -> str:
 
     python, libyaml = _dumpers()
     dumper = libyaml if yaml.__with_libyaml__ and _libyaml_writes_alike(data) else python
-    return yaml.dump(data, Dumper=dumper, default_flow_style=False, sort_keys=True,  # type: ignore[no-any-return]
+    return yaml.dump(data, Dumper=dumper, default_flow_style=False, sort_keys=True,
                      allow_unicode=True, width=1 << 16)
 
 

@@ -19,6 +19,10 @@ import sys
 import types
 from collections.abc import Iterable
 from importlib.machinery import ModuleSpec
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from importlib.abc import Loader
 
 PRIVATE = "pydantic.plugin._loader"
 
@@ -38,7 +42,7 @@ class _StandIn:
     importlib.resources) every `mpc` process would pay."""
 
     def find_spec(self, name: str, path: object = None, target: object = None) -> ModuleSpec | None:
-        return ModuleSpec(name, self, origin=None) if name == PRIVATE else None
+        return ModuleSpec(name, cast("Loader", self), origin=None) if name == PRIVATE else None
 
     def create_module(self, spec: ModuleSpec) -> None:
         return None  # a plain module

@@ -50,7 +50,7 @@ import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path, PurePath
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from mpc.compiler.kept_values import BadValue, dumps, loads
 from mpc.core import cache
@@ -170,6 +170,7 @@ class KeptBuild:
             program = loads(self._program_json)
             _check(isinstance(program, Program), "program")
             self._program = program
+            return program
         return self._program
 
     def model(self) -> tuple[Program, Robot]:
@@ -471,7 +472,8 @@ def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes, bytes]:
     _check(type(values) is list and len(values) == 3 and isinstance(values[0], Span)
            and _are_diagnostics(values[1])
            and (values[2] is None if out is None else _are_diagnostics(values[2])), "span and diagnostics")
-    _check(type(header["front"]) is int and 0 <= header["front"] <= len(values[1]), "front end's diagnostics")
+    said: list[Diagnostic] = cast("list[Diagnostic]", values[1])
+    _check(type(header["front"]) is int and 0 <= header["front"] <= len(said), "front end's diagnostics")
     header["span"], header["diagnostics"] = values[0], values[1]
     if out is not None:
         out["diagnostics"] = values[2]

@@ -175,7 +175,7 @@ def _parameters(cls: type, env: dict[str, Any]) -> tuple[list[str], dict[str, st
 def _compiled(source: str, env: dict[str, Any], name: str) -> Callable[..., Any]:
     namespace: dict[str, Any] = {}
     exec(compile(source, "<record>", "exec"), env, namespace)
-    return namespace[name]  # type: ignore[no-any-return]
+    return namespace[name]
 
 
 def _init(cls: type) -> Callable[..., None]:
@@ -186,7 +186,7 @@ def _init(cls: type) -> Callable[..., None]:
     env: dict[str, Any] = {"_set": object.__setattr__}
     params, values = _parameters(cls, env)
     body = []
-    for f in fields(cls):  # type: ignore[arg-type]
+    for f in fields(cls):
         setter = getattr(cls, f.name, None)
         if isinstance(setter, types.MemberDescriptorType):
             env[f"_s_{f.name}"] = setter.__set__
@@ -198,7 +198,7 @@ def _init(cls: type) -> Callable[..., None]:
     init = _compiled(f"def __init__({', '.join(['self', *params])}):\n{''.join(body) or '    pass'}",
                      env, "__init__")
     init.__qualname__ = f"{cls.__qualname__}.__init__"
-    init.__annotations__ = {**{f.name: f.type for f in fields(cls)}, "return": None}  # type: ignore[arg-type]
+    init.__annotations__ = {**{f.name: f.type for f in fields(cls)}, "return": None}
     return init
 
 
@@ -280,7 +280,7 @@ def _needs_dataclass_init(cls: type) -> bool:
 def _check_defaults(cls: type) -> None:
     """dataclass's check, which it makes only when it writes `__init__`."""
     default = None
-    for f in fields(cls):  # type: ignore[arg-type]
+    for f in fields(cls):
         if f.kw_only:
             continue
         if f.default is not MISSING or f.default_factory is not MISSING:
@@ -320,7 +320,7 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bu
                 setattr(out, name, method)
         if not classic and not written:
             _check_defaults(out)
-            out.__init__ = _first_init(out)  # type: ignore[misc]
+            out.__init__ = _first_init(out)
             _OWN_INIT.add(out)
         if classic:
             _CLASSIC.add(out)
