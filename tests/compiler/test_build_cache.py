@@ -101,18 +101,25 @@ def test_an_unchanged_definition_writes_its_kept_outputs_and_diagnostics_without
     assert second.program == first.program and second.robot == first.robot  # read when asked
 
 
-def test_a_warm_compile_in_a_new_process_imports_no_schema_yaml_xml_or_numpy(tmp_path: Path,
-                                                                             trace: Path) -> None:
+@pytest.mark.parametrize(("force", "heavy", "events"), [
+    (False, ["pydantic", "yaml", "lxml", "numpy", "trimesh"], ["reuse build with its outputs"]),
+    (True, ["pydantic"], ["reuse build for its program", "keep build"]),
+], ids=["warm", "forced"])
+def test_a_second_compile_in_a_new_process_imports_no_schema(tmp_path: Path, trace: Path, force: bool,
+                                                              heavy: list[str], events: list[str]) -> None:
+    """A warm compile imports no schema, YAML, XML or numpy; a forced one (which reads the
+    input models and runs the ops anew) no schema and no front end."""
     spec = _model(tmp_path / "model")
     assert _build(spec, tmp_path / "out1", trace)[2] == ["keep build"]
-    code = ("import sys; from mpc.cli.main import main; code = main(['compile', sys.argv[1], '-o', "
-            "sys.argv[2]]); print(sorted({m.split('.')[0] for m in sys.modules} & {'pydantic', 'yaml', "
-            "'lxml', 'numpy', 'trimesh'}), 'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
-    done = subprocess.run([sys.executable, "-c", code, str(spec), str(tmp_path / "out2")],
-                          capture_output=True, text=True, env=os.environ, timeout=120)
+    code = ("import sys; from mpc.cli.main import main; code = main(['compile', *sys.argv[2:]]); "
+            "print(sorted({m.split('.')[0] for m in sys.modules} & set(sys.argv[1].split(','))), "
+            "'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
+    args = [",".join(heavy), str(spec), "-o", str(tmp_path / "out2"), *(["--force"] if force else [])]
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          env=os.environ, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "[] False"
-    assert _events(trace)[-1] == "reuse build with its outputs"
+    assert _events(trace)[1:] == events
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
 
 
@@ -405,20 +412,6 @@ def test_werror_with_force_fails_on_the_kept_programs_warnings(tmp_path: Path, t
     result = compile_model(spec, sink, Options(out=tmp_path / "out2", force=True))
     assert result.out is None and not (tmp_path / "out2").exists()
     assert [(d.severity, d.code) for d in sink.diagnostics] == [(Severity.ERROR, "W0401")]
-
-
-def test_a_forced_compile_in_a_new_process_imports_no_schema(tmp_path: Path, trace: Path) -> None:
-    spec = _model(tmp_path / "model")
-    assert _build(spec, tmp_path / "out1", trace)[2] == ["keep build"]
-    code = ("import sys; from mpc.cli.main import main; code = main(['compile', sys.argv[1], '-o', "
-            "sys.argv[2], '--force']); print('pydantic' in sys.modules, "
-            "'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
-    done = subprocess.run([sys.executable, "-c", code, str(spec), str(tmp_path / "out2")],
-                          capture_output=True, text=True, env=os.environ, timeout=120)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines()[-1] == "False False"
-    assert _events(trace)[-2:] == ["reuse build for its program", "keep build"]
-    assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
 
 
 def test_an_output_folder_that_cannot_be_written_is_said_with_the_kept_build_too(tmp_path: Path,
