@@ -249,7 +249,9 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
             definition = Span.of_file(str(path))
             if kept is not None and kept.header is not None and kept.model_holds(sink, definition):
                 if kept.force:                                 # its program, the ops run anew
-                    program, robot = _robot(kept.replay_program(sink), path, sink, options)
+                    program = kept.replay_program(sink)
+                    kept.program_done()
+                    program, robot = _robot(program, path, sink, options)
                     kept.front_end_done()
                 else:
                     program, robot = kept.replay_model(sink)   # its program and robot

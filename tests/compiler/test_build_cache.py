@@ -347,6 +347,9 @@ def test_force_builds_anew_from_the_kept_program_and_keeps_that_build(
     assert _files(tmp_path / "out1") == built  # every output written anew, and only those
     assert _said(sink) == _said(said)  # W0401 of the input model, once
     assert result.program == first.program and result.robot == first.robot
+    again = Sink()  # from the program the forced build kept: its front end's diagnostics too
+    compile_model(spec, again, Options(out=tmp_path / "out1", force=True))
+    assert _said(again) == _said(said)
     _, _, events = _build(spec, tmp_path / "out2", trace)  # the build it kept
     assert events == ["reuse build with its outputs"] and _files(tmp_path / "out2") == built
 
