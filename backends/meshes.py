@@ -326,7 +326,7 @@ def _copy_problem(src: Path) -> str | None:
 
     try:
         digest = file_digest(src)
-        mark = cache_dir("verdicts") / "dae" / digest[:2] / digest
+        mark = cache_dir("verdicts") / "dae" / digest
         if mark.is_file():
             return None
         data = src.read_bytes()
@@ -358,7 +358,7 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     # from shapes has no file: its ops are all of it.
     content = "made" if _made(src) else file_digest(src)
     digest = hashlib.sha256(f"{content}|{src.name}|{ENGINE}|{ops!r}|{suffix}".encode()).hexdigest()
-    return cache_dir("meshes") / digest[:2] / f"{digest}{suffix}"
+    return cache_dir("meshes") / f"{digest}{suffix}"
 
 
 Task = tuple[bool, list[tuple[Path, tuple[MeshOp, ...], Path]]]  # by the plain path or not; its jobs

@@ -44,7 +44,7 @@ def figures(geometry: Geometry) -> Figures:
         return _computed(geometry)
     from mpc.core.cache import cache_dir, load_entry, store_entry
 
-    entry = cache_dir("shapes") / key[:2] / f"{key}.json"
+    entry = cache_dir("shapes") / f"{key}.json"
     data, _ = load_entry(entry)
     if data is not None:
         try:

@@ -131,7 +131,7 @@ class KeptBuild:
             *([] if options.post_processing else ["no post_processing"]),
         ])
         name = hashlib.sha256(json.dumps(where).encode()).hexdigest()
-        kept = cls(cache.cache_dir("builds") / name[:2] / name, hashlib.sha256(key.encode()).hexdigest(),
+        kept = cls(cache.cache_dir("builds") / name, hashlib.sha256(key.encode()).hexdigest(),
                    options)
         kept._load()
         return kept

@@ -198,7 +198,7 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
         if key in _digests:
             return _digests[key]
         name = hashlib.sha256(repr(key).encode()).hexdigest()
-        memo = cache_dir("digests") / name[:2] / name
+        memo = cache_dir("digests") / name
         with contextlib.suppress(OSError, UnicodeDecodeError):
             known = memo.read_text(encoding="ascii").strip()
             if len(known) == length and all(c in "0123456789abcdef" for c in known):

@@ -161,7 +161,7 @@ def material_colours(path: Path) -> tuple[RGBA | None, ...]:
     from mpc.core.cache import cache_dir, file_digest, load_entry, store_entry
 
     digest = file_digest(path)
-    entry = cache_dir("meshes") / "materials" / digest[:2] / f"{digest}-{COLOURS}.json"
+    entry = cache_dir("meshes") / "materials" / f"{digest}-{COLOURS}.json"
     try:
         data, _ = load_entry(entry)
         if data is not None:

@@ -131,7 +131,7 @@ def _touching_entry(placed: list[tuple[str, Geometry, np.ndarray]]) -> Path | No
             return None
         h.update(f"|{name}|{key}|".encode() + np.ascontiguousarray(X, dtype=np.float64).tobytes())
     digest = h.hexdigest()
-    return cache_dir("touching") / digest[:2] / f"{digest}.json"
+    return cache_dir("touching") / f"{digest}.json"
 
 
 def never_colliding(robot: Robot) -> set[frozenset[str]]:

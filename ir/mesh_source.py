@@ -92,7 +92,7 @@ def entry_of(content: str, name: str) -> Path:
     from mpc.core.cache import cache_dir
 
     digest = hashlib.sha256(f"{content}|{FORM}|{name}".encode()).hexdigest()
-    return cache_dir("meshes") / "normal" / digest[:2] / f"{digest}.npz"
+    return cache_dir("meshes") / "normal" / f"{digest}.npz"
 
 
 def _parse(path: Path, suffix: str, broken: list[str]) -> trimesh.Trimesh:

@@ -23,7 +23,7 @@ from mpc.pipeline.fingerprint import data_digest
 def valid_pipeline(doc: Document, sink: Sink) -> bool:
     """Whether the schema accepts the pipeline file `doc` (its diagnostics go to `sink`)."""
     key = data_digest(["pipeline file", source_version(), doc.data])
-    marker = cache_dir("verdicts") / key[:2] / key
+    marker = cache_dir("verdicts") / key
     if marker.is_file():
         return True
     from mpc.compiler import schema

@@ -54,8 +54,7 @@ SITES: dict[tuple[str, str, str], str] = {
     ("mjcf_reader.py", "msh_as_stl", "cache_dir('msh') / f'{hashlib.sha256(data).hexdigest()}.stl'"): CACHE,
     ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "copy", "out / rel"): "only whether it is there (a name inside); written through confined",
-    ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2] / f'{digest}{suffix}'"): CACHE,
-    ("meshes.py", "_cached_path", "cache_dir('meshes') / digest[:2]"): CACHE,
+    ("meshes.py", "_cached_path", "cache_dir('meshes') / f'{digest}{suffix}'"): CACHE,
     ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
     ("mjcf_actuation.py", "_actuator", "effort / FULL_EFFORT_AT"): MATH,
     ("mjcf.py", "emit", "confined(out, 'mjcf', f'{name}.xml')"): CONFINED,
@@ -104,8 +103,7 @@ SITES: dict[tuple[str, str, str], str] = {
     ("xacro_origins.py", "start_element_handler", "Path(stack[-1])"): READ,
     ("xacro_origins.py", "_recording", "Path(stack[-1])"): READ,
     ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae'"): CACHE,
-    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest[:2]"): CACHE,
-    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest[:2] / digest"): CACHE,
+    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest"): CACHE,
     ("meshes.py", "key", "Path(mesh.source.uri.removeprefix(GENERATED))"):
         "a made mesh's key (`<link>_joined`); its output path goes through copy's confined",
 }

@@ -189,7 +189,7 @@ def test_a_damaged_kept_output_is_noticed_and_written_anew(tmp_path: Path, trace
     spec = _model(tmp_path / "model")
     _build(spec, tmp_path / "out1", trace)
     built = _files(tmp_path / "out1")
-    kept = next((tmp_path / "cache/builds").glob("*/*/outputs-*/urdf/arm.urdf"))
+    kept = next((tmp_path / "cache/builds").glob("*/outputs-*/urdf/arm.urdf"))
     kept.write_text(kept.read_text().replace("arm", "mra"))  # or the output it is a link of
     result, _, events = _build(spec, tmp_path / "out2", trace)
     assert events == ["reuse build with its outputs", "keep build"]
@@ -359,18 +359,18 @@ def test_force_keeps_the_kept_copy_of_unchanged_outputs_and_damage_is_found_when
     spec = _model(tmp_path / "model")
     _build(spec, tmp_path / "out", trace)
     built = _files(tmp_path / "out")
-    [kept] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
+    [kept] = (tmp_path / "cache/builds").glob("*/outputs-*")
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
-    assert list((tmp_path / "cache/builds").glob("*/*/outputs-*")) == [kept]  # the same files
+    assert list((tmp_path / "cache/builds").glob("*/outputs-*")) == [kept]  # the same files
     urdf = kept / "urdf/arm.urdf"
     urdf.write_text("damaged\n")  # another size: a new copy
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
-    [kept] = (tmp_path / "cache/builds").glob("*/*/outputs-*")
+    [kept] = (tmp_path / "cache/builds").glob("*/outputs-*")
     assert _files(kept) == built
     urdf = kept / "urdf/arm.urdf"
     urdf.write_bytes(urdf.read_bytes().upper())  # the same size: kept, and found when written out
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
-    assert list((tmp_path / "cache/builds").glob("*/*/outputs-*")) == [kept]
+    assert list((tmp_path / "cache/builds").glob("*/outputs-*")) == [kept]
     # the damaged copy is not written out: the build runs from the kept model and keeps a new copy
     assert _build(spec, tmp_path / "out2", trace)[2] == ["reuse build with its outputs", "keep build"]
     assert _build(spec, tmp_path / "out3", trace)[2] == ["reuse build with its outputs"]

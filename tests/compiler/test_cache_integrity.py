@@ -49,7 +49,7 @@ def _first_build(spec: Path, tmp_path: Path) -> None:
 
 
 def _entry(tmp_path: Path) -> Path:
-    (entry,) = (tmp_path / "cache/builds").glob("*/*/entry")
+    (entry,) = (tmp_path / "cache/builds").glob("*/entry")
     return entry
 
 
