@@ -195,31 +195,34 @@ def _digest(k: MeshKey) -> str:
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
          robot: Robot | None = None) -> bool:
     """Write each planned mesh into `out` (`contents`), leaving those already there. The digest
-    of each one written from the cache is noted (core/cache.note_written): keeping the build
-    (compiler/build_cache.py) need not read it again."""
-    from mpc.core.cache import note_written
+    and the origin of each one are noted (core/cache.note_written): keeping the build
+    (compiler/build_cache.py) need not read it again, nor keep a copy of its own."""
+    from mpc.core.cache import file_digest, note_written
     from mpc.core.files import confined, copy_file
 
     # Written already (by another export of the build): asked without resolving the path, which
     # `confined` does for each file written, below; a name that is not inside the output is
     # never taken as written, and is refused there.
-    digests: dict[str, str] = {}
+    entries: dict[str, tuple[str, Path]] = {}
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
-                         and (out / rel).exists(), digests)
+                         and (out / rel).exists(), entries)
     for rel, content in found.items():
         dest = confined(out, rel)
         dest.parent.mkdir(parents=True, exist_ok=True)
         if isinstance(content, bytes):
             dest.write_bytes(content)
-            note_written(dest, digests[rel])
+            note_written(dest, *entries[rel])
         else:
+            digest = file_digest(content)  # the build depends on its bytes: hashed once
             copy_file(content, dest)  # a regular file, checked when the model was read
+            note_written(dest, digest, content)
     return ok
 
 
 def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Robot | None = None,
-             skip: Callable[[str], bool] = lambda rel: False, digests: dict[str, str] | None = None,
+             skip: Callable[[str], bool] = lambda rel: False,
+             entries_used: dict[str, tuple[str, Path]] | None = None,
              ) -> tuple[dict[str, bytes | Path], bool]:
     """What each planned mesh is, by its file name: the bytes of the result of its ops, or the
     source file to copy as it is; and whether none failed. A mesh that fails is reported and
@@ -229,7 +232,8 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     the source's bytes, the ops and the format, and computed in parallel (a process pool)
     when several are missing; a later build with the same inputs only reads them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
-    digests: filled with the SHA-256 of each mesh given as bytes, by its file name.
+    entries_used: filled with the SHA-256 and the cache entry of each mesh given as bytes, by
+    its file name.
     """
     from mpc.core.cache import notes_file, read_entry, remove_entry, touch_entry
     from mpc.core.files import describe
@@ -304,8 +308,8 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
                          hint="the geometry is complete; only materials or textures are missing")
         if source in entries:
             found[rel], digest = entries[source]
-            if digests is not None:
-                digests[rel] = digest
+            if entries_used is not None:
+                entries_used[rel] = digest, source
         else:
             found[rel] = source
     return found, ok

@@ -30,8 +30,10 @@ One entry per definition (its path as given and the working folder), replaced by
 build, in `$MPC_CACHE_DIR/builds/`: a verified entry (core/cache.py) of two lines of JSON,
 the dependencies, outputs and diagnostics, then the program and the robot (compiler/
 kept_values.py: data that no reading of it can make run). Beside it, a copy of the outputs
-(never the delivered files themselves: a clone or a copy), each file checked against its
-SHA-256 when it is written out again. Anyone who can write the cache can change what a
+(never the delivered files themselves: a clone or a copy), but for those that are copies of
+a mesh entry of the cache or of a file the build read (a mesh copied as it is), which it
+names: making a hundred files cost a cold build more than its meshes' bytes. Each file is
+checked against its SHA-256 when it is written out again. Anyone who can write the cache can change what a
 build delivers, but not make mpc run anything: an entry that is not of this form (a pickle
 of an earlier mpc, a crafted one) is refused unread with a warning (W0650), and the build
 runs.
@@ -103,6 +105,8 @@ class KeptBuild:
         self.refused: str | None = None  # why the entry found was not read (W0650), if it was not
         # the kept program and robot as the entry holds them, and read:
         self._program_json, self._robot_json = b"", b""
+        self._entry_data = b""  # the entry as read: one kept again unchanged is not rewritten
+        self.meshes = cache.cache_dir("meshes")  # where the outputs' mesh entries are (`copies`)
         self._program: Program | None = None
         self._model: tuple[Program, Robot] | None = None
         self.recorder = ReadRecorder(ignore=[cache.cache_dir("")])  # derived data, commits' checkouts
@@ -219,19 +223,32 @@ class KeptBuild:
         file that was kept, or not a regular file inside the kept folder. Raises OSError when
         `staging` cannot be written."""
         assert self.header is not None and self.outputs_hold
-        kept = self.folder / self.header["outputs"]["folder"]
-        for folder in self.header["outputs"]["folders"]:
+        outputs = self.header["outputs"]
+        kept = self.folder / outputs["folder"]
+        for folder in outputs["folders"]:
             (staging / folder).mkdir(parents=True, exist_ok=True)
         if kept.is_symlink():
             return False  # a link put into the cache: never read through
         inside = os.path.realpath(kept) + os.sep
-        for name, digest in self.header["outputs"]["files"]:
-            source = kept / name
+        copies = {name: Path(origin) for name, origin in outputs["copies"]}
+        inputs = {f for f, _ in outputs["read"]} | {f for f, _ in self.header["files"]}
+        for name, digest in outputs["files"]:
+            source = copies.get(name)
             try:
-                if not os.path.realpath(source).startswith(inside):
-                    return False  # a link put into the cache: never read through
-                # not through a link, and without waiting on a FIFO put in a file's place
-                fd = os.open(source, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+                if source is None:
+                    source = kept / name
+                    if not os.path.realpath(source).startswith(inside):
+                        return False  # a link put into the cache: never read through
+                    link = os.O_NOFOLLOW
+                elif source.parent == self.meshes:  # a mesh entry, never read through a link
+                    cache.touch_entry(source)  # used: `mpc ci job` passes it on
+                    link = os.O_NOFOLLOW
+                elif str(source) in inputs:  # a file the build read, as it was then (its digest)
+                    link = 0
+                else:
+                    return False
+                # without waiting on a FIFO put in a file's place
+                fd = os.open(source, os.O_RDONLY | link | os.O_NONBLOCK | os.O_CLOEXEC)
                 with open(fd, "rb") as f:
                     if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
                         return False
@@ -290,20 +307,27 @@ class KeptBuild:
             if model_files is None:
                 return
             packages = {(p, n): f for (p, n), f in self.recorder.packages.items()}
+            opened = {f for f, _ in model_files}
             if self.header is not None and self.program_used:
-                # the program's dependencies, read by the build that made it, still hold
+                # --force from the kept program: its dependencies, read by the build that made
+                # it, still hold, and the ops ran anew on them, unchanged: they made the robot
+                # the entry holds, whose JSON is kept again as it was.
                 model_files = list({**dict(self.header["files"]), **dict(model_files)}.items())
                 packages = {(p, n): f for p, n, f in self.header["packages"]} | packages
-            paths = list[PurePath]()
+                model_json, named = (self._program_json, self._robot_json), self.header["named"]
+            else:
+                paths = list[PurePath]()
+                try:
+                    model_json = dumps(program, paths), dumps(robot, paths)
+                except (TypeError, ValueError, RecursionError):
+                    return  # a value that cannot be kept: the next build runs in full
+                named = [(p, *_where(p)) for p in sorted(set(map(str, paths)) - opened)]
             try:
-                model_json = dumps(program, paths), dumps(robot, paths)
                 diagnostics = _kept_diagnostics(model_diagnostics)
             except (TypeError, ValueError, RecursionError):
-                return  # a value that cannot be kept: the next build runs in full
+                return
             front = len(_kept_diagnostics(model_diagnostics[:self.front_said]))
-            opened = {f for f, _ in model_files}
-            header = {"key": self.key, "files": model_files,
-                      "named": [(p, *_where(p)) for p in sorted(set(map(str, paths)) - opened)],
+            header = {"key": self.key, "files": model_files, "named": named,
                       "packages": sorted((p, n, f) for (p, n), f in packages.items()),
                       "diagnostics": diagnostics, "front": front, "modelname": program.modelname,
                       "span": program.span, "outputs": None}
@@ -319,8 +343,11 @@ class KeptBuild:
                 data = _entry_bytes(header, model_json)
             except (TypeError, ValueError, RecursionError):
                 return
-            self.folder.mkdir(parents=True, exist_ok=True)
-            cache.store_entry(self.entry, data)
+            if data == self._entry_data:
+                cache.touch_entry(self.entry)  # the same entry: used, not written again
+            else:
+                self.folder.mkdir(parents=True, exist_ok=True)
+                cache.store_entry(self.entry, data)
             cache.trace(f"keep build {self.folder.name}")
             self._remove_old_outputs(header["outputs"])
 
@@ -334,7 +361,9 @@ class KeptBuild:
         if files is None:
             return None
         names: list[tuple[str, str]] = []
+        copies: list[tuple[str, str]] = []
         folders: list[str] = []
+        origins = {f for f, _ in files} | model_files | {str(self.meshes)}
         for here, dirs, found in os.walk(out):
             rel = Path(here).relative_to(out)
             folders += (str(rel / name) for name in dirs)
@@ -342,23 +371,29 @@ class KeptBuild:
                 source = Path(here) / name
                 if source.is_symlink() or not source.is_file():
                     return None
-                digest = cache.written_digest(source)  # a mesh out of the cache, unchanged since
-                if digest is None:
+                noted = cache.written_copy(source)  # a mesh out of the cache, unchanged since
+                if noted is None:
                     with open(source, "rb") as f:
-                        digest = hashlib.file_digest(f, "sha256").hexdigest()
+                        noted = hashlib.file_digest(f, "sha256").hexdigest(), None
+                digest, origin = noted
                 names.append((str(rel / name), digest))
-        kept = {"files": sorted(names), "folders": sorted(folders), "read": files,
-                "diagnostics": _kept_diagnostics(diagnostics)}
+                if origin is not None and (str(origin) in origins or str(origin.parent) in origins):
+                    copies.append((str(rel / name), str(origin)))
+        kept = {"files": sorted(names), "folders": sorted(folders), "copies": sorted(copies),
+                "read": files, "diagnostics": _kept_diagnostics(diagnostics)}
         before = self.header["outputs"] if self.header is not None else None
         if (before is not None and [list(f) for f in kept["files"]] == before["files"]
+                and [list(f) for f in kept["copies"]] == before["copies"]
                 and kept["folders"] == before["folders"] and self._intact(before, out)):
             return {**kept, "folder": before["folder"]}
         self.folder.mkdir(parents=True, exist_ok=True)
         copy = Path(tempfile.mkdtemp(prefix="outputs-", dir=self.folder))
         for folder in kept["folders"]:
             (copy / folder).mkdir()
+        copied = dict(copies)
         for name, _ in kept["files"]:
-            copy_file(out / name, copy / name)  # a file changed since is found when written out
+            if name not in copied:
+                copy_file(out / name, copy / name)  # a file changed since is found when written out
         return {**kept, "folder": copy.name}
 
     def _intact(self, outputs: dict[str, Any], out: Path) -> bool:
@@ -370,9 +405,10 @@ class KeptBuild:
         folder = self.folder / outputs["folder"]
         if folder.is_symlink() or not folder.is_dir():
             return False
+        copies = dict(outputs["copies"])
         for name, _ in outputs["files"]:
             try:
-                st = os.lstat(folder / name)
+                st = os.lstat(copies[name]) if name in copies else os.lstat(folder / name)
                 if not stat.S_ISREG(st.st_mode) or st.st_size != os.stat(out / name).st_size:
                     return False
             except OSError:
@@ -394,6 +430,7 @@ class KeptBuild:
             return
         try:
             header, self._program_json, self._robot_json = _read_entry(data)
+            self._entry_data = data
         except BadValue as e:
             self._refuse(f"it is not a kept build: {e}")
             return
@@ -427,9 +464,9 @@ class KeptBuild:
 # values; the span and the diagnostics of the header, the program, and the robot, each written
 # by compiler/kept_values.py. The program and the robot are read when first asked for. `front`
 # counts the diagnostics (the first ones) that the front end said.
-_FORM = "mpc kept build 3"
+_FORM = "mpc kept build 4"
 _HEADER_KEYS = frozenset({"form", "key", "files", "named", "packages", "front", "modelname", "outputs"})
-_OUTPUT_KEYS = frozenset({"folder", "files", "folders", "read"})
+_OUTPUT_KEYS = frozenset({"folder", "files", "folders", "copies", "read"})
 _VALUES = ("span", "diagnostics")  # of the header, on the second line
 
 
@@ -465,6 +502,8 @@ def _read_entry(data: bytes) -> tuple[dict[str, Any], bytes, bytes]:
                and name_problem(out["folder"]) is None, "outputs' folder")
         _check(_rows(out["files"], (str, str)) and all(name_problem(n, folders=True) is None
                                                          for n, _ in out["files"]), "output files")
+        copies, files = cast("tuple[Any, Any]", (out["copies"], out["files"]))
+        _check(_rows(copies, (str, str)) and {n for n, _ in copies} <= {n for n, _ in files}, "output copies")
         _check(type(out["folders"]) is list and all(type(n) is str and name_problem(n, folders=True) is None
                                                     for n in out["folders"]), "output folders")
         _check_files(out["read"])

@@ -85,21 +85,29 @@ def read_entry(entry: Path) -> tuple[bytes | None, str | None, str]:
     return data, None, expected
 
 
-def note_written(path: Path, digest: str) -> None:
+def note_written(path: Path, digest: str, origin: Path | None = None) -> None:
     """Remember that `path`, just written by this process, holds bytes of SHA-256 `digest`:
-    `written_digest` answers without reading it while it is the same file, unchanged."""
+    `written_digest` answers without reading it while it is the same file, unchanged.
+    origin: the file `path` is a copy of (a mesh entry of the cache, a source mesh), which a
+    kept build names instead of keeping a copy of its own (`written_copy`)."""
     st = os.stat(path)
-    _written[(st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)] = digest
+    _written[(st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)] = digest, origin
 
 
 def written_digest(path: Path) -> str | None:
     """The SHA-256 noted for `path` (`note_written`) if it is still that file, unchanged (any
     write changes its status time); else None."""
+    noted = written_copy(path)
+    return noted[0] if noted is not None else None
+
+
+def written_copy(path: Path) -> tuple[str, Path | None] | None:
+    """(the SHA-256, the origin) noted for `path` if it is still that file, unchanged; else None."""
     st = os.stat(path)
     return _written.get((st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns))
 
 
-_written: dict[tuple[int, int, int, int, int], str] = {}
+_written: dict[tuple[int, int, int, int, int], tuple[str, Path | None]] = {}
 
 
 def touch_entry(entry: Path) -> None:

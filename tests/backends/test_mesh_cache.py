@@ -334,8 +334,8 @@ def test_a_noted_digest_holds_only_while_the_file_is_unchanged(tmp_path: Path) -
 
 def test_a_forced_build_keeps_the_digests_of_what_it_wrote(tmp_path: Path,
                                                             monkeypatch: pytest.MonkeyPatch) -> None:
-    """The kept copy of each output, meshes out of the cache included, has the digest the entry
-    records: a third build writes them out."""
+    """The kept copy of each output, or the mesh entry or source file it names, has the digest
+    the entry records: a third build writes them out."""
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.setenv("MPC_CACHE_TRACE", str(tmp_path / "trace"))
     spec = _arm(tmp_path / "model")
@@ -347,7 +347,9 @@ def test_a_forced_build_keeps_the_digests_of_what_it_wrote(tmp_path: Path,
     outputs = json.loads(entry.read_bytes().split(b"\n", 1)[0])["outputs"]
     kept = entry.parent / outputs["folder"]
     assert any(name.endswith(".stl") for name, _ in outputs["files"])
+    copies = {name: Path(origin) for name, origin in outputs["copies"]}
+    assert copies and all(name.endswith(".stl") for name in copies)
     for name, digest in outputs["files"]:
-        assert hashlib.sha256((kept / name).read_bytes()).hexdigest() == digest, name
+        assert hashlib.sha256(copies.get(name, kept / name).read_bytes()).hexdigest() == digest, name
     assert compile_file(spec, tmp_path / "out2", Sink()).out is not None
     assert (tmp_path / "trace").read_text().splitlines()[-1].endswith("with its outputs")

@@ -8,6 +8,8 @@ its outputs` when its outputs are, `… for its program` when its program alone 
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import shutil
 import subprocess
@@ -196,6 +198,65 @@ def test_a_damaged_kept_output_is_noticed_and_written_anew(tmp_path: Path, trace
     assert result.out is not None and _files(tmp_path / "out2") == built
 
 
+def _mesh_model(folder: Path) -> Path:
+    """The arm with its mesh copied as it is (URDF: STL) and converted (SDF: OBJ, a mesh entry)."""
+    spec = _model(folder)
+    spec.write_text(spec.read_text().replace("sdf, mesh_format: stl", "sdf, mesh_format: obj"))
+    _settle()
+    return spec
+
+
+def _entry(cache: Path) -> tuple[Path, dict]:
+    [entry] = cache.glob("builds/*/entry")
+    return entry, json.loads(entry.read_bytes().split(b"\n", 1)[0])
+
+
+def test_a_kept_build_names_the_meshes_it_copied_and_writes_them_from_there(
+        tmp_path: Path, trace: Path) -> None:
+    spec = _mesh_model(tmp_path / "model")
+    _build(spec, tmp_path / "out1", trace)
+    built = _files(tmp_path / "out1")
+    _, header = _entry(tmp_path / "cache")
+    [obj] = (tmp_path / "cache/meshes").glob("*.obj")
+    assert header["outputs"]["copies"] == [["meshes/obj/tetra.obj", str(obj)],
+                                           ["meshes/stl/tetra.stl", str(tmp_path / "model/meshes/tetra.stl")]]
+    [kept] = (tmp_path / "cache/builds").glob("*/outputs-*")
+    assert sorted(_files(kept)) == sorted(k for k in built if not k.startswith("meshes/"))  # no copies
+    _, _, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs"] and _files(tmp_path / "out2") == built
+
+
+def test_a_damaged_mesh_entry_is_not_written_out_by_a_kept_build(tmp_path: Path, trace: Path) -> None:
+    spec = _mesh_model(tmp_path / "model")
+    _build(spec, tmp_path / "out1", trace)
+    built = _files(tmp_path / "out1")
+    [obj] = (tmp_path / "cache/meshes").glob("*.obj")
+    obj.write_bytes(obj.read_bytes().replace(b"v ", b"w "))  # its size kept
+    _, sink, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs", "keep build"]  # built from the kept model
+    assert [d.code for d in sink.diagnostics] == ["W0401", "W0650"]  # the entry, computed again
+    assert _files(tmp_path / "out2") == built
+
+
+def test_a_kept_build_reads_no_copy_from_a_file_the_build_did_not_read(tmp_path: Path, trace: Path) -> None:
+    """An entry that names another origin for a mesh (one put into the cache by hand) is not
+    written out, even when that file holds the same bytes."""
+    spec = _mesh_model(tmp_path / "model")
+    _build(spec, tmp_path / "out1", trace)
+    built = _files(tmp_path / "out1")
+    other = tmp_path / "elsewhere.stl"
+    shutil.copy(tmp_path / "model/meshes/tetra.stl", other)
+    entry, _ = _entry(tmp_path / "cache")
+    source = str(tmp_path / "model/meshes/tetra.stl").encode()
+    data = entry.read_bytes().replace(source + b'"]]', str(other).encode() + b'"]]')
+    assert data != entry.read_bytes()
+    entry.write_bytes(data)
+    entry.with_name("entry.sha256").write_text(hashlib.sha256(data).hexdigest() + "\n")
+    _, _, events = _build(spec, tmp_path / "out2", trace)
+    assert events == ["reuse build with its outputs", "keep build"]  # not written out: built
+    assert _files(tmp_path / "out2") == built
+
+
 def test_another_environment_builds_again(tmp_path: Path, trace: Path,
                                           monkeypatch: pytest.MonkeyPatch) -> None:
     spec = _model(tmp_path / "model")
@@ -366,7 +427,7 @@ def test_force_keeps_the_kept_copy_of_unchanged_outputs_and_damage_is_found_when
     urdf.write_text("damaged\n")  # another size: a new copy
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
     [kept] = (tmp_path / "cache/builds").glob("*/outputs-*")
-    assert _files(kept) == built
+    assert _files(kept) == {k: v for k, v in built.items() if k != "meshes/stl/tetra.stl"}  # named
     urdf = kept / "urdf/arm.urdf"
     urdf.write_bytes(urdf.read_bytes().upper())  # the same size: kept, and found when written out
     compile_model(spec, Sink(), Options(out=tmp_path / "out", force=True))
