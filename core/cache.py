@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import shutil
 import time
@@ -186,8 +187,21 @@ def trace(event: str) -> None:
 # not yet show a change made in the same tick of the file system's clock. The file is opened
 # all the same, without being read: `mpc run` learns what a build depends on from the files
 # it opens (pipeline/fingerprint.py).
+#
+# What is remembered of the files of one folder is one JSON file, `digests/<hash of the
+# folder's path>`: {name: [device, inode, size, mtime, ctime, {what: value}]}, the last status
+# seen of each file. A process writes what it learnt when it is done (`keep_digests`; at exit,
+# and after each model a worker of `mpc run` builds), each folder's file once: one file per
+# mesh made a cold build of a hundred meshes create a hundred files. Two processes that keep
+# the same folder at once may lose each other's news, never a value: each merges into what
+# the file holds when it writes it.
 _digests: dict[tuple[object, ...], str] = {}
 _SETTLED_NS = 2_000_000_000
+_HEX = frozenset("0123456789abcdef")
+Memo = list  # [device, inode, size, mtime, ctime, {what: value}]
+_folders: dict[Path, dict[str, Memo]] = {}  # each folder's file, as this process read it
+_news: dict[Path, dict[str, Memo]] = {}  # what this process learnt of each folder's files, by file
+_keeper: list[int] = []  # the process that registered `keep_digests` at exit
 
 
 def file_digest(path: Path) -> str:
@@ -201,22 +215,79 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
     the file cannot be read. A remembered value of another form is computed again."""
     with open(path, "rb") as f:
         st = os.fstat(f.fileno())
-        identity = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
-        key = (*identity, what) if what else identity
+        identity = [st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns]
+        key = (*identity, what)
         if key in _digests:
             return _digests[key]
-        name = hashlib.sha256(repr(key).encode()).hexdigest()
-        memo = cache_dir("digests") / name
-        with contextlib.suppress(OSError, UnicodeDecodeError):
-            known = memo.read_text(encoding="ascii").strip()
-            if len(known) == length and all(c in "0123456789abcdef" for c in known):
-                _digests[key] = known
-                return known
+        folder, _, name = os.path.abspath(path).rpartition("/")
+        file = _memo_file(folder)
+        known = _memo_value(_folder_memos(file).get(name), identity, what)
+        if known is not None and len(known) == length and _HEX.issuperset(known):
+            _digests[key] = known
+            return known
         value = compute(f)
     _digests[key] = value
     if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
-        from mpc.core.files import write_atomic
+        news = _news.setdefault(file, {})
+        memo = news.get(name)
+        if memo is None or memo[:5] != identity:
+            memo = news[name] = [*identity, {}]
+        memo[5][what] = value
+        if _keeper != [os.getpid()]:
+            import atexit
 
-        with contextlib.suppress(OSError):
-            write_atomic(memo, value + "\n")
+            _keeper[:] = [os.getpid()]
+            atexit.register(keep_digests)
     return value
+
+
+def keep_digests() -> None:
+    """Write what this process learnt of its files into `digests/` (a cache that cannot be
+    written keeps nothing); a forked process that inherited it writes only its own."""
+    from mpc.core.files import write_atomic
+
+    if _keeper != [os.getpid()]:
+        _news.clear()
+    for file, news in list(_news.items()):
+        memos = _read_memos(file)
+        for name, memo in news.items():
+            old = memos.get(name)
+            if type(old) is list and old[:5] == memo[:5] and _is_memo(old):
+                memo = [*memo[:5], {**old[5], **memo[5]}]
+            memos[name] = memo
+        _folders[file] = memos
+        with contextlib.suppress(OSError, ValueError):
+            write_atomic(file, json.dumps(memos, separators=(",", ":")) + "\n")
+    _news.clear()
+
+
+def _memo_file(folder: str) -> Path:
+    return cache_dir("digests") / hashlib.sha256(folder.encode(errors="surrogateescape")).hexdigest()
+
+
+def _folder_memos(file: Path) -> dict[str, Memo]:
+    memos = _folders.get(file)
+    if memos is None:
+        memos = _folders[file] = _read_memos(file)
+    return memos
+
+
+def _read_memos(file: Path) -> dict[str, Memo]:
+    """A folder's file in `digests/`: {} when there is none, or it is not of this form."""
+    try:
+        memos = json.loads(file.read_bytes())
+    except (OSError, ValueError, RecursionError):
+        return {}
+    return memos if type(memos) is dict else {}
+
+
+def _is_memo(memo: object) -> bool:
+    return type(memo) is list and len(memo) == 6 and type(memo[5]) is dict
+
+
+def _memo_value(memo: object, identity: list[int], what: str) -> str | None:
+    """The value remembered for `what` of the file of `identity`, if `memo` holds one."""
+    if not _is_memo(memo) or memo[:5] != identity:  # type: ignore[index]
+        return None
+    value = memo[5].get(what)  # type: ignore[index]
+    return value if type(value) is str else None

@@ -17,6 +17,7 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
+from mpc.core.cache import keep_digests
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.reads import ReadRecorder
 from mpc.core.span import Span
@@ -39,6 +40,7 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
     except Exception as e:  # a bug in mpc; the runner reports it as one
         message = {"internal_error": bug(job, e)}
     message["imported"] = sorted(m for m in set(sys.modules) - before if shareable(m))
+    keep_digests()  # a worker ends without running what is registered to run at exit
     conn.send(message)
     conn.close()
 

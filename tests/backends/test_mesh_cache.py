@@ -177,8 +177,9 @@ def test_a_remembered_digest_is_given_only_for_the_same_file_status(
     mesh = tetra_stl(tmp_path / "tetra.stl")
     first = cache.file_digest(mesh)
     assert first == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    cache.keep_digests()  # as the process ends
     assert len(list((tmp_path / "cache/digests").glob("*"))) == 1
-    monkeypatch.setattr(cache, "_digests", {})  # another process
+    _another_process(monkeypatch)
     monkeypatch.setattr(hashlib, "file_digest", None)  # hashing now fails the test
     _OPENED = []
     try:
@@ -188,7 +189,7 @@ def test_a_remembered_digest_is_given_only_for_the_same_file_status(
         _OPENED = None
     monkeypatch.undo()
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
-    monkeypatch.setattr(cache, "_digests", {})
+    _another_process(monkeypatch)
     st = os.stat(mesh)
     data = bytearray(mesh.read_bytes())
     data[-1] ^= 1
@@ -208,7 +209,42 @@ def test_a_file_written_a_moment_ago_is_not_remembered_for_other_processes(
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
     mesh = tetra_stl(tmp_path / "tetra.stl")
     assert cache.file_digest(mesh) == hashlib.sha256(mesh.read_bytes()).hexdigest()
+    cache.keep_digests()
     assert not (tmp_path / "cache/digests").exists()
+
+
+def _another_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Forget what this process remembers of its files (core/cache.py), as a new one would."""
+    from mpc.core import cache
+
+    for name in ("_digests", "_folders", "_news"):
+        monkeypatch.setattr(cache, name, {})
+
+
+def test_what_a_process_learns_of_its_files_is_kept_once_for_each_folder(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """One file in `digests/` for each folder, merged with what other processes kept there; a
+    damaged one is written anew."""
+    from mpc.core import cache
+
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(cache, "_SETTLED_NS", 0)
+    meshes = [tetra_stl(tmp_path / folder / f"{name}.stl") for folder in ("a", "b") for name in ("x", "y")]
+    digests = [cache.file_digest(mesh) for mesh in meshes[:3]]
+    cache.keep_digests()
+    memos = sorted((tmp_path / "cache/digests").glob("*"))
+    assert len(memos) == 2
+    _another_process(monkeypatch)
+    assert cache.file_digest(meshes[3]) == digests[0]  # the same bytes
+    cache.keep_digests()
+    assert sorted(len(json.loads(memo.read_text())) for memo in memos) == [2, 2]  # merged
+    for damaged in ("", "[1, 2]", '{"x.stl": [1]}', "{"):
+        for memo in memos:
+            memo.write_text(damaged)
+        _another_process(monkeypatch)
+        assert [cache.file_digest(mesh) for mesh in meshes] == [digests[0]] * 4
+        cache.keep_digests()
+        assert sorted(len(json.loads(memo.read_text())) for memo in memos) == [2, 2]
 
 
 def _name_digits(path: Path) -> str:
@@ -240,15 +276,22 @@ def test_what_a_warm_build_would_read_a_whole_mesh_for_is_remembered(
     mesh = tmp_path / "tetra.dae"
     mesh.write_bytes(b"<COLLADA><mesh><triangles count='1'><p>0 1 2</p></triangles></mesh></COLLADA>")
     assert ask(mesh) == expected(mesh)
+    cache.keep_digests()
     [memo] = (tmp_path / "cache/digests").glob("*")
-    memo.write_text(other + "\n")
-    monkeypatch.setattr(cache, "_digests", {})  # another process
+
+    def remember(value: str) -> None:
+        memos = json.loads(memo.read_text())
+        memos[mesh.name][5] = {what: value for what in memos[mesh.name][5]}
+        memo.write_text(json.dumps(memos))
+        _another_process(monkeypatch)
+
+    remember(other)
     assert ask(mesh) == other  # what is remembered: the file is not read again
     for damaged in ("", other + "0", "x" * len(other)):
-        memo.write_text(damaged)
-        monkeypatch.setattr(cache, "_digests", {})
+        remember(damaged)
         assert ask(mesh) == expected(mesh)
-        assert memo.read_text() == expected(mesh) + "\n"
+        cache.keep_digests()
+        assert list(json.loads(memo.read_text())[mesh.name][5].values()) == [expected(mesh)]
 
 
 @pytest.mark.parametrize("same_bytes", [True, False])
