@@ -198,7 +198,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     and the origin of each one are noted (core/cache.note_written): keeping the build
     (compiler/build_cache.py) need not read it again, nor keep a copy of its own."""
     from mpc.core.cache import file_digest, note_written
-    from mpc.core.files import confined, copy_file
+    from mpc.core.files import confined_files, copy_file
 
     # Written already (by another export of the build): asked without resolving the path, which
     # `confined` does for each file written, below; a name that is not inside the output is
@@ -207,8 +207,9 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
                          and (out / rel).exists(), entries)
+    paths = confined_files(out, found)
     for rel, content in found.items():
-        dest = confined(out, rel)
+        dest = paths[rel]
         dest.parent.mkdir(parents=True, exist_ok=True)
         if isinstance(content, bytes):
             dest.write_bytes(content)

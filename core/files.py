@@ -58,6 +58,28 @@ def name_problem(name: str, *, folders: bool = False) -> str | None:
     return None
 
 
+def confined_files(root: Path, names: Iterable[str]) -> dict[str, Path]:
+    """`confined(root, name)` of each name (a relative path), each folder resolved once: a
+    plain file name in a folder inside `root` is inside it too unless it is a link (which, and
+    any other name, `confined` judges). A build writes a hundred meshes into two folders, and
+    each `confined` resolves every folder of the path from `/` (ten system calls)."""
+    folders: dict[str, Path | None] = {"": root}
+    paths: dict[str, Path] = {}
+    for name in names:
+        folder, _, base = name.rpartition("/")
+        path = None
+        if not name_problem(name, folders=True):  # no `..`, `.`, `//`, nor an absolute path
+            if folder not in folders:
+                try:
+                    folders[folder] = confined(root, folder)
+                except OutsideOutput:
+                    folders[folder] = None  # said for the file's own name (below)
+            inside = folders[folder]
+            path = inside / base if inside is not None and not os.path.islink(inside / base) else None
+        paths[name] = path if path is not None else confined(root, name)
+    return paths
+
+
 def file_name(name: str, what: str) -> str:
     """`name`, a name taken from the model (`what`: 'link', 'pose'), as one file name inside
     the output; raises NotAFileName when it is not one (a '/', '..', an absolute path…).

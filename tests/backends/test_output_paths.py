@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from mpc.core.files import NotAFileName, confined, file_name
+from mpc.core.files import NotAFileName, OutsideOutput, confined, confined_files, file_name
 
 BACKENDS = Path(__file__).resolve().parents[2] / "backends"
-PATH_CALLS = {"confined", "joinpath", "with_name", "with_suffix", "Path"}
+PATH_CALLS = {"confined", "confined_files", "joinpath", "with_name", "with_suffix", "Path"}
 
 CONFINED = "confined: names checked (E0250 robotname, filename, file_name, submodel, dirname)"
 DATA = "confined, the model's name through file_name (E0540 before any build)"
@@ -52,7 +52,7 @@ SITES: dict[tuple[str, str, str], str] = {
     ("mjcf_reader.py", "gather_other_files", "os.path.join(spec.modelfiledir, uri)"):
         "the name MuJoCo looks a file up by among the files handed to it; no file",
     ("mjcf_reader.py", "msh_as_stl", "cache_dir('msh') / f'{hashlib.sha256(data).hexdigest()}.stl'"): CACHE,
-    ("meshes.py", "copy", "confined(out, rel)"): "confined: mesh paths mpc makes (meshes/…)",
+    ("meshes.py", "copy", "confined_files(out, found)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "copy", "out / rel"): "only whether it is there (a name inside); written through confined",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / f'{digest}{suffix}'"): CACHE,
     ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
@@ -155,3 +155,21 @@ def test_file_name_refuses_what_is_not_one_file_name(tmp_path: Path, name: str) 
 def test_file_name_keeps_a_file_name(tmp_path: Path) -> None:
     assert confined(tmp_path, "config", f"x_{file_name('ok.name-1', 'pose')}.yml") == \
         tmp_path / "config" / "x_ok.name-1.yml"
+
+
+def test_confined_files_judges_each_name_as_confined_does(tmp_path: Path) -> None:
+    """Each folder resolved once; a link, in a folder or as the file, judged where it leads."""
+    out, outside = tmp_path / "out", tmp_path / "outside"
+    (out / "meshes/stl").mkdir(parents=True)
+    outside.mkdir()
+    (out / "meshes/stl/away.stl").symlink_to(outside / "away.stl")  # dangling, and outside
+    (out / "meshes/stl/near.stl").symlink_to(out / "meshes/stl/a.stl")
+    (out / "meshes/obj").symlink_to(outside)
+    names = ["meshes/stl/a.stl", "meshes/stl/near.stl", "urdf.urdf", "meshes/stl/./b.stl"]
+    assert confined_files(out, names) == {name: confined(out, name) for name in names}
+    for name in ("meshes/stl/away.stl", "meshes/obj/c.obj", "meshes/../../c.stl", "/c.stl"):
+        with pytest.raises(OutsideOutput) as raised:
+            confined_files(out, ["meshes/stl/a.stl", name])
+        with pytest.raises(OutsideOutput) as expected:
+            confined(out, name)
+        assert str(raised.value) == str(expected.value)
