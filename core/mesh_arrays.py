@@ -110,9 +110,9 @@ def obj_name(data: bytes, file_name: str) -> str | None:
     return name or None
 
 
-def face_normals(arrays: Arrays) -> np.ndarray:
-    """The unit normal of each triangle, 0 for a degenerate one (trimesh's `face_normals`)."""
-    triangles = arrays.vertices[arrays.faces]
+def face_normals(triangles: np.ndarray) -> np.ndarray:
+    """The unit normal of each triangle (its corners: `vertices[faces]`), 0 for a degenerate
+    one (trimesh's `face_normals`)."""
     vectors = triangles[:, 1:, :] - triangles[:, :2, :]
     crosses = np.cross(vectors[:, 0], vectors[:, 1])
     norm = np.sqrt(np.dot(crosses * crosses, [1.0] * 3))
@@ -128,8 +128,9 @@ def encode_stl(arrays: Arrays) -> bytes:
     """A binary STL: an empty 80-byte header, the count, each triangle's normal and corners."""
     header = bytes(80) + np.array([len(arrays.faces)], dtype="<u4").tobytes()
     packed = np.zeros(len(arrays.faces), dtype=_STL_RECORD)
-    packed["normals"] = face_normals(arrays)
-    packed["vertices"] = arrays.vertices[arrays.faces]
+    triangles = arrays.vertices[arrays.faces]
+    packed["normals"] = face_normals(triangles)
+    packed["vertices"] = triangles
     return header + packed.tobytes()
 
 
