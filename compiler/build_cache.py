@@ -398,17 +398,17 @@ class KeptBuild:
 
     def _intact(self, outputs: dict[str, Any], out: Path) -> bool:
         """Whether the kept copy of `outputs` (the same files as in `out`, by their digests) is
-        still there: each file a regular file of the cache, of the size of its twin in `out`. Its
-        bytes are checked against their digests when they are written out (`write_outputs`); a
-        damaged copy is then dropped (`drop_outputs`), and the build that runs instead keeps a
-        new one."""
+        still there: each file a regular file of the cache (or the file it names), of the size of
+        its twin in `out`. Its bytes are checked against their digests when they are written out
+        (`write_outputs`); a damaged copy is then dropped (`drop_outputs`), and the build that
+        runs instead keeps a new one."""
         folder = self.folder / outputs["folder"]
         if folder.is_symlink() or not folder.is_dir():
             return False
         copies = dict(outputs["copies"])
         for name, _ in outputs["files"]:
             try:
-                st = os.lstat(copies[name]) if name in copies else os.lstat(folder / name)
+                st = os.stat(copies[name]) if name in copies else os.lstat(folder / name)
                 if not stat.S_ISREG(st.st_mode) or st.st_size != os.stat(out / name).st_size:
                     return False
             except OSError:
