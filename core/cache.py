@@ -32,8 +32,9 @@ def cache_dir(kind: str) -> Path:
 # The files an entry keeps beside it: its hash, and the notes its computation left (a mesh's
 # broken DAE references, W0605). They are touched, removed and passed on with the entry.
 SIDECARS = (".sha256", ".ignored")
-LOCK = ".lock"  # beside an entry: `single_flight`; neither part of the entry nor removed with it
+LOCK = ".lock"  # beside an entry of an earlier mpc's cache (its `single_flight`): no part of the entry
 BESIDE = (*SIDECARS, LOCK)  # every file that is kept beside an entry and is no entry itself
+LOCKS = ".locks"  # in each folder of entries: the file whose bytes `single_flight` locks
 
 
 def _hash_file(entry: Path) -> Path:
@@ -130,11 +131,17 @@ def remove_entry(entry: Path) -> None:
 
 # -- single flight -----------------------------------------------------------------------------
 # Two processes (workers of `mpc run`, concurrent `mpc compile`s) that miss the same entry
-# would both compute it. Each takes an exclusive lock on `<entry>.lock` first and looks again
-# once it holds it: the second finds the first's result. flock locks belong to the open file,
-# so a process that dies (killed, crashed) releases its lock with it: a lock file left behind
-# is never stale, and the next process simply takes it. A process holds at most two such locks,
-# always a derived entry's before its source's, so no two processes wait for each other.
+# would both compute it. Each locks the entry's byte of its folder's `.locks` file first (a
+# byte chosen by the entry's name: POSIX record locks, one file for a folder's entries rather
+# than a lock file of its own for each, which cost a cold build of a hundred meshes a hundred
+# files) and looks again once it holds it: the second finds the first's result. Record locks
+# belong to the process: one that dies (killed, crashed) releases its locks with it, and a
+# forked child holds none of its parent's. A process keeps one descriptor of each `.locks`
+# file open for its life, since closing any descriptor of a file releases every record lock
+# the process holds on it. A process holds at most two such locks, always a derived entry's
+# before its source's (in another folder), so no two processes wait for each other; two names
+# of one byte (one in two billion) only wait for each other.
+_lock_files: dict[Path, int] = {}
 
 
 @contextlib.contextmanager
@@ -144,22 +151,32 @@ def single_flight(entry: Path) -> Iterator[None]:
     entry reports the cache's problem."""
     import fcntl
 
-    lock = entry.with_name(entry.name + LOCK)
+    name = entry.name.encode(errors="surrogateescape")
+    byte = int.from_bytes(hashlib.sha256(name).digest()[:4], "big") >> 1  # below 2**31
     try:
-        lock.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        fd = _lock_file(entry.parent)
+        try:
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB, 1, byte)
+        except (BlockingIOError, PermissionError):  # EAGAIN or EACCES: another process holds it
+            trace(f"wait {entry.name}")
+            fcntl.lockf(fd, fcntl.LOCK_EX, 1, byte)
     except OSError:
         yield
         return
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            trace(f"wait {entry.name}")  # another process computes it
-            fcntl.flock(fd, fcntl.LOCK_EX)
         yield
     finally:
-        os.close(fd)  # releases the lock
+        with contextlib.suppress(OSError):
+            fcntl.lockf(fd, fcntl.LOCK_UN, 1, byte)
+
+
+def _lock_file(folder: Path) -> int:
+    """This process's descriptor of `folder`'s `.locks` file, opened once."""
+    fd = _lock_files.get(folder)
+    if fd is None:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd = _lock_files[folder] = os.open(folder / LOCKS, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    return fd
 
 
 def trace(event: str) -> None:

@@ -8,7 +8,6 @@ imports no mesh library.
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import json
 import os
@@ -23,6 +22,7 @@ import pytest
 
 from mpc.backends.meshes import _cached_path
 from mpc.compiler.driver import Options, compile_model
+from mpc.core.cache import single_flight
 from mpc.core.diagnostics import Sink
 from tests.conftest import ERD, compile_file, definition, write
 from tests.fixtures import ARM_URDF, tetra_stl
@@ -59,16 +59,13 @@ def test_two_processes_on_the_same_cold_mesh_convert_it_once(tmp_path: Path,
     env = {**os.environ, "MPC_CACHE_TRACE": str(trace)}
     # The test holds the entry's lock first, so that both builds are certain to meet there.
     entry = _cached_path(tmp_path / "model/meshes/forearm.dae", (), ".stl")
-    lock = entry.with_name(entry.name + ".lock")
-    lock.parent.mkdir(parents=True)
-    holder = os.open(lock, os.O_RDWR | os.O_CREAT)
-    fcntl.flock(holder, fcntl.LOCK_EX)
-    builds = [_mpc(spec, tmp_path / f"out{n}", env) for n in (1, 2)]
-    deadline = time.monotonic() + 120
-    while _trace(trace).count(f"wait {entry.name}") < 2 and time.monotonic() < deadline:
-        assert all(b.poll() is None for b in builds), [b.communicate()[0] for b in builds]
-        time.sleep(0.05)
-    os.close(holder)  # both wait: let them go
+    with single_flight(entry):
+        builds = [_mpc(spec, tmp_path / f"out{n}", env) for n in (1, 2)]
+        deadline = time.monotonic() + 120
+        while _trace(trace).count(f"wait {entry.name}") < 2 and time.monotonic() < deadline:
+            assert all(b.poll() is None for b in builds), [b.communicate()[0] for b in builds]
+            time.sleep(0.05)
+    # both wait: let them go
     for build in builds:
         assert build.wait(120) == 0, build.communicate()[0]
     events = _trace(trace)
@@ -90,9 +87,9 @@ def test_a_process_that_died_holding_the_lock_blocks_nobody(tmp_path: Path) -> N
     holder = subprocess.Popen([sys.executable, "-c", hold, str(tmp_path / "model/meshes/forearm.dae")],
                               env=env, stdout=subprocess.PIPE, text=True)
     assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
-    holder.kill()  # killed while holding the lock; its lock file stays behind
+    holder.kill()  # killed while holding the lock; the file of the locks stays behind
     holder.wait()
-    assert list(cache.rglob("*.stl.lock"))
+    assert (cache / "meshes" / ".locks").is_file()
     build = _mpc(spec, tmp_path / "out", env)
     assert build.wait(120) == 0, build.communicate()[0]
     assert [e.split()[0] for e in _trace(trace)] == ["parse", "derive"]

@@ -67,7 +67,7 @@ def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path,
     assert first is not None
     # an entry computed again is a new file (renamed into place); a used one is only touched
     cache = {p: p.stat().st_ino for p in (tmp_path / "cache/meshes").rglob("*")
-             if p.is_file() and p.suffix != ".lock"}
+             if p.is_file() and p.name != ".locks"}
     # every OBJ, computed once, and its hash; the STL files are copied; each STL file read by
     # the plain path (specs/files.md), which keeps no normalized form
     assert len([p for p in cache if "normal" not in p.parts]) == 2 * 48
@@ -75,7 +75,7 @@ def test_a_second_build_reads_every_mesh_from_the_cache(tmp_path: Path,
     second = compile_file(spec, tmp_path / "b", Diags()).out
     assert second is not None
     again = {p: p.stat().st_ino for p in (tmp_path / "cache/meshes").rglob("*")
-             if p.is_file() and p.suffix != ".lock"}
+             if p.is_file() and p.name != ".locks"}
     assert again == cache  # nothing was computed again
     files = sorted(p.relative_to(first) for p in first.rglob("*") if p.is_file())
     assert files == sorted(p.relative_to(second) for p in second.rglob("*") if p.is_file())
