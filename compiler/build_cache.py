@@ -33,10 +33,10 @@ kept_values.py: data that no reading of it can make run). Beside it, a copy of t
 (never the delivered files themselves: a clone or a copy), but for those that are copies of
 a mesh entry of the cache or of a file the build read (a mesh copied as it is), which it
 names: making a hundred files cost a cold build more than its meshes' bytes. Each file is
-checked against its SHA-256 when it is written out again. Anyone who can write the cache can change what a
-build delivers, but not make mpc run anything: an entry that is not of this form (a pickle
-of an earlier mpc, a crafted one) is refused unread with a warning (W0650), and the build
-runs.
+checked against its SHA-256 when it is written out again. Anyone who can write the cache can
+change what a build delivers, but not make mpc run anything: an entry that is not of this
+form (a pickle of an earlier mpc, a crafted one) is refused unread with a warning (W0650),
+and the build runs.
 """
 
 from __future__ import annotations
@@ -363,7 +363,7 @@ class KeptBuild:
         names: list[tuple[str, str]] = []
         copies: list[tuple[str, str]] = []
         folders: list[str] = []
-        origins = {f for f, _ in files} | model_files | {str(self.meshes)}
+        inputs = {f for f, _ in files} | model_files  # what `write_outputs` may read besides
         for here, dirs, found in os.walk(out):
             rel = Path(here).relative_to(out)
             folders += (str(rel / name) for name in dirs)
@@ -377,7 +377,7 @@ class KeptBuild:
                         noted = hashlib.file_digest(f, "sha256").hexdigest(), None
                 digest, origin = noted
                 names.append((str(rel / name), digest))
-                if origin is not None and (str(origin) in origins or str(origin.parent) in origins):
+                if origin is not None and (origin.parent == self.meshes or str(origin) in inputs):
                     copies.append((str(rel / name), str(origin)))
         kept = {"files": sorted(names), "folders": sorted(folders), "copies": sorted(copies),
                 "read": files, "diagnostics": _kept_diagnostics(diagnostics)}
