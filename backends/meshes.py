@@ -201,8 +201,8 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     from mpc.core.files import confined_files, copy_file
 
     # Written already (by another export of the build): asked without resolving the path, which
-    # `confined` does for each file written, below; a name that is not inside the output is
-    # never taken as written, and is refused there.
+    # `confined_files` does for the files written, below; a name that is not inside the output
+    # is never taken as written, and is refused there.
     entries: dict[str, tuple[str, Path]] = {}
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")

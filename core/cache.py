@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable, Iterator
 from io import BufferedReader
 from pathlib import Path
+from typing import Any
 
 
 def cache_dir(kind: str) -> Path:
@@ -92,8 +93,7 @@ def note_written(path: Path, digest: str, origin: Path | None = None) -> None:
     `written_digest` answers without reading it while it is the same file, unchanged.
     origin: the file `path` is a copy of (a mesh entry of the cache, a source mesh), which a
     kept build names instead of keeping a copy of its own (`written_copy`)."""
-    st = os.stat(path)
-    _written[(st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)] = digest, origin
+    _written[status(os.stat(path))] = digest, origin
 
 
 def written_digest(path: Path) -> str | None:
@@ -105,8 +105,13 @@ def written_digest(path: Path) -> str | None:
 
 def written_copy(path: Path) -> tuple[str, Path | None] | None:
     """(the SHA-256, the origin) noted for `path` if it is still that file, unchanged; else None."""
-    st = os.stat(path)
-    return _written.get((st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns))
+    return _written.get(status(os.stat(path)))
+
+
+def status(st: os.stat_result) -> tuple[int, int, int, int, int]:
+    """A file's identity and status, as git's index keeps them: device, inode, size,
+    modification and change times (any write changes the change time)."""
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns
 
 
 _written: dict[tuple[int, int, int, int, int], tuple[str, Path | None]] = {}
@@ -232,7 +237,7 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
     the file cannot be read. A remembered value of another form is computed again."""
     with open(path, "rb") as f:
         st = os.fstat(f.fileno())
-        identity = [st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns]
+        identity = list(status(st))
         key = (*identity, what)
         if key in _digests:
             return _digests[key]
@@ -298,13 +303,14 @@ def _read_memos(file: Path) -> dict[str, Memo]:
     return memos if type(memos) is dict else {}
 
 
-def _is_memo(memo: object) -> bool:
+def _is_memo(memo: Any) -> bool:
     return type(memo) is list and len(memo) == 6 and type(memo[5]) is dict
 
 
-def _memo_value(memo: object, identity: list[int], what: str) -> str | None:
-    """The value remembered for `what` of the file of `identity`, if `memo` holds one."""
-    if not _is_memo(memo) or memo[:5] != identity:  # type: ignore[index]
+def _memo_value(memo: Any, identity: list[int], what: str) -> str | None:
+    """The value remembered for `what` of the file of `identity`, if `memo` (read from a file
+    of `digests/`, of any form) holds one."""
+    if not _is_memo(memo) or memo[:5] != identity:
         return None
-    value = memo[5].get(what)  # type: ignore[index]
+    value = memo[5].get(what)
     return value if type(value) is str else None
