@@ -374,7 +374,8 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     that failed. The jobs of one source go together: all of them by the plain path
     (backends/plain_meshes.py: one read of the file, no trimesh) when it takes each of them,
     else each by trimesh. Several groups run in a pool of processes, one per core, the
-    distinct files side by side (a trimesh job parses once: mesh_source.read's single flight)."""
+    distinct files side by side (a trimesh job parses once: mesh_source.read's single flight);
+    plain groups of a few megabytes, here and in one forked child (backends/mesh_fork.py)."""
     if not jobs:
         return {}
     from mpc.backends.plain_meshes import plain
@@ -393,8 +394,16 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
                                                     if tasks[i][1][0][0] not in firsts else len(tasks) + i))
     tasks = [tasks[i] for i in order]
     workers = min(len(tasks), mesh_workers())
-    if workers < 2 or len(jobs) < 3 or _light(tasks):
+    sizes = _plain_sizes(tasks)
+    if workers < 2 or len(jobs) < 3 or (sizes is not None and sum(sizes) < FORKED):
         results = [_materialise_all(task) for task in tasks]
+    elif sizes is not None and sum(sizes) < LIGHT:
+        from mpc.backends.mesh_fork import beside_a_fork, may_fork
+
+        if _share is None and may_fork():
+            results = beside_a_fork(tasks, sizes, _materialise_all)
+        else:  # `mpc run`'s builds use the other cores already
+            results = [_materialise_all(task) for task in tasks]
     else:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
@@ -409,21 +418,26 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     return {dest: problem for found in results for dest, problem in found.items()}
 
 
-# Bytes of source files the plain path reads faster in the build's own process than a pool
-# starts and feeds its workers (the 88-link assembly's 14 MB: 0.86× the wall time, bench/README.md).
+# Bytes of source files the plain path reads faster in the build's own process, or beside one
+# forked child (backends/mesh_fork.py), than a pool starts and feeds its workers (the 88-link
+# assembly's 14 MB: 0.86× the wall time, bench/README.md); and below which the fork (about 2 ms)
+# costs more than the half it takes over saves.
 LIGHT = 32 * 2**20
+FORKED = 2**20
 
 
-def _light(tasks: list[Task]) -> bool:
-    """Whether the tasks are all the plain path's and their sources small (LIGHT), so that they
-    are done here, not in a pool; MPC_MESH_WORKERS set to a number asks for the pool anyway."""
+def _plain_sizes(tasks: list[Task]) -> list[int] | None:
+    """The bytes of each task's source when all are the plain path's; None when some are not,
+    or when MPC_MESH_WORKERS set to a number asks for the pool."""
     if os.environ.get(WORKERS, "").isdigit() or not all(is_plain for is_plain, _ in tasks):
-        return False
-    size = 0
+        return None
+    sizes = []
     for _, jobs in tasks:
-        with contextlib.suppress(OSError):  # reading it reports the problem
-            size += jobs[0][0].stat().st_size
-    return size < LIGHT
+        try:
+            sizes.append(jobs[0][0].stat().st_size)
+        except OSError:  # reading it reports the problem
+            sizes.append(0)
+    return sizes
 
 
 def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:

@@ -31,12 +31,14 @@ SHAPES = {"box": lambda: trimesh.creation.box((0.1, 0.2, 0.3)),
           "cone": lambda: trimesh.creation.cone(0.05, 0.1)}
 
 
-def _robot(folder: Path, size: float = 1.0) -> Path:
+def _robot(folder: Path, size: float = 1.0, fine: bool = False) -> Path:
     """Four links, each with its own STL mesh (`size` times the shape): converted to OBJ, they
-    are four jobs."""
+    are four jobs. fine: the ball of 81,920 triangles (4 MB), which a build shares with a
+    forked child (backends/mesh_fork.py), not of 20,480 (1 MB)."""
     links, joints = [], []
     for i, (name, make) in enumerate(SHAPES.items()):
-        make().apply_scale(size).export(folder / f"{name}.stl")
+        mesh = trimesh.creation.icosphere(6, 0.1) if fine and name == "ball" else make()
+        mesh.apply_scale(size).export(folder / f"{name}.stl")
         links.append(f'<link name="{name}"><visual><geometry><mesh filename="{name}.stl"/></geometry>'
                      f'</visual></link>')
         if i:
@@ -46,14 +48,19 @@ def _robot(folder: Path, size: float = 1.0) -> Path:
     return write(folder / "shapes.yml", definition("shapes.urdf", mesh_format="obj", robotname="shapes"))
 
 
-def _built(folder: Path, workers: str, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, set[int]]:
-    """The build's output folder with MPC_MESH_WORKERS=workers (and a cache of its own), and
-    the processes that derived its meshes (MPC_CACHE_TRACE's lines: pid, event, name)."""
-    monkeypatch.setenv("MPC_MESH_WORKERS", workers)
-    monkeypatch.setenv("MPC_CACHE_DIR", str(folder / f"cache-{workers}"))
-    monkeypatch.setenv("MPC_CACHE_TRACE", str(trace := folder / f"trace-{workers}"))
+def _built(folder: Path, workers: str | None, monkeypatch: pytest.MonkeyPatch,
+           fine: bool = False, run: str = "") -> tuple[Path, set[int]]:
+    """The build's output folder with MPC_MESH_WORKERS=workers (None: unset; and a cache of
+    its own, named with `run`), and the processes that derived its meshes (MPC_CACHE_TRACE's
+    lines: pid, event, name)."""
+    if workers is None:
+        monkeypatch.delenv("MPC_MESH_WORKERS")
+    else:
+        monkeypatch.setenv("MPC_MESH_WORKERS", workers)
+    monkeypatch.setenv("MPC_CACHE_DIR", str(folder / f"cache-{workers}{run}"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(trace := folder / f"trace-{workers}{run}"))
     sink = Sink()
-    result = compile_file(_robot(folder), folder / f"out-{workers}", sink)
+    result = compile_file(_robot(folder, fine=fine), folder / f"out-{workers}{run}", sink)
     assert result.out is not None and not sink.diagnostics, sink.summary()
     return result.out, {int(line.split()[0]) for line in trace.read_text().splitlines() if " derive " in line}
 
@@ -72,6 +79,68 @@ def test_a_pool_writes_what_one_process_writes(tmp_path: Path, monkeypatch: pyte
     pooled, computed_pooled = _built(tmp_path, "2", monkeypatch)
     assert os.getpid() not in computed_pooled and 1 <= len(computed_pooled) <= 2
     _same_tree(alone, pooled)
+
+
+def _two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The build has the machine to itself, of two cores (not one of `mpc run`'s), and has
+    loaded no MuJoCo (another test in this process may have: it is unloaded for the test)."""
+    monkeypatch.setattr("mpc.backends.meshes.usable_cores", lambda: 2)
+    monkeypatch.setattr("mpc.backends.meshes._share", None)
+    monkeypatch.delitem(sys.modules, "mujoco", raising=False)
+
+
+def test_a_build_makes_half_its_plain_meshes_in_one_forked_child(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Megabytes of the plain path's jobs (STL → OBJ) on two cores: the largest here, the other
+    three in a child, and the same bytes as in one process."""
+    alone, computed_alone = _built(tmp_path, "1", monkeypatch, fine=True)
+    assert computed_alone == {os.getpid()}
+    _two_cores(monkeypatch)
+    forked, computed = _built(tmp_path, None, monkeypatch, fine=True)
+    assert os.getpid() in computed and len(computed) == 2
+    _same_tree(alone, forked)
+
+
+def test_a_build_makes_the_half_of_a_child_that_failed(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    from mpc.backends import meshes
+
+    alone, _ = _built(tmp_path, "1", monkeypatch, fine=True)
+    _two_cores(monkeypatch)
+    parent, materialise_all = os.getpid(), meshes._materialise_all
+
+    def dies_in_the_child(task: meshes.Task) -> dict[Path, tuple[str, str]]:
+        if os.getpid() != parent:
+            os._exit(7)
+        return materialise_all(task)
+
+    monkeypatch.setattr(meshes, "_materialise_all", dies_in_the_child)
+    forked, computed = _built(tmp_path, None, monkeypatch, fine=True)
+    assert computed == {parent}
+    _same_tree(alone, forked)
+
+
+@pytest.mark.parametrize("why", ["a thread runs", "MuJoCo is loaded", "mpc run", "small"])
+def test_a_build_forks_no_child_when(why: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Another thread's locks would be copied held into the child, and MuJoCo's GL context;
+    `mpc run`'s builds use the other cores for other models; a megabyte of jobs is made here
+    sooner than a fork."""
+    import threading
+
+    _two_cores(monkeypatch)
+    if why == "MuJoCo is loaded":
+        import mujoco  # noqa: F401
+    if why == "mpc run":
+        share_cores(1)
+    stop = threading.Event()
+    thread = threading.Thread(target=stop.wait)
+    if why == "a thread runs":
+        thread.start()
+    try:
+        _, computed = _built(tmp_path, None, monkeypatch, fine=why != "small")
+    finally:
+        stop.set()
+    assert computed == {os.getpid()}
 
 
 def test_mpc_compile_forks_its_pool(tmp_path: Path) -> None:
@@ -102,6 +171,31 @@ def test_the_workers_of_a_build(monkeypatch: pytest.MonkeyPatch) -> None:
     for given, used in (("3", 3), ("0", max(1, cores // 2)), ("x", max(1, cores // 2))):
         monkeypatch.setenv("MPC_MESH_WORKERS", given)
         assert mesh_workers() == used
+
+
+def test_mpc_compile_forks_one_child_for_half_its_plain_meshes(tmp_path: Path) -> None:
+    """As `mpc compile` runs (MPC_MESH_WORKERS unset), on a machine of two cores or more: the
+    meshes are made in the build and one child, and it prints what one process prints."""
+    path = _robot(tmp_path, fine=True)
+    printed, derived = [], []
+    for workers in ("1", None):
+        env = {k: v for k, v in os.environ.items() if k != "MPC_MESH_WORKERS"}
+        env |= {"MPC_CACHE_DIR": str(tmp_path / f"cache-{workers}"),
+                "MPC_CACHE_TRACE": str(trace := tmp_path / f"trace-{workers}")}
+        if workers:
+            env["MPC_MESH_WORKERS"] = workers
+        mpc = subprocess.Popen([sys.executable, "-m", "mpc.cli.main", "compile", str(path), "-o",
+                                str(tmp_path / f"out-{workers}")], env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+        out, err = mpc.communicate(timeout=600)
+        assert mpc.returncode == 0, err
+        printed.append((out.replace(f"out-{workers}", "OUT"), err))
+        lines = trace.read_text().splitlines()
+        derived.append({int(line.split()[0]) for line in lines if " derive " in line})
+    assert printed[0] == printed[1]
+    cores = len(os.sched_getaffinity(0))
+    assert len(derived[0]) == 1 and len(derived[1]) == min(cores, 2)
+    _same_tree(tmp_path / "out-1", tmp_path / "out-None")
 
 
 @pytest.mark.parametrize("models", [1, 2])
