@@ -55,6 +55,8 @@ SITES: dict[tuple[str, str, str], str] = {
     ("meshes.py", "copy", "confined_files(out, found)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "copy", "out / rel"): "only whether it is there (a name inside); written through confined",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / f'{digest}{suffix}'"): CACHE,
+    ("mesh_fork.py", "beside_a_fork", "Path(entry)"):
+        "the forked child's answer: the cache entries `_cached_path` named, as keys; nothing is written",
     ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
     ("mjcf_actuation.py", "_actuator", "effort / FULL_EFFORT_AT"): MATH,
     ("mjcf.py", "emit", "confined(out, 'mjcf', f'{name}.xml')"): CONFINED,
