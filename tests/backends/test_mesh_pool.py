@@ -120,6 +120,30 @@ def test_a_build_makes_the_half_of_a_child_that_failed(tmp_path: Path,
     _same_tree(alone, forked)
 
 
+def test_what_the_forked_child_cannot_make_is_said_as_one_process_says_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A broken STL among the child's jobs (the three smaller meshes): the build says what it
+    says when one process makes every mesh, word for word."""
+    said, derived = [], []
+    for workers in ("1", None):
+        folder = tmp_path / f"workers-{workers}"
+        folder.mkdir()
+        spec = _robot(folder, fine=True)
+        (folder / "cone.stl").write_bytes(b"no triangles here\n" * 8)
+        if workers is None:
+            _two_cores(monkeypatch)
+            monkeypatch.delenv("MPC_MESH_WORKERS")
+        monkeypatch.setenv("MPC_CACHE_DIR", str(folder / "cache"))
+        monkeypatch.setenv("MPC_CACHE_TRACE", str(trace := folder / "trace"))
+        sink = Sink()
+        assert compile_file(spec, folder / "out", sink).out is None
+        said.append([(d.code, d.message.replace(str(folder), "FOLDER")) for d in sink.diagnostics])
+        derived.append({line.split()[0] for line in trace.read_text().splitlines() if " derive " in line})
+    assert said[0] == said[1]
+    assert [code for code, _ in said[0]] == ["E0603"] and "cone.stl" in said[0][0][1]
+    assert len(derived[0]) == 1 and len(derived[1]) == 2
+
+
 @pytest.mark.parametrize("why", ["a thread runs", "MuJoCo is loaded", "mpc run", "small"])
 def test_a_build_forks_no_child_when(why: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Another thread's locks would be copied held into the child, and MuJoCo's GL context;
