@@ -16,13 +16,15 @@ from tests.conftest import ERD
 from tests.pipeline.helpers import env, run_json
 
 # Waits while the file `hold` exists next to it (or until its parent, the worker, is gone),
-# after writing `waiting` with its own pid: the point where the test kills the worker.
+# after writing `waiting` with its own pid (whole: the test may look at any moment): the point
+# where the test kills the worker.
 HOLD = """\
 import os, pathlib, time
 here = pathlib.Path(__file__).parent
 if (here / "hold").exists():
     parent = os.getppid()
-    (here / "waiting").write_text(str(os.getpid()))
+    (here / "waiting.part").write_text(str(os.getpid()))
+    os.replace(here / "waiting.part", here / "waiting")
     for _ in range(1200):
         if os.getppid() != parent or not (here / "hold").exists():
             break
