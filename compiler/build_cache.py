@@ -253,9 +253,9 @@ class KeptBuild:
                     if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
                         return False
                     data = f.read()
+                    if cache.digest_of_read(f, source, data) != digest:  # a settled file: by its status
+                        return False
             except OSError:
-                return False
-            if hashlib.sha256(data).hexdigest() != digest:
                 return False
             (staging / name).write_bytes(data)
         return True

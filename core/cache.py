@@ -236,18 +236,30 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
     their sha256), remembered by the file's identity and status as above; raises OSError when
     the file cannot be read. A remembered value of another form is computed again."""
     with open(path, "rb") as f:
-        st = os.fstat(f.fileno())
-        identity = list(status(st))
-        key = (*identity, what)
-        if key in _digests:
-            return _digests[key]
-        folder, _, name = os.path.abspath(path).rpartition("/")
-        file = _memo_file(folder)
-        known = _memo_value(_folder_memos(file).get(name), identity, what)
-        if known is not None and len(known) == length and _HEX.issuperset(known):
-            _digests[key] = known
-            return known
-        value = compute(f)
+        return _remembered_in(f, path, what, compute, length)
+
+
+def digest_of_read(f: BufferedReader, path: Path, data: bytes) -> str:
+    """The sha256 (hex) of `data`, just read whole from `f`, the open file `path`: remembered
+    as `file_digest` remembers it, by the status of the file as it is after the read (a write
+    during the read changes it), so that a settled file is not hashed again."""
+    return _remembered_in(f, path, "", lambda _: hashlib.sha256(data).hexdigest(), 64)
+
+
+def _remembered_in(f: BufferedReader, path: Path, what: str, compute: Callable[[BufferedReader], str],
+                   length: int) -> str:
+    st = os.fstat(f.fileno())
+    identity = list(status(st))
+    key = (*identity, what)
+    if key in _digests:
+        return _digests[key]
+    folder, _, name = os.path.abspath(path).rpartition("/")
+    file = _memo_file(folder)
+    known = _memo_value(_folder_memos(file).get(name), identity, what)
+    if known is not None and len(known) == length and _HEX.issuperset(known):
+        _digests[key] = known
+        return known
+    value = compute(f)
     _digests[key] = value
     if time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns) > _SETTLED_NS:
         news = _news.setdefault(file, {})
