@@ -1,8 +1,8 @@
 """A build's plain mesh jobs on two cores: half in the build's own process, half in one child
 forked for them (backends/meshes.py `_compute`).
 
-A pool of workers (ProcessPoolExecutor) costs more to start and feed than the plain path's
-tens of milliseconds gain (bench/README.md); one `fork` costs about two. The child makes
+A pool of workers (ProcessPoolExecutor) costs more to start and feed than it saves on the
+plain path's tens of milliseconds (bench/README.md); one `fork` costs about 2 ms. The child makes
 its cache entries as the build itself would (single flight, atomic stores) and sends back only
 its problems, as JSON through a pipe, then ends with `os._exit` (no atexit handler, no buffer
 of the build's flushed twice). When the child fails in any way, the build does its half
