@@ -395,9 +395,10 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     tasks = [tasks[i] for i in order]
     workers = min(len(tasks), mesh_workers())
     sizes = _plain_sizes(tasks)
-    if workers < 2 or len(jobs) < 3 or (sizes is not None and sum(sizes) < FORKED):
+    size = sum(sizes) if sizes is not None else LIGHT  # not all plain: the pool's
+    if workers < 2 or len(jobs) < 3 or size < FORKED:
         results = [_materialise_all(task) for task in tasks]
-    elif sizes is not None and sum(sizes) < LIGHT:
+    elif sizes is not None and size < LIGHT:
         from mpc.backends.mesh_fork import beside_a_fork, may_fork
 
         if _share is None and may_fork():

@@ -48,21 +48,25 @@ def _robot(folder: Path, size: float = 1.0, fine: bool = False) -> Path:
     return write(folder / "shapes.yml", definition("shapes.urdf", mesh_format="obj", robotname="shapes"))
 
 
+def _derivers(trace: Path) -> list[int]:
+    """The process of each mesh derived, from MPC_CACHE_TRACE's lines (pid, event, name)."""
+    return [int(line.split()[0]) for line in trace.read_text().splitlines() if " derive " in line]
+
+
 def _built(folder: Path, workers: str | None, monkeypatch: pytest.MonkeyPatch,
-           fine: bool = False, run: str = "") -> tuple[Path, set[int]]:
+           fine: bool = False) -> tuple[Path, set[int]]:
     """The build's output folder with MPC_MESH_WORKERS=workers (None: unset; and a cache of
-    its own, named with `run`), and the processes that derived its meshes (MPC_CACHE_TRACE's
-    lines: pid, event, name)."""
+    its own), and the processes that derived its meshes."""
     if workers is None:
         monkeypatch.delenv("MPC_MESH_WORKERS")
     else:
         monkeypatch.setenv("MPC_MESH_WORKERS", workers)
-    monkeypatch.setenv("MPC_CACHE_DIR", str(folder / f"cache-{workers}{run}"))
-    monkeypatch.setenv("MPC_CACHE_TRACE", str(trace := folder / f"trace-{workers}{run}"))
+    monkeypatch.setenv("MPC_CACHE_DIR", str(folder / f"cache-{workers}"))
+    monkeypatch.setenv("MPC_CACHE_TRACE", str(trace := folder / f"trace-{workers}"))
     sink = Sink()
-    result = compile_file(_robot(folder, fine=fine), folder / f"out-{workers}{run}", sink)
+    result = compile_file(_robot(folder, fine=fine), folder / f"out-{workers}", sink)
     assert result.out is not None and not sink.diagnostics, sink.summary()
-    return result.out, {int(line.split()[0]) for line in trace.read_text().splitlines() if " derive " in line}
+    return result.out, set(_derivers(trace))
 
 
 def _same_tree(a: Path, b: Path) -> None:
@@ -138,7 +142,7 @@ def test_what_the_forked_child_cannot_make_is_said_as_one_process_says_it(
         sink = Sink()
         assert compile_file(spec, folder / "out", sink).out is None
         said.append([(d.code, d.message.replace(str(folder), "FOLDER")) for d in sink.diagnostics])
-        derived.append({line.split()[0] for line in trace.read_text().splitlines() if " derive " in line})
+        derived.append(set(_derivers(trace)))
     assert said[0] == said[1]
     assert [code for code, _ in said[0]] == ["E0603"] and "cone.stl" in said[0][0][1]
     assert len(derived[0]) == 1 and len(derived[1]) == 2
@@ -179,7 +183,7 @@ def test_mpc_compile_forks_its_pool(tmp_path: Path) -> None:
                            stderr=subprocess.PIPE, text=True)
     _, stderr = mpc.communicate(timeout=600)
     assert mpc.returncode == 0, stderr
-    derived = [int(line.split()[0]) for line in trace.read_text().splitlines() if " derive " in line]
+    derived = _derivers(trace)
     assert len(derived) == len(SHAPES) and mpc.pid not in derived and 1 <= len(set(derived)) <= 2
     written = sorted(p.name for p in (tmp_path / "out/meshes/obj").iterdir())
     assert written == sorted(f"{n}.obj" for n in SHAPES)
@@ -214,8 +218,7 @@ def test_mpc_compile_forks_one_child_for_half_its_plain_meshes(tmp_path: Path) -
         out, err = mpc.communicate(timeout=600)
         assert mpc.returncode == 0, err
         printed.append((out.replace(f"out-{workers}", "OUT"), err))
-        lines = trace.read_text().splitlines()
-        derived.append({int(line.split()[0]) for line in lines if " derive " in line})
+        derived.append(set(_derivers(trace)))
     assert printed[0] == printed[1]
     cores = len(os.sched_getaffinity(0))
     assert len(derived[0]) == 1 and len(derived[1]) == min(cores, 2)
@@ -238,7 +241,7 @@ def test_mpc_run_gives_each_build_its_share_of_the_cores(tmp_path: Path, models:
     env |= {"MPC_CACHE_DIR": str(tmp_path / "cache"), "MPC_CACHE_TRACE": str(trace := tmp_path / "trace")}
     done = mpc_process("run", tmp_path / "pipeline.yml", "-j", "2", env=env)
     assert done.returncode == 0, done.stderr
-    derived = [line.split()[0] for line in trace.read_text().splitlines() if " derive " in line]
+    derived = _derivers(trace)
     cores = len(os.sched_getaffinity(0))
     assert len(derived) == 4 * models
     assert len(set(derived)) == (min(cores, 4) if models == 1 else 2)
