@@ -55,6 +55,10 @@ _LIMIT, _DYNAMICS = ("lower", "upper", "effort", "velocity"), ("damping", "frict
 # The children of a joint that are no fragments.
 _JOINT_CHILDREN = frozenset({"origin", "parent", "child", "axis", "limit", "dynamics", "mimic",
                              "calibration", "safety_controller"})
+# The filenames of the meshes the reader reads (plain strings: an lxml "smart" string would
+# hold its element and the whole tree).
+_LINK_MESHES = etree.XPath("link/visual/geometry/mesh/@filename | link/collision/geometry/mesh/@filename",
+                           smart_strings=False)
 # Elements inside links and joints that become IR values (anything else is a fragment).
 _MODELLED = frozenset({
     "inertial", "visual", "collision", "origin", "geometry", "material", "mass", "inertia",
@@ -142,6 +146,17 @@ class _Reader:
         self.fragments = Fragments(src, self.new.fragment, self.new.ref)
         self.fragment = self.fragments.fragment
         self.joint_names = self.fragments.joint_names  # filled by robot(), first
+        self.locate_meshes()
+
+    def locate_meshes(self) -> None:
+        """Find the file of every mesh the links name, in one pass before the walk: done at
+        each <mesh> among the walk's other work, the same calls took twice their time
+        (bench/README.md, 2026-11-28)."""
+        resolver, base_dir, found = self.resolver, self.base_dir, self.mesh_sources
+        for uri in _LINK_MESHES(self.src.root):
+            if uri and uri not in found:
+                source = mesh_source(resolver, uri, base_dir)
+                found[uri] = source, resolver.refusal(source.path, base_dir) if source.path else None
 
     # -- helpers ---------------------------------------------------------------------------
 
@@ -459,12 +474,7 @@ class _Reader:
             self.error(el, "E0403", f"<mesh> in {where} has no 'filename' attribute")
             return None
         scale = self.floats(el, "scale", 3, where)
-        found = self.mesh_sources.get(uri)
-        if found is None:  # a file's visuals and collisions share meshes
-            source = mesh_source(self.resolver, uri, self.base_dir)
-            refusal = self.resolver.refusal(source.path, self.base_dir) if source.path else None
-            found = self.mesh_sources[uri] = source, refusal
-        source, why = found
+        source, why = self.mesh_sources[uri]  # locate_meshes found them all
         if why:
             self.error(el, "E0650", f"mesh '{uri}' in {where} is not read: {why}", "filename")
             return None
