@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.backends.missing_packages import unfound_packages
+from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, judge
+from mpc.backends.mujoco_meshes import problem as mujoco_problem
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
@@ -92,11 +94,15 @@ def mesh_uses(robot: Robot) -> Iterator[MeshUse]:
 EXTENSIONS = {"stl": "stl", "obj": "obj", "dae": "dae", "mars_obj": "mars.obj", "ply": "ply", "bobj": "bobj"}
 
 
-def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[MeshKey, str] | None:
+def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span,
+         mujoco: bool = False) -> dict[MeshKey, str] | None:
     """Map each mesh value to its path in the output (relative, `meshes/<fmt>/<name>`).
 
     A mesh in another format than the export's, or with ops, is computed with trimesh at
     `copy`; an unchanged one is copied. Reports meshes that cannot be found; None if any.
+    mujoco: the meshes are MuJoCo's (an MJCF export): an unchanged file that MuJoCo would not
+    read as it is, but would once written again, is written again as `<name>_mujoco`
+    (backends/mujoco_meshes.py), beside the copy another export may make.
     """
     ok = True
     wanted: dict[MeshKey, str] = {}
@@ -137,6 +143,8 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span) -> dict[
                 return None
             fmt = "stl"  # a computed mesh whose own format trimesh cannot write
         stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
+        if mujoco and not use.mesh.ops and fmt == src.format and _rewritten_for_mujoco(src.path):
+            stem += "_mujoco"
         wanted[k] = f"meshes/{fmt}/{stem}.{EXTENSIONS[fmt]}"
     if not ok:
         return None
@@ -181,6 +189,23 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
     return out
 
 
+def _mujoco_verdict(path: Path) -> str:
+    """backends/mujoco_meshes.py `verdict`; READS for a file that cannot be read (copying it
+    says why)."""
+    from mpc.backends import mujoco_meshes
+
+    try:
+        return mujoco_meshes.verdict(path)
+    except OSError:
+        return mujoco_meshes.READS
+
+
+def _rewritten_for_mujoco(path: Path) -> bool:
+    from mpc.backends.mujoco_meshes import REWRITE
+
+    return _mujoco_verdict(path) == REWRITE
+
+
 def _digest(k: MeshKey) -> str:
     """Ten hex digits of the source's bytes and the ops, which tell apart meshes of one name;
     remembered with the file's digest (core/cache.py), so that a warm build does not read them."""
@@ -193,10 +218,11 @@ def _digest(k: MeshKey) -> str:
 
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
-         robot: Robot | None = None) -> bool:
+         robot: Robot | None = None, mujoco: bool = False) -> bool:
     """Write each planned mesh into `out` (`contents`), leaving those already there. The digest
     and the origin of each one are noted (core/cache.note_written): keeping the build
-    (compiler/build_cache.py) need not read it again, nor keep a copy of its own."""
+    (compiler/build_cache.py) need not read it again, nor keep a copy of its own. mujoco: as
+    `plan`'s."""
     from mpc.core.cache import file_digest, note_written
     from mpc.core.files import confined_files, copy_file
 
@@ -206,7 +232,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
     entries: dict[str, tuple[str, Path]] = {}
     found, ok = contents(files, sink, export_span, robot,
                          lambda rel: not rel.startswith("/") and ".." not in rel.split("/")
-                         and (out / rel).exists(), entries)
+                         and (out / rel).exists(), entries, mujoco)
     paths = confined_files(out, found)
     for rel, content in found.items():
         dest = paths[rel]
@@ -223,7 +249,7 @@ def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,
 
 def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Robot | None = None,
              skip: Callable[[str], bool] = lambda rel: False,
-             entries_used: dict[str, tuple[str, Path]] | None = None,
+             entries_used: dict[str, tuple[str, Path]] | None = None, mujoco: bool = False,
              ) -> tuple[dict[str, bytes | Path], bool]:
     """What each planned mesh is, by its file name: the bytes of the result of its ops, or the
     source file to copy as it is; and whether none failed. A mesh that fails is reported and
@@ -234,7 +260,8 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     when several are missing; a later build with the same inputs only reads them.
     robot: to name, in a diagnostic, the link and element that use a mesh that fails.
     entries_used: filled with the SHA-256 and the cache entry of each mesh given as bytes, by
-    its file name.
+    its file name. mujoco: as `plan`'s; a mesh MuJoCo refuses is reported (E0585 copied, E0588
+    computed) and left out.
     """
     from mpc.core.cache import notes_file, read_entry, remove_entry, touch_entry
     from mpc.core.files import describe
@@ -251,20 +278,39 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
         return ((use.mesh.span or export_span) if use else export_span,
                 f" of a {use.element} of link '{use.link}'" if use else "")
 
+    def refused(src: Path, ops: tuple[MeshOp, ...], rel: str, why: str, hint: str) -> None:
+        """E0588: the computed mesh `rel` is one MuJoCo refuses."""
+        span, of = where(src, ops)
+        sink.error(span, "E0588", f"mesh '{rel}'{of}, computed from '{src}' for MuJoCo, is one it "
+                   f"refuses: {why}", hint=hint)
+
     for (src, ops), rel in sorted(files.items(), key=lambda kv: kv[1]):
-        if skip(rel):
-            continue
         name = rel.rsplit("/", 1)[-1]
-        if not ops and name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
-                and not name.endswith(".mars.obj"):
-            problem = _copy_problem(src)
+        as_is = not ops and name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
+            and not name.endswith(".mars.obj")
+        if skip(rel) and not mujoco:
+            continue
+        if skip(rel):  # written by another export of the build, from the same source and ops
+            if not as_is and (refusal := _mujoco_refusal(_cached_path(src, ops, os.path.splitext(name)[1]))):
+                refused(src, ops, rel, *refusal)
+                ok = False
+            elif not as_is or _mujoco_verdict(src) != REFUSED:
+                continue
+        if as_is:
+            problem, hint = _copy_problem(src), REPAIR_HINT
+            verdict = _mujoco_verdict(src) if mujoco and problem is None else READS
+            if verdict == REFUSED:
+                problem, hint = mujoco_problem(src)
             if problem is not None:
                 span, of = where(src, ops)
                 sink.error(span, "E0585", f"mesh '{src}'{of} cannot be copied into the build: {problem}",
-                           hint="export the mesh again from its modelling tool")
+                           hint=hint)
                 ok = False
                 continue
-            plan_.append((src, rel))
+            if verdict == READS:
+                plan_.append((src, rel))
+                continue
+        elif skip(rel):
             continue
         try:
             cached = _cached_path(src, ops, os.path.splitext(name)[1])
@@ -307,6 +353,10 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
+        if source in entries and mujoco and (refusal := _mujoco_refusal(source, entries[source][0])):
+            refused(*next((s, o) for (s, o), r in files.items() if r == rel), rel, *refusal)
+            ok = False
+            continue
         if source in entries:
             found[rel], digest = entries[source]
             if entries_used is not None:
@@ -314,6 +364,29 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
         else:
             found[rel] = source
     return found, ok
+
+
+def _mujoco_refusal(entry: Path, data: bytes | None = None) -> tuple[str, str] | None:
+    """(why, hint) when MuJoCo refuses the mesh computed into the cache entry `entry` (its bytes
+    `data`, read when not given), else None. The verdict on an entry it reads is kept in the
+    cache (`verdicts/mujoco/<entry's name>`: an entry's name is its content's), as
+    `_copy_problem` keeps its own, so that a warm build does not look at every vertex again."""
+    from mpc.core.cache import cache_dir, read_entry
+
+    mark = cache_dir("verdicts") / "mujoco" / entry.name
+    if mark.is_file():
+        return None
+    if data is None:
+        data = read_entry(entry)[0]
+        if data is None:  # gone: the export that wrote the build's copy read it
+            return None
+    verdict, why, hint = judge(data, entry.suffix.lower())
+    if verdict != READS:
+        return why, hint
+    with contextlib.suppress(OSError):  # a read-only cache: judged again next time
+        mark.parent.mkdir(parents=True, exist_ok=True)
+        mark.touch()
+    return None
 
 
 def _copy_problem(src: Path) -> str | None:
@@ -544,15 +617,16 @@ def _derive(src: Path, ops: tuple[MeshOp, ...], dest: Path) -> tuple[str, str] |
 
 
 def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path, sink: Sink,
-          export_span: Span) -> dict[MeshKey, str] | None:
+          export_span: Span, mujoco: bool = False) -> dict[MeshKey, str] | None:
     """The meshes of an export (urdf, sdf, mjcf): those its file references, in `mesh_format`
     (their plan, or None after an error), then the same in each `additional` format
-    (`additional_meshes`: written beside, referenced by nothing)."""
+    (`additional_meshes`: written beside, referenced by nothing). mujoco: the file is an MJCF
+    (`plan`)."""
     from mpc.core.profile import stage
 
     with stage("meshes"):
-        files = plan(robot, mesh_format, sink, export_span)
-        if files is None or not copy(files, out, sink, export_span, robot):
+        files = plan(robot, mesh_format, sink, export_span, mujoco)
+        if files is None or not copy(files, out, sink, export_span, robot, mujoco):
             return None
         for fmt in additional:
             extra = plan(robot, fmt, sink, export_span)
@@ -566,7 +640,8 @@ def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: P
     """Write the meshes of a urdf, sdf or mjcf export (`write`); the robot to write (numbers
     near zero made 0 with `enforce_zero`; every unnamed visual and collision named as the
     SMURF names it, `named_shapes`) and where each mesh went, or None after an error."""
-    files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span)
+    files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span,
+                  export.type == "mjcf")
     if files is None:
         return None
     return named_shapes(zero_small(robot) if export.enforce_zero else robot), files

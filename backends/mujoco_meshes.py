@@ -1,0 +1,158 @@
+"""Which mesh files MuJoCo reads as they are: the rules of its STL and OBJ decoders, for the
+meshes an MJCF export writes (backends/meshes.py).
+
+MuJoCo reads a mesh file through a decoder of its own (plugin/stl_decoder, plugin/obj_decoder
+on tinyobjloader), stricter than trimesh and than the URDF consumers that read the same files:
+- an STL must be binary, exactly 84 + 50 × n bytes, with 1 to 200,000 triangles, each
+  coordinate finite and within ±2^30. An ASCII STL (common in ROS packages) or one with bytes
+  after its triangles is refused: such a file is written again as a binary STL.
+- an OBJ gives MuJoCo its first object only (tinyobjloader's first shape: the faces up to the
+  first `o` or `g` that more faces follow): an OBJ of several objects is written again as one,
+  as is a face line that tinyobjloader cannot read but trimesh can (a comment after the
+  indices, a line continued with `\\`) and a file with normals that some face corner does not
+  name (MuJoCo then takes the corner's normal from outside the list and refuses the file). A
+  face that names no vertex (`f 2 x`, index 0, an index beyond the vertices) or a coordinate
+  that is not finite is refused by both readers, or read as another shape by trimesh: such a
+  file is not written.
+
+`verdict` says which of the three a file is, remembered by the file's status (core/cache.py);
+`problem` says why a refused file is refused.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+READS = "0"  # MuJoCo reads the file as it is
+REWRITE = "1"  # the same mesh, written again, is one MuJoCo reads
+REFUSED = "2"  # the file is refused (`problem` says why)
+
+MAX_STL_TRIANGLES = 200_000  # plugin/stl_decoder/stl_decoder.cc
+BOUND = 2.0**30  # the same: the largest coordinate it reads
+SIZE_HINT = ("reduce the mesh (`reduce_meshes`) or write OBJ meshes (`mesh_format: obj`), which have no "
+             "such limit")
+REPAIR_HINT = "export the mesh again from its modelling tool"
+
+_VERTEX_LINE = re.compile(rb"^[ \t]*v[ \t]", re.MULTILINE)
+_NORMAL_LINE = re.compile(rb"^[ \t]*vn[ \t]", re.MULTILINE)
+_LEADING_INT = re.compile(rb"[+-]?\d+")
+
+
+def verdict(path: Path) -> str:
+    """READS, REWRITE or REFUSED for the mesh file `path` (STL or OBJ; other files READS),
+    remembered by its status; raises OSError when it cannot be read."""
+    from mpc.core.cache import remembered
+
+    suffix = path.suffix.lower()
+    if suffix not in (".stl", ".obj"):
+        return READS
+    return remembered(path, "mujoco", lambda f: judge(f.read(), suffix)[0], 1)
+
+
+def problem(path: Path) -> tuple[str, str]:
+    """Why MuJoCo refuses the mesh file `path`, and what to do (a file `verdict` refuses)."""
+    return judge(path.read_bytes(), path.suffix.lower())[1:]
+
+
+def judge(data: bytes, suffix: str) -> tuple[str, str, str]:
+    """(verdict, why refused, hint) for a mesh file's bytes."""
+    return _stl(data) if suffix == ".stl" else _obj(data)
+
+
+def _stl(data: bytes) -> tuple[str, str, str]:
+    import numpy as np
+
+    count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else 0
+    if count < 1 or len(data) != 84 + 50 * count:
+        return REWRITE, "", ""  # ASCII, or binary of another length: MuJoCo reads neither
+    if count > MAX_STL_TRIANGLES:
+        return (REFUSED, f"it has {count:,} triangles; MuJoCo reads at most {MAX_STL_TRIANGLES:,} "
+                "from an STL file", SIZE_HINT)
+    record = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attributes", "<u2")])
+    vertices = np.frombuffer(data, record, offset=84)["vertices"].reshape(count, 9)
+    bad = ~np.isfinite(vertices).all(axis=1)
+    if bad.any():
+        return REFUSED, f"triangle {int(bad.argmax()) + 1} has a coordinate that is not finite", REPAIR_HINT
+    far = (np.abs(vertices) > BOUND).any(axis=1)
+    if far.any():
+        return (REFUSED, f"triangle {int(far.argmax()) + 1} has a coordinate beyond ±2^30, the largest "
+                "MuJoCo reads", REPAIR_HINT)
+    return READS, "", ""
+
+
+def _obj(data: bytes) -> tuple[str, str, str]:
+    """The OBJ rules of the module's docstring, one line at a time."""
+    total, with_normals = len(_VERTEX_LINE.findall(data)), _NORMAL_LINE.search(data) is not None
+    vertices = normals = objects = 0  # vertices and normals so far; objects (tinyobjloader's
+    # shapes) with faces so far
+    faces_here = rewrite = False
+    for number, raw in enumerate(data.split(b"\n"), 1):
+        words = raw.split()
+        if not words:
+            continue
+        word = words[0]
+        if raw.rstrip().endswith(b"\\"):
+            rewrite = True  # tinyobjloader does not join continued lines
+        if word == b"v":
+            vertices += 1
+            for text in words[1:4]:
+                try:
+                    value = float(text)
+                except ValueError:
+                    continue  # read as 0 by tinyobjloader (trimesh reports it)
+                if not math.isfinite(value):
+                    return (REFUSED, f"vertex {vertices} has a coordinate that is not finite "
+                            f"('{_shown(text)}', line {number})", REPAIR_HINT)
+        elif word == b"vn":
+            normals += 1
+        elif word == b"f":
+            if not faces_here:
+                faces_here, objects = True, objects + 1
+            for corner in words[1:]:
+                if corner.startswith(b"#"):
+                    rewrite = True  # a comment: tinyobjloader reads it as a corner
+                    break
+                why = _corner_problem(corner, vertices, total)
+                if why:
+                    return REFUSED, f"{why} (line {number})", REPAIR_HINT
+                if with_normals and not _names_a_normal(corner, normals):
+                    rewrite = True
+        elif word in (b"o", b"g"):
+            faces_here = False
+    return (REWRITE if rewrite or objects > 1 else READS), "", ""
+
+
+def _corner_problem(corner: bytes, before: int, total: int) -> str:
+    """Why a face's corner (`v`, `v/vt`, `v//vn` or `v/vt/vn`) names no vertex, or ""; `before`:
+    the vertices above its line, `total`: the file's."""
+    parts = corner.split(b"/")
+    if len(parts) > 3:
+        return f"a face corner '{_shown(corner)}' is not v, v/vt, v//vn or v/vt/vn"
+    found = _LEADING_INT.match(parts[0])  # tinyobjloader reads the leading digits, as atoi does
+    if found is None:
+        return f"a face corner '{_shown(corner)}' names no vertex"
+    index = int(found[0])
+    if index == 0:
+        return f"a face corner '{_shown(corner)}' names vertex 0 (an OBJ counts its vertices from 1)"
+    if index > total:
+        return f"a face corner '{_shown(corner)}' names vertex {index} of the file's {total}"
+    if -index > before:
+        return f"a face corner '{_shown(corner)}' counts back beyond the {before} vertices above it"
+    return ""
+
+
+def _names_a_normal(corner: bytes, before: int) -> bool:
+    """Whether the face corner (`v//vn`, `v/vt/vn`) names one of the `before` normals above it."""
+    parts = corner.split(b"/")
+    found = _LEADING_INT.match(parts[2]) if len(parts) == 3 else None
+    index = int(found[0]) if found else 0
+    return 0 < index <= before or 0 < -index <= before
+
+
+def _shown(text: bytes) -> str:
+    """A word of the file as a diagnostic quotes it: printable, and at most 40 characters."""
+    shown = text.decode("utf-8", "replace")
+    shown = "".join(c if c.isprintable() else "?" for c in shown)
+    return shown if len(shown) <= 40 else shown[:37] + "..."

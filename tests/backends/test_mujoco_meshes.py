@@ -1,0 +1,192 @@
+"""The meshes of an MJCF export are files MuJoCo reads (backends/mujoco_meshes.py), checked by
+MuJoCo: an ASCII STL or an OBJ of several objects, which it refuses or reads in part, is written
+again as `<name>_mujoco`; a mesh it refuses whatever is done is an error naming the file and
+what in it, and no MJCF is written. The other exports copy the same files as they are."""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mpc.cli.main import main
+from tests.conftest import definition, write
+from tests.fixtures import ARM_URDF, arm
+
+TETRA = [(0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.0, 0.1, 0.0), (0.0, 0.0, 0.1)]
+FACES = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+TETRA_OBJ = "".join(f"v {x} {y} {z}\n" for x, y, z in TETRA) + "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+MJCF = "    - type: mjcf\n      mesh_format: {fmt}\n"
+
+
+def _stl(triangles: list[list[tuple[float, float, float]]]) -> bytes:
+    data = bytearray(80) + struct.pack("<I", len(triangles))
+    for triangle in triangles:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v) for v in triangle) + b"\0\0"
+    return bytes(data)
+
+
+def _ascii_stl() -> str:
+    facets = "".join("facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in
+                     (TETRA[i] for i in face)) + "endloop\nendfacet\n" for face in FACES)
+    return f"solid tetra\n{facets}endsolid tetra\n"
+
+
+def _compile(folder: Path, mesh: str, data: str | bytes, exports: str,
+             capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    arm(folder, ARM_URDF.replace("meshes/tetra.stl", f"meshes/{mesh}"))
+    path = folder / "meshes" / mesh
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
+    spec = write(folder / "model.yml", definition("arm.urdf") + exports)
+    code = main(["compile", str(spec), "-o", str(folder / "out")])
+    return code, capsys.readouterr().err
+
+
+def _mujoco_mesh(mjcf: Path) -> tuple[np.ndarray, int]:
+    """The vertices and the number of triangles of the one mesh MuJoCo compiled from `mjcf`."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    assert model.nmesh == 1
+    start, count = model.mesh_vertadr[0], model.mesh_vertnum[0]
+    return model.mesh_vert[start:start + count], int(model.mesh_facenum[0])
+
+
+def test_an_ascii_stl_is_written_as_binary_for_mujoco_and_copied_for_urdf(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, err = _compile(tmp_path, "tetra.stl", _ascii_stl(), MJCF.format(fmt="stl"), capsys)
+    assert code == 0, err
+    out = tmp_path / "out"
+    assert (out / "meshes/stl/tetra.stl").read_bytes() == (tmp_path / "meshes/tetra.stl").read_bytes()
+    assert 'filename="../meshes/stl/tetra.stl"' in (out / "urdf/robot.urdf").read_text()
+    rewritten = (out / "meshes/stl/tetra_mujoco.stl").read_bytes()
+    assert len(rewritten) == 84 + 50 * 4
+    assert 'file="../meshes/stl/tetra_mujoco.stl"' in (out / "mjcf/robot.xml").read_text()
+    # MuJoCo moves a mesh into its principal frame: the same tetrahedron written as a binary STL
+    # by its modelling tool gives the same compiled mesh.
+    vertices, triangles = _mujoco_mesh(out / "mjcf/robot.xml")
+    assert _compile(tmp_path / "binary", "tetra.stl", _stl(_tetra_triangles()), MJCF.format(fmt="stl"),
+                    capsys)[0] == 0
+    expected, expected_triangles = _mujoco_mesh(tmp_path / "binary/out/mjcf/robot.xml")
+    assert triangles == expected_triangles == 4
+    assert np.array_equal(vertices, expected)
+
+
+def test_an_obj_of_two_objects_is_written_as_one_for_mujoco(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """MuJoCo reads the first object of an OBJ only: the copy gave it half the mesh."""
+    second = "".join(f"v {x + 1} {y} {z}\n" for x, y, z in TETRA) + "f 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
+    text = f"o a\n{TETRA_OBJ}o b\n{second}"
+    code, err = _compile(tmp_path, "two.obj", text, MJCF.format(fmt="obj"), capsys)
+    assert code == 0, err
+    out = tmp_path / "out"
+    assert 'file="../meshes/obj/two_mujoco.obj"' in (out / "mjcf/robot.xml").read_text()
+    assert (out / "meshes/obj/two.obj").read_text() == text  # the URDF export's copy
+    vertices, triangles = _mujoco_mesh(out / "mjcf/robot.xml")
+    assert triangles == 8 and len(vertices) == 8
+
+
+def test_an_obj_mujoco_reads_whole_is_copied_as_it_is(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = "# a comment\n" + TETRA_OBJ.replace("f 1 3 2", "f -4 -2 -3")
+    code, err = _compile(tmp_path, "tetra.obj", text, MJCF.format(fmt="obj"), capsys)
+    assert code == 0, err
+    assert (tmp_path / "out/meshes/obj/tetra.obj").read_text() == text
+    assert _mujoco_mesh(tmp_path / "out/mjcf/robot.xml")[1] == 4
+
+
+def test_an_obj_whose_faces_name_normals_in_part_is_written_again_for_mujoco(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """MuJoCo refuses it ("normal index out of bounds"); trimesh reads its triangles."""
+    text = "vn 0 0 1\n" + TETRA_OBJ.replace("f 2 3 4", "f 2//1 3//1 4//1")
+    code, err = _compile(tmp_path, "tetra.obj", text, MJCF.format(fmt="obj"), capsys)
+    assert code == 0, err
+    assert 'file="../meshes/obj/tetra_mujoco.obj"' in (tmp_path / "out/mjcf/robot.xml").read_text()
+    assert _mujoco_mesh(tmp_path / "out/mjcf/robot.xml")[1] == 4
+
+
+def _tetra_triangles() -> list[list[tuple[float, float, float]]]:
+    return [[TETRA[i] for i in face] for face in FACES]
+
+
+def _with(value: float) -> bytes:
+    triangles = _tetra_triangles()
+    triangles[1][2] = (0.0, value, 0.1)
+    return _stl(triangles)
+
+
+@pytest.mark.parametrize(("mesh", "data", "problem"), [
+    ("nan.stl", _with(float("nan")), "triangle 2 has a coordinate that is not finite"),
+    ("far.stl", _with(2.0**31), "triangle 2 has a coordinate beyond ±2^30, the largest MuJoCo reads"),
+    ("word.obj", TETRA_OBJ.replace("f 1 2 4", "f 2 [[["), "a face corner '[[[' names no vertex (line 6)"),
+    ("zero.obj", TETRA_OBJ.replace("f 1 2 4", "f 0 1 2"),
+     "a face corner '0' names vertex 0 (an OBJ counts its vertices from 1) (line 6)"),
+    ("beyond.obj", TETRA_OBJ.replace("f 1 2 4", "f 1 2 9"),
+     "a face corner '9' names vertex 9 of the file's 4 (line 6)"),
+    ("back.obj", TETRA_OBJ.replace("f 1 2 4", "f -1 -2 -5"),
+     "a face corner '-5' counts back beyond the 4 vertices above it (line 6)"),
+    ("corner.obj", TETRA_OBJ.replace("f 1 2 4", "f 1/1/1/1 2 4"),
+     "a face corner '1/1/1/1' is not v, v/vt, v//vn or v/vt/vn (line 6)"),
+    ("inf.obj", TETRA_OBJ.replace("v 0.1 0.0 0.0", "v 1e999 0.0 0.0"),
+     "vertex 2 has a coordinate that is not finite ('1e999', line 2)"),
+])
+def test_a_mesh_mujoco_refuses_is_an_error_for_mjcf_and_copied_for_urdf(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], mesh: str, data: str | bytes,
+        problem: str) -> None:
+    fmt = mesh.rsplit(".", 1)[1]
+    code, err = _compile(tmp_path / "mjcf", mesh, data, MJCF.format(fmt=fmt), capsys)
+    assert code == 1
+    assert (f"{tmp_path}/mjcf/arm.urdf:10:33: error[E0585]: mesh '{tmp_path}/mjcf/meshes/{mesh}' of a visual "
+            f"of link 'base' cannot be copied into the build: {problem}\n") in err
+    assert "  hint: export the mesh again from its modelling tool\n" in err
+    assert not (tmp_path / "mjcf/out/mjcf").exists()
+    code, err = _compile(tmp_path / "urdf", mesh, data, "", capsys)
+    assert code == 0, err
+    copied = tmp_path / f"urdf/out/meshes/{fmt}/{mesh}"
+    assert copied.read_bytes() == (tmp_path / f"urdf/meshes/{mesh}").read_bytes()
+
+
+def test_an_stl_of_more_triangles_than_mujoco_reads_is_an_error_copied_or_computed(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    many = _tetra_triangles() * 50_001  # 200,004 triangles
+    code, err = _compile(tmp_path / "copied", "many.stl", _stl(many), MJCF.format(fmt="stl"), capsys)
+    assert code == 1
+    assert (f"error[E0585]: mesh '{tmp_path}/copied/meshes/many.stl' of a visual of link 'base' cannot be "
+            "copied into the build: it has 200,004 triangles; MuJoCo reads at most 200,000 from an STL "
+            "file\n") in err
+    assert ("  hint: reduce the mesh (`reduce_meshes`) or write OBJ meshes (`mesh_format: obj`), which have "
+            "no such limit\n") in err
+    obj = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\n" + "f 1 2 3\n" * 200_001
+    code, err = _compile(tmp_path / "computed", "many.obj", obj, MJCF.format(fmt="stl"), capsys)
+    assert code == 1
+    assert (f"error[E0588]: mesh 'meshes/stl/many.stl' of a visual of link 'base', computed from "
+            f"'{tmp_path}/computed/meshes/many.obj' for MuJoCo, is one it refuses: it has 200,001 triangles; "
+            "MuJoCo reads at most 200,000 from an STL file\n") in err
+    assert not (tmp_path / "computed/out/mjcf").exists()
+
+
+def test_laikago_in_mujoco_has_every_triangle_of_its_meshes(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """example-robot-data's Laikago: its trunk.obj is 54 objects; MuJoCo read 5,368 of its 22,246
+    triangles from the copy an MJCF export used to make."""
+    import mujoco
+    import trimesh
+
+    from mpc.core.packages import PackageResolver
+
+    erd = PackageResolver().find("example-robot-data")
+    assert erd is not None
+    robot = erd / "robots/laikago_description"
+    spec = write(tmp_path / "model.yml", definition(robot / "urdf/laikago.urdf").replace(
+        "    - type: urdf\n      mesh_format: input_type\n", MJCF.format(fmt="obj")))
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out")]) == 0, capsys.readouterr().err
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "out/mjcf/robot.xml"))
+    compiled = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_MESH, i): int(model.mesh_facenum[i])
+                for i in range(model.nmesh)}
+    assert set(compiled) == {"trunk_mujoco", "hip", "thigh", "thigh_mirror", "calf"}
+    for name, triangles in compiled.items():
+        source = robot / "meshes" / (name.removesuffix("_mujoco").removesuffix("_mirror") + ".obj")
+        assert triangles == len(trimesh.load(source, force="mesh", process=False).faces), name
+    assert compiled["trunk_mujoco"] == 22_246
