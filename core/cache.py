@@ -10,6 +10,7 @@ import hashlib
 import json
 import os
 import shutil
+import threading
 import time
 from collections.abc import Callable, Iterator
 from io import BufferedReader
@@ -141,12 +142,19 @@ def remove_entry(entry: Path) -> None:
 # than a lock file of its own for each, which cost a cold build of a hundred meshes a hundred
 # files) and looks again once it holds it: the second finds the first's result. Record locks
 # belong to the process: one that dies (killed, crashed) releases its locks with it, and a
-# forked child holds none of its parent's. A process keeps one descriptor of each `.locks`
-# file open for its life, since closing any descriptor of a file releases every record lock
-# the process holds on it. A process holds at most two such locks, always a derived entry's
-# before its source's (in another folder), so no two processes wait for each other; two names
-# of one byte (one in two billion) only wait for each other.
+# forked child holds none of its parent's. A process keeps a descriptor of each `.locks` file
+# open while it holds a lock through it, since closing any descriptor of a file releases every
+# record lock the process holds on it; it keeps the last few open after (a build's meshes are
+# in one or two folders), and closes those it holds no lock through when it opens more than
+# _KEPT_LOCK_FILES: a long-lived process (the language server, a worker of `mpc run`, a test
+# run) that meets many caches would otherwise keep a descriptor of each for its life. A
+# process holds at most two such locks, always a derived entry's before its source's (in
+# another folder), so no two processes wait for each other; two names of one byte (one in two
+# billion) only wait for each other.
 _lock_files: dict[Path, int] = {}
+_locks_held: dict[int, int] = {}  # by descriptor: the locks held (or being taken) through it
+_lock_files_guard = threading.Lock()
+_KEPT_LOCK_FILES = 8
 
 
 @contextlib.contextmanager
@@ -160,12 +168,17 @@ def single_flight(entry: Path) -> Iterator[None]:
     byte = int.from_bytes(hashlib.sha256(name).digest()[:4], "big") >> 1  # below 2**31
     try:
         fd = _lock_file(entry.parent)
+    except OSError:
+        yield
+        return
+    try:
         try:
             fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB, 1, byte)
         except (BlockingIOError, PermissionError):  # EAGAIN or EACCES: another process holds it
             trace(f"wait {entry.name}")
             fcntl.lockf(fd, fcntl.LOCK_EX, 1, byte)
     except OSError:
+        _let_go(fd)
         yield
         return
     try:
@@ -173,15 +186,29 @@ def single_flight(entry: Path) -> Iterator[None]:
     finally:
         with contextlib.suppress(OSError):
             fcntl.lockf(fd, fcntl.LOCK_UN, 1, byte)
+        _let_go(fd)
 
 
 def _lock_file(folder: Path) -> int:
-    """This process's descriptor of `folder`'s `.locks` file, opened once."""
-    fd = _lock_files.get(folder)
-    if fd is None:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd = _lock_files[folder] = os.open(folder / LOCKS, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
-    return fd
+    """This process's descriptor of `folder`'s `.locks` file, counted as held until `_let_go`."""
+    with _lock_files_guard:
+        fd = _lock_files.get(folder)
+        if fd is None:
+            if len(_lock_files) >= _KEPT_LOCK_FILES:
+                for kept, idle in [(k, d) for k, d in _lock_files.items() if not _locks_held.get(d)]:
+                    del _lock_files[kept]
+                    os.close(idle)
+            folder.mkdir(parents=True, exist_ok=True)
+            fd = _lock_files[folder] = os.open(folder / LOCKS, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        _locks_held[fd] = _locks_held.get(fd, 0) + 1
+        return fd
+
+
+def _let_go(fd: int) -> None:
+    with _lock_files_guard:
+        _locks_held[fd] -= 1
+        if not _locks_held[fd]:
+            del _locks_held[fd]
 
 
 def trace(event: str) -> None:

@@ -393,3 +393,35 @@ def test_a_forced_build_keeps_the_digests_of_what_it_wrote(tmp_path: Path,
         assert hashlib.sha256(copies.get(name, kept / name).read_bytes()).hexdigest() == digest, name
     assert compile_file(spec, tmp_path / "out2", Sink()).out is not None
     assert (tmp_path / "trace").read_text().splitlines()[-1].endswith("with its outputs")
+
+
+def _open_lock_files() -> list[str]:
+    links = (os.readlink(f"/proc/self/fd/{fd}") for fd in os.listdir("/proc/self/fd")
+             if os.path.islink(f"/proc/self/fd/{fd}"))
+    return [link for link in links if link.endswith("/.locks") or link.endswith("/.locks (deleted)")]
+
+
+def test_a_process_meeting_many_caches_keeps_a_few_lock_files_open_and_each_lock_it_holds(
+        tmp_path: Path) -> None:
+    """A long-lived process (the language server, a fuzz run making a cache per case) kept a
+    descriptor of every folder's `.locks` file it ever locked: the fuzz run of 2026-11-27 ran
+    out of descriptors. A lock held meanwhile stays held: closing a descriptor of its file
+    would release it."""
+    before = len(_open_lock_files())
+    held = tmp_path / "held/meshes/entry.stl"
+    probe = ("import fcntl, os, sys\nfd = os.open(sys.argv[1], os.O_RDWR)\nbyte = int(sys.argv[2])\n"
+             "try:\n    fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB, 1, byte)\nexcept OSError:\n"
+             "    print('held')\nelse:\n    print('free')\n")
+    byte = int.from_bytes(hashlib.sha256(held.name.encode()).digest()[:4], "big") >> 1
+
+    def other_process_sees() -> str:
+        return subprocess.run([sys.executable, "-c", probe, str(held.parent / ".locks"), str(byte)],
+                              capture_output=True, text=True, check=True).stdout.strip()
+
+    with single_flight(held):
+        for n in range(40):
+            with single_flight(tmp_path / f"cache{n}/meshes/entry.stl"):
+                pass
+        assert len(_open_lock_files()) - before <= 8
+        assert other_process_sees() == "held"
+    assert other_process_sees() == "free"
