@@ -24,7 +24,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from tests.fuzzing import KINDS, OPS, TOKENS, Edit, Outputs, Seeds, run_case
+from tests.fuzzing import KINDS, MUJOCO_WARNINGS, OPS, TOKENS, Edit, Outputs, Seeds, run_case
 
 
 def main() -> int:
@@ -76,6 +76,9 @@ def main() -> int:
           f"refused by check_urdf or ign sdf -k: {len(refused)}")
     for problem in (outputs.invalid + refused)[:20]:
         print("  " + problem)
+    print(f"MJCF files MuJoCo loaded with a warning: {len(MUJOCO_WARNINGS)}")
+    for warning in MUJOCO_WARNINGS[:5]:
+        print("  " + warning)
     return 1 if failures or outputs.invalid or refused else 0
 
 

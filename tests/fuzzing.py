@@ -295,6 +295,9 @@ class Outputs:
         return refused
 
 
+MUJOCO_WARNINGS: list[str] = []  # what MuJoCo said of the MJCF files it loaded (consumer_refuses)
+
+
 def consumer_refuses(path: Path) -> str | None:
     """Why MuJoCo refuses an MJCF file mpc wrote (the robot's, or the scene that includes it),
     or usd-core a USD layer (the stage it opens, with every payload and sublayer); None when
@@ -302,10 +305,16 @@ def consumer_refuses(path: Path) -> str | None:
     if path.suffix == ".xml":
         import mujoco
 
+        # MuJoCo's warnings (a joint-space inertia it finds near singular) are counted, not left
+        # to MuJoCo, which prints them and appends them to MUJOCO_LOG.TXT in the working folder.
+        before = mujoco.get_mju_user_warning()
+        mujoco.set_mju_user_warning(lambda message: MUJOCO_WARNINGS.append(f"{path.name}: {message}"))
         try:
             mujoco.MjModel.from_xml_path(str(path))
         except Exception as e:
             return f"MuJoCo refuses it: {e}"
+        finally:
+            mujoco.set_mju_user_warning(before)
         return None
     from pxr import Tf, Usd
 
