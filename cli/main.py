@@ -10,6 +10,7 @@ import argparse
 import contextlib
 import os
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
@@ -253,6 +254,11 @@ def main(argv: list[str] | None = None) -> int:
 
     blas.one_thread()  # before anything imports numpy
     pydantic_plugins.install()  # before anything builds a pydantic validator
+    if not os.environ.get("MPC_DEBUG"):
+        # The libraries' own warnings (numpy's RuntimeWarning in trimesh on a mesh with a
+        # coordinate of 3.4e38) name their source lines, not the user's file: what they point
+        # at is a diagnostic where it matters. MPC_DEBUG=1 shows them.
+        warnings.simplefilter("ignore")
     args = _parser().parse_args(argv)
     try:
         with _without_cyclic_gc(args.command):

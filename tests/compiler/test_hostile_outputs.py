@@ -271,3 +271,29 @@ def test_an_stl_whose_normals_do_not_parse_is_read_without_a_traceback(tmp_path:
                        env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")})
     assert "Traceback" not in done.stderr and "failed to extract" not in done.stderr
     assert done.returncode == 0
+
+
+def test_a_library_warning_on_a_degenerate_mesh_reaches_no_user(tmp_path: Path) -> None:
+    """The convex hull of a mesh with a coordinate of 3.4e38 (the fuzz run of 2026-11-27):
+    trimesh's vertex merging casts it to an integer, and numpy printed its RuntimeWarning, with
+    trimesh's source line, under mpc's messages."""
+    import struct
+
+    triangles = [((0, 0, 0), (0.1, 0, 0), (0, 0.1, 0)), ((0, 0, 0), (0.1, 0, 0), (0, 0, -3.4e38)),
+                 ((0, 0, 0), (0, 0.1, 0), (0, 0, -3.4e38)), ((0.1, 0, 0), (0, 0.1, 0), (0, 0, -3.4e38))]
+    data = bytearray(80) + struct.pack("<I", len(triangles))
+    for triangle in triangles:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v) for v in triangle) + b"\0\0"
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes/far.stl").write_bytes(bytes(data))
+    urdf = ARM_URDF.replace('<box size="0.05 0.05 0.4"/>', '<mesh filename="meshes/far.stl"/>')
+    spec = _model(tmp_path, urdf)
+    spec.write_text(spec.read_text() + "  collisions:\n    $default:\n      shape: convex\n")
+    done = mpc_process("compile", spec, "-o", tmp_path / "out",
+                       env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")})
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "out/meshes/stl/far_hull.stl").is_file()
+    assert "Warning" not in done.stderr and ".py:" not in done.stderr, done.stderr
+    debug = mpc_process("compile", spec, "-o", tmp_path / "out2",
+                        env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache2"), "MPC_DEBUG": "1"})
+    assert "RuntimeWarning" in debug.stderr
