@@ -21,8 +21,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.backends.missing_packages import unfound_packages
-from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, judge
+from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, REWRITE, judge
 from mpc.backends.mujoco_meshes import problem as mujoco_problem
+from mpc.backends.mujoco_meshes import verdict as mujoco_verdict
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
@@ -143,7 +144,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span,
                 return None
             fmt = "stl"  # a computed mesh whose own format trimesh cannot write
         stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
-        if mujoco and not use.mesh.ops and fmt == src.format and _rewritten_for_mujoco(src.path):
+        if mujoco and not use.mesh.ops and fmt == src.format and _mujoco_verdict(src.path) == REWRITE:
             stem += "_mujoco"
         wanted[k] = f"meshes/{fmt}/{stem}.{EXTENSIONS[fmt]}"
     if not ok:
@@ -192,18 +193,10 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
 def _mujoco_verdict(path: Path) -> str:
     """backends/mujoco_meshes.py `verdict`; READS for a file that cannot be read (copying it
     says why)."""
-    from mpc.backends import mujoco_meshes
-
     try:
-        return mujoco_meshes.verdict(path)
+        return mujoco_verdict(path)
     except OSError:
-        return mujoco_meshes.READS
-
-
-def _rewritten_for_mujoco(path: Path) -> bool:
-    from mpc.backends.mujoco_meshes import REWRITE
-
-    return _mujoco_verdict(path) == REWRITE
+        return READS
 
 
 def _digest(k: MeshKey) -> str:
@@ -288,14 +281,9 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
         name = rel.rsplit("/", 1)[-1]
         as_is = not ops and name.lower().endswith("." + src.name.rsplit(".", 1)[-1].lower()) \
             and not name.endswith(".mars.obj")
-        if skip(rel) and not mujoco:
+        written = skip(rel)  # by another export of the build, from the same source and ops
+        if written and not mujoco:
             continue
-        if skip(rel):  # written by another export of the build, from the same source and ops
-            if not as_is and (refusal := _mujoco_refusal(_cached_path(src, ops, os.path.splitext(name)[1]))):
-                refused(src, ops, rel, *refusal)
-                ok = False
-            elif not as_is or _mujoco_verdict(src) != REFUSED:
-                continue
         if as_is:
             problem, hint = _copy_problem(src), REPAIR_HINT
             verdict = _mujoco_verdict(src) if mujoco and problem is None else READS
@@ -308,9 +296,13 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
                 ok = False
                 continue
             if verdict == READS:
-                plan_.append((src, rel))
+                if not written:
+                    plan_.append((src, rel))
                 continue
-        elif skip(rel):
+        if written:  # computed by the other export: MuJoCo's verdict on its cache entry
+            if refusal := _mujoco_refusal(_cached_path(src, ops, os.path.splitext(name)[1])):
+                refused(src, ops, rel, *refusal)
+                ok = False
             continue
         try:
             cached = _cached_path(src, ops, os.path.splitext(name)[1])

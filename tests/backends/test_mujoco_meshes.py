@@ -159,12 +159,14 @@ def test_an_stl_of_more_triangles_than_mujoco_reads_is_an_error_copied_or_comput
     assert ("  hint: reduce the mesh (`reduce_meshes`) or write OBJ meshes (`mesh_format: obj`), which have "
             "no such limit\n") in err
     obj = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\n" + "f 1 2 3\n" * 200_001
-    code, err = _compile(tmp_path / "computed", "many.obj", obj, MJCF.format(fmt="stl"), capsys)
-    assert code == 1
-    assert (f"error[E0588]: mesh 'meshes/stl/many.stl' of a visual of link 'base', computed from "
-            f"'{tmp_path}/computed/meshes/many.obj' for MuJoCo, is one it refuses: it has 200,001 triangles; "
-            "MuJoCo reads at most 200,000 from an STL file\n") in err
-    assert not (tmp_path / "computed/out/mjcf").exists()
+    # Computed for the MJCF export, or by the SDF export before it, into the same file.
+    for folder, exports in (("computed", ""), ("shared", "    - type: sdf\n      mesh_format: stl\n")):
+        code, err = _compile(tmp_path / folder, "many.obj", obj, exports + MJCF.format(fmt="stl"), capsys)
+        assert code == 1
+        assert (f"error[E0588]: mesh 'meshes/stl/many.stl' of a visual of link 'base', computed from "
+                f"'{tmp_path}/{folder}/meshes/many.obj' for MuJoCo, is one it refuses: it has 200,001 "
+                "triangles; MuJoCo reads at most 200,000 from an STL file\n") in err
+        assert not (tmp_path / folder / "out/mjcf").exists()
 
 
 def test_laikago_in_mujoco_has_every_triangle_of_its_meshes(
