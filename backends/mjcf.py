@@ -666,10 +666,14 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
     path = confined(out, "mjcf", f"{name}.xml")
     write_path(path, text)
     if export.scene:
+        said: list[str] = []
         try:
-            floor = mjcf_scene.floor_height(path, COLLISION_GROUP)
+            floor = mjcf_scene.floor_height(path, COLLISION_GROUP, said)
         except ValueError as e:
             sink.error(export.span, "E0696", f"MuJoCo refuses the MJCF of robot '{robot.name}', so its "
                        f"scene cannot place the floor: {e}")
             return
+        for message in dict.fromkeys(said):
+            sink.warning(export.span, "W0506", f"MuJoCo warns about the MJCF of robot '{robot.name}' "
+                         f"as it loads it to place the scene's floor: {message}")
         write_path(confined(out, "mjcf", f"{name}_scene.xml"), mjcf_scene.scene(robot, f"{name}.xml", floor))

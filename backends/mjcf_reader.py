@@ -31,12 +31,9 @@ are E0440 at the file, line and column MuJoCo names.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import re
-import warnings
 from collections import Counter
-from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -87,6 +84,8 @@ _ATTRIBUTE = re.compile(r"attribute:? '([\w-]+)'")
 def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Robot | None:
     """Read the MJCF at `path`; None when it has errors (all of them reported)."""
     mujoco = _mujoco()
+    from mpc.backends.mujoco_module import warnings_into
+
     src = load(path, sink, "MJCF")
     if src is None:
         return None
@@ -105,7 +104,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
         return None
     said: list[str] = []  # MuJoCo's warnings
     try:
-        with _warnings_into(said):
+        with warnings_into(said):
             spec = mujoco.MjSpec.from_file(str(path), include=files.includes)
     except ValueError as e:
         files.mujoco_error(str(e))
@@ -116,7 +115,7 @@ def read(path: Path, sink: Sink, resolver: PackageResolver | None = None) -> Rob
         return None
     spec.assets = files.assets
     try:
-        with _warnings_into(said):
+        with warnings_into(said):
             model = spec.compile()
     except ValueError as e:
         files.mujoco_error(str(e))
@@ -136,24 +135,6 @@ def _mujoco() -> Any:
     from mpc.backends.mujoco_module import mujoco
 
     return mujoco
-
-
-@contextlib.contextmanager
-def _warnings_into(said: list[str]) -> Iterator[None]:
-    """MuJoCo's warnings inside the block go to `said`, not to stderr nor to the
-    MUJOCO_LOG.TXT that MuJoCo would write into the working folder."""
-    mujoco = _mujoco()
-    before = mujoco.get_mju_user_warning()
-    mujoco.set_mju_user_warning(lambda message: said.append(str(message).strip()))
-    warned: list[warnings.WarningMessage] = []
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            warned = caught
-            yield
-    finally:
-        mujoco.set_mju_user_warning(before)
-        said += [str(w.message).strip() for w in warned]
 
 
 # The compiled numbers the robot is made of, and what each is (E0480).

@@ -26,15 +26,16 @@ __all__ = ["floor_height", "scene"]
 ALL_BITS = str(2**31 - 1)  # contype and conaffinity are C ints
 
 
-def floor_height(robot_xml: Path, collision_group: int) -> float:
+def floor_height(robot_xml: Path, collision_group: int, said: list[str]) -> float:
     """The lowest z of the robot's collision geoms (group `collision_group`; all geoms when it
     has none) at q0, from MuJoCo's compiled model; 0 without geoms. ValueError (MuJoCo's
-    message) when MuJoCo refuses the file."""
+    message) when MuJoCo refuses the file; its warnings go to `said`."""
     import numpy as np
 
-    from mpc.backends.mujoco_module import mujoco
+    from mpc.backends.mujoco_module import mujoco, warnings_into
 
-    model = mujoco.MjModel.from_xml_path(str(robot_xml))
+    with warnings_into(said):
+        model = mujoco.MjModel.from_xml_path(str(robot_xml))
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     geoms = np.flatnonzero(model.geom_group == collision_group)

@@ -11,7 +11,10 @@ type stubs for its compiled API: the module is `Any` here.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import warnings
+from collections.abc import Iterator
 from typing import Any
 
 
@@ -28,3 +31,21 @@ def _imported() -> Any:
 
 
 mujoco: Any = _imported()
+
+
+@contextlib.contextmanager
+def warnings_into(said: list[str]) -> Iterator[None]:
+    """MuJoCo's warnings inside the block (and Python's: a deprecated attribute) go to `said`,
+    not to stdout nor to the MUJOCO_LOG.TXT that MuJoCo would append them to in the working
+    folder, which is the user's, not the build's."""
+    before = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: said.append(str(message).strip()))
+    warned: list[warnings.WarningMessage] = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            warned = caught
+            yield
+    finally:
+        mujoco.set_mju_user_warning(before)
+        said += [str(w.message).strip() for w in warned]

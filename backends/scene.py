@@ -178,7 +178,7 @@ class Scene:
         OBJ into `workdir`; None after an error (a mesh that cannot be converted, a model MuJoCo
         refuses: E0571)."""
         from mpc.backends import mjcf
-        from mpc.backends.mujoco_module import mujoco
+        from mpc.backends.mujoco_module import mujoco, warnings_into
 
         robot = coloured(_drawable(robot, geometry))
         files = _mesh_files(robot, workdir, sink, span)
@@ -190,11 +190,13 @@ class Scene:
                f'rgb2="{rgb}" width="8" height="8"/></asset>\n  <worldbody>')
         text = text.replace("  <worldbody>", sky, 1)
         (workdir / "scene.xml").write_text(text, encoding="utf-8")
+        said: list[str] = []
         try:
             # Through a spec let go of at once, and without MuJoCo's mesh cache: from_xml_path
             # keeps both, three times the model's memory (TALOS: 120 MB beside a 33 MB model).
-            spec = mujoco.MjSpec.from_file(str(workdir / "scene.xml"))
-            model = spec.compile()
+            with warnings_into(said):
+                spec = mujoco.MjSpec.from_file(str(workdir / "scene.xml"))
+                model = spec.compile()
         except ValueError as e:
             sink.error(span, "E0571", f"MuJoCo cannot load robot '{robot.name}' to draw it: {e}")
             return None
@@ -202,6 +204,9 @@ class Scene:
             spec = None
             mujoco.mj_clearCache(mujoco.mj_getCache())
             give_back()
+        for message in dict.fromkeys(said):
+            sink.warning(span, "W0571", f"MuJoCo warns about robot '{robot.name}' as it loads it to draw "
+                         f"it: {message}")
         return cls(model, geometry)
 
     def only(self, robot: int) -> None:

@@ -297,3 +297,22 @@ def test_a_library_warning_on_a_degenerate_mesh_reaches_no_user(tmp_path: Path) 
     debug = mpc_process("compile", spec, "-o", tmp_path / "out2",
                         env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache2"), "MPC_DEBUG": "1"})
     assert "RuntimeWarning" in debug.stderr
+
+
+def test_what_mujoco_warns_placing_a_scene_is_a_warning_not_a_log_in_the_working_folder(
+        tmp_path: Path) -> None:
+    """A link of 1.7e308 kg (the fuzz run of 2026-11-27): MuJoCo finds the joint-space inertia
+    near singular as it loads the robot to place the scene's floor. It printed that on stdout
+    and appended it to MUJOCO_LOG.TXT in the folder mpc was started from."""
+    spec = _model(tmp_path / "model", ARM_URDF.replace('<mass value="0.5"/>', '<mass value="1.7e308"/>'),
+                  "    - type: mjcf\n      scene: true\n")
+    (tmp_path / "elsewhere").mkdir()
+    done = mpc_process("compile", spec, "-o", tmp_path / "out", cwd=tmp_path / "elsewhere",
+                       env={**os.environ, "MPC_CACHE_DIR": str(tmp_path / "cache")})
+    assert done.returncode == 0, done.stderr
+    assert list((tmp_path / "elsewhere").iterdir()) == []
+    assert "WARNING" not in done.stdout
+    assert (f"{spec}:12:7: warning[W0506]: MuJoCo warns about the MJCF of robot 'robot' as it loads it to "
+            "place the scene's floor: Inertia matrix is too close to singular, or the effective-metric "
+            "solve failed to converge, at DOF 1. Check model. Time = 0.0000.\n") in done.stderr
+    assert (tmp_path / "out/mjcf/robot_scene.xml").is_file()
