@@ -108,6 +108,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span,
     ok = True
     wanted: dict[MeshKey, str] = {}
     uses = list(mesh_uses(robot))
+    collided = {key(u.mesh) for u in uses if u.element == "collision"}  # MuJoCo needs their hulls
     if any(use.mesh.source.path is None for use in uses):  # a package not found: once each
         for diagnostic in unfound_packages(((u.link, u.element, u.mesh) for u in uses), export_span):
             if diagnostic not in sink.diagnostics:  # said once, not once per export
@@ -144,7 +145,8 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span,
                 return None
             fmt = "stl"  # a computed mesh whose own format trimesh cannot write
         stem = src.path.name.rsplit(".", 1)[0] + _suffix(use.mesh.ops)
-        if mujoco and not use.mesh.ops and fmt == src.format and _mujoco_verdict(src.path) == REWRITE:
+        if mujoco and not use.mesh.ops and fmt == src.format and \
+                _mujoco_verdict(src.path, k in collided) == REWRITE:
             stem += "_mujoco"
         wanted[k] = f"meshes/{fmt}/{stem}.{EXTENSIONS[fmt]}"
     if not ok:
@@ -190,11 +192,11 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
     return out
 
 
-def _mujoco_verdict(path: Path) -> str:
+def _mujoco_verdict(path: Path, collision: bool) -> str:
     """backends/mujoco_meshes.py `verdict`; READS for a file that cannot be read (copying it
     says why)."""
     try:
-        return mujoco_verdict(path)
+        return mujoco_verdict(path, collision)
     except OSError:
         return READS
 
@@ -264,7 +266,9 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     entries: dict[Path, tuple[bytes, str]] = {}
     plan_: list[tuple[Path, str]] = []
     found: dict[str, bytes | Path] = {}
-    users = {(key(u.mesh)): u for u in mesh_uses(robot)} if robot is not None else {}
+    uses = list(mesh_uses(robot)) if robot is not None else []
+    users = {(key(u.mesh)): u for u in uses}
+    collided = {key(u.mesh) for u in uses if u.element == "collision"}  # MuJoCo needs their hulls
 
     def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
         use = users.get((src, ops))
@@ -286,9 +290,10 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             continue
         if as_is:
             problem, hint = _copy_problem(src), REPAIR_HINT
-            verdict = _mujoco_verdict(src) if mujoco and problem is None else READS
+            collision = (src, ops) in collided
+            verdict = _mujoco_verdict(src, collision) if mujoco and problem is None else READS
             if verdict == REFUSED:
-                problem, hint = mujoco_problem(src)
+                problem, hint = mujoco_problem(src, collision)
             if problem is not None:
                 span, of = where(src, ops)
                 sink.error(span, "E0585", f"mesh '{src}'{of} cannot be copied into the build: {problem}",
@@ -300,7 +305,8 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
                     plan_.append((src, rel))
                 continue
         if written:  # computed by the other export: MuJoCo's verdict on its cache entry
-            if refusal := _mujoco_refusal(_cached_path(src, ops, os.path.splitext(name)[1])):
+            entry = _cached_path(src, ops, os.path.splitext(name)[1])
+            if refusal := _mujoco_refusal(entry, (src, ops) in collided):
                 refused(src, ops, rel, *refusal)
                 ok = False
             continue
@@ -345,10 +351,12 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
-        if source in entries and mujoco and (refusal := _mujoco_refusal(source, entries[source][0])):
-            refused(*next((s, o) for (s, o), r in files.items() if r == rel), rel, *refusal)
-            ok = False
-            continue
+        if source in entries and mujoco:
+            src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
+            if refusal := _mujoco_refusal(source, (src, ops) in collided, entries[source][0]):
+                refused(src, ops, rel, *refusal)
+                ok = False
+                continue
         if source in entries:
             found[rel], digest = entries[source]
             if entries_used is not None:
@@ -358,21 +366,22 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     return found, ok
 
 
-def _mujoco_refusal(entry: Path, data: bytes | None = None) -> tuple[str, str] | None:
+def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> tuple[str, str] | None:
     """(why, hint) when MuJoCo refuses the mesh computed into the cache entry `entry` (its bytes
-    `data`, read when not given), else None. The verdict on an entry it reads is kept in the
-    cache (`verdicts/mujoco/<entry's name>`: an entry's name is its content's), as
-    `_copy_problem` keeps its own, so that a warm build does not look at every vertex again."""
+    `data`, read when not given) for a visual or a `collision`, else None. The verdict on an
+    entry it reads is kept in the cache (`verdicts/mujoco/<entry's name>`: an entry's name is
+    its content's), as `_copy_problem` keeps its own, so that a warm build does not look at
+    every vertex again."""
     from mpc.core.cache import cache_dir, read_entry
 
-    mark = cache_dir("verdicts") / "mujoco" / entry.name
+    mark = cache_dir("verdicts") / "mujoco" / (entry.name + (".collision" if collision else ""))
     if mark.is_file():
         return None
     if data is None:
         data = read_entry(entry)[0]
         if data is None:  # gone: the export that wrote the build's copy read it
             return None
-    verdict, why, hint = judge(data, entry.suffix.lower())
+    verdict, why, hint = judge(data, entry.suffix.lower(), collision)
     if verdict != READS:
         return why, hint
     with contextlib.suppress(OSError):  # a read-only cache: judged again next time

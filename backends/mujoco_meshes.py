@@ -15,6 +15,10 @@ on tinyobjloader), stricter than trimesh and than the URDF consumers that read t
   that is not finite is refused by both readers, or read as another shape by trimesh: such a
   file is not written.
 
+A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it does not),
+and refuses one whose vertices lie in one plane or on one line ("coplanar vertices, cannot
+compute convex hull").
+
 `verdict` says which of the three a file is, remembered by the file's status (core/cache.py);
 `problem` says why a refused file is refused.
 """
@@ -34,60 +38,87 @@ BOUND = 2.0**30  # the same: the largest coordinate it reads
 SIZE_HINT = ("reduce the mesh (`reduce_meshes`) or write OBJ meshes (`mesh_format: obj`), which have no "
              "such limit")
 REPAIR_HINT = "export the mesh again from its modelling tool"
+FLAT_HINT = ("give the link a primitive collision instead (`collisions: {<link>: {shape: box}}`), "
+             "as MuJoCo suggests")
+# Vertices whose spread across their thinnest direction is below this fraction of their widest
+# spread lie in one plane for MuJoCo, which computes the hull in single precision.
+_FLAT = 1e-6
 
 _VERTEX_LINE = re.compile(rb"^[ \t]*v[ \t]", re.MULTILINE)
 _NORMAL_LINE = re.compile(rb"^[ \t]*vn[ \t]", re.MULTILINE)
 _LEADING_INT = re.compile(rb"[+-]?\d+")
 
 
-def verdict(path: Path) -> str:
-    """READS, REWRITE or REFUSED for the mesh file `path` (STL or OBJ; other files READS),
-    remembered by its status; raises OSError when it cannot be read."""
+def verdict(path: Path, collision: bool = False) -> str:
+    """READS, REWRITE or REFUSED for the mesh file `path` (STL or OBJ; other files READS) of a
+    visual, or of a `collision`; remembered by its status; raises OSError when it cannot be
+    read."""
     from mpc.core.cache import remembered
 
     suffix = path.suffix.lower()
     if suffix not in (".stl", ".obj"):
         return READS
-    return remembered(path, "mujoco", lambda f: judge(f.read(), suffix)[0], 1)
+    what = "mujoco collision" if collision else "mujoco"
+    return remembered(path, what, lambda f: judge(f.read(), suffix, collision)[0], 1)
 
 
-def problem(path: Path) -> tuple[str, str]:
+def problem(path: Path, collision: bool = False) -> tuple[str, str]:
     """Why MuJoCo refuses the mesh file `path`, and what to do (a file `verdict` refuses)."""
-    return judge(path.read_bytes(), path.suffix.lower())[1:]
+    return judge(path.read_bytes(), path.suffix.lower(), collision)[1:]
 
 
-def judge(data: bytes, suffix: str) -> tuple[str, str, str]:
-    """(verdict, why refused, hint) for a mesh file's bytes."""
-    return _stl(data) if suffix == ".stl" else _obj(data)
+def judge(data: bytes, suffix: str, collision: bool = False) -> tuple[str, str, str]:
+    """(verdict, why refused, hint) for a mesh file's bytes, of a visual or of a `collision`."""
+    verdict, why, hint, vertices = _stl(data) if suffix == ".stl" else _obj(data)
+    if verdict == READS and collision and _flat(vertices):
+        return (REFUSED, "its vertices lie in one plane, and MuJoCo computes the convex hull of a "
+                "collision mesh", FLAT_HINT)
+    return verdict, why, hint
 
 
-def _stl(data: bytes) -> tuple[str, str, str]:
+def _flat(vertices: object) -> bool:
+    """Whether the points lie in one plane (or on one line), as MuJoCo's hull finds them."""
+    import numpy as np
+
+    points = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    if len(points) < 4:
+        return True
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    return bool(spread[2] <= _FLAT * spread[0])
+
+
+Judged = tuple[str, str, str, object]  # verdict, why, hint, the vertices (for `_flat`)
+
+
+def _stl(data: bytes) -> Judged:
     import numpy as np
 
     count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else 0
     if count < 1 or len(data) != 84 + 50 * count:
-        return REWRITE, "", ""  # ASCII, or binary of another length: MuJoCo reads neither
+        return REWRITE, "", "", ()  # ASCII, or binary of another length: MuJoCo reads neither
     if count > MAX_STL_TRIANGLES:
         return (REFUSED, f"it has {count:,} triangles; MuJoCo reads at most {MAX_STL_TRIANGLES:,} "
-                "from an STL file", SIZE_HINT)
+                "from an STL file", SIZE_HINT, ())
     record = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attributes", "<u2")])
     vertices = np.frombuffer(data, record, offset=84)["vertices"].reshape(count, 9)
     bad = ~np.isfinite(vertices).all(axis=1)
     if bad.any():
-        return REFUSED, f"triangle {int(bad.argmax()) + 1} has a coordinate that is not finite", REPAIR_HINT
+        why = f"triangle {int(bad.argmax()) + 1} has a coordinate that is not finite"
+        return REFUSED, why, REPAIR_HINT, ()
     far = (np.abs(vertices) > BOUND).any(axis=1)
     if far.any():
         return (REFUSED, f"triangle {int(far.argmax()) + 1} has a coordinate beyond ±2^30, the largest "
-                "MuJoCo reads", REPAIR_HINT)
-    return READS, "", ""
+                "MuJoCo reads", REPAIR_HINT, ())
+    return READS, "", "", vertices
 
 
-def _obj(data: bytes) -> tuple[str, str, str]:
+def _obj(data: bytes) -> Judged:
     """The OBJ rules of the module's docstring, one line at a time."""
     total, with_normals = len(_VERTEX_LINE.findall(data)), _NORMAL_LINE.search(data) is not None
     vertices = normals = objects = 0  # vertices and normals so far; objects (tinyobjloader's
     # shapes) with faces so far
     faces_here = rewrite = False
+    points: list[tuple[float, float, float]] = []
     for number, raw in enumerate(data.split(b"\n"), 1):
         words = raw.split()
         if not words:
@@ -97,14 +128,16 @@ def _obj(data: bytes) -> tuple[str, str, str]:
             rewrite = True  # tinyobjloader does not join continued lines
         if word == b"v":
             vertices += 1
-            for text in words[1:4]:
+            point = [0.0, 0.0, 0.0]
+            for axis, text in enumerate(words[1:4]):
                 try:
-                    value = float(text)
+                    point[axis] = float(text)
                 except ValueError:
                     continue  # read as 0 by tinyobjloader (trimesh reports it)
-                if not math.isfinite(value):
+                if not math.isfinite(point[axis]):
                     return (REFUSED, f"vertex {vertices} has a coordinate that is not finite "
-                            f"('{_shown(text)}', line {number})", REPAIR_HINT)
+                            f"('{_shown(text)}', line {number})", REPAIR_HINT, ())
+            points.append((point[0], point[1], point[2]))
         elif word == b"vn":
             normals += 1
         elif word == b"f":
@@ -116,12 +149,12 @@ def _obj(data: bytes) -> tuple[str, str, str]:
                     break
                 why = _corner_problem(corner, vertices, total)
                 if why:
-                    return REFUSED, f"{why} (line {number})", REPAIR_HINT
+                    return REFUSED, f"{why} (line {number})", REPAIR_HINT, ()
                 if with_normals and not _names_a_normal(corner, normals):
                     rewrite = True
         elif word in (b"o", b"g"):
             faces_here = False
-    return (REWRITE if rewrite or objects > 1 else READS), "", ""
+    return (REWRITE if rewrite or objects > 1 else READS), "", "", points
 
 
 def _corner_problem(corner: bytes, before: int, total: int) -> str:

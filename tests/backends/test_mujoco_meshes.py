@@ -192,3 +192,39 @@ def test_laikago_in_mujoco_has_every_triangle_of_its_meshes(
         source = robot / "meshes" / (name.removesuffix("_mujoco").removesuffix("_mirror") + ".obj")
         assert triangles == len(trimesh.load(source, force="mesh", process=False).faces), name
     assert compiled["trunk_mujoco"] == 22_246
+
+
+FLAT = [[(0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.1, 0.1, 0.0)],
+        [(0.0, 0.0, 0.0), (0.1, 0.1, 0.0), (0.0, 0.1, 0.0)]]
+FLAT_OBJ = "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n"
+
+
+@pytest.mark.parametrize(("mesh", "data", "fmt", "code", "named"), [
+    ("flat.stl", _stl(FLAT), "stl", "E0585",
+     "mesh '{tmp}/meshes/flat.stl' of a collision of link 'upper' cannot be copied into the build"),
+    ("flat.obj", FLAT_OBJ, "stl", "E0588",
+     "mesh 'meshes/stl/flat.stl' of a collision of link 'upper', computed from '{tmp}/meshes/flat.obj' for "
+     "MuJoCo, is one it refuses"),
+])
+def test_a_flat_collision_mesh_is_an_error_for_mjcf_and_a_flat_visual_is_not(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], mesh: str, data: str | bytes, fmt: str,
+        code: str, named: str) -> None:
+    """MuJoCo computes the convex hull of a collision mesh, and refuses a flat one ("coplanar
+    vertices, cannot compute convex hull"); a visual's it does not compute."""
+    urdf = ARM_URDF.replace('<box size="0.05 0.05 0.4"/>', f'<mesh filename="meshes/{mesh}"/>')
+    arm(tmp_path, urdf)
+    path = tmp_path / "meshes" / mesh
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
+    spec = write(tmp_path / "model.yml", definition("arm.urdf") + MJCF.format(fmt=fmt))
+    assert main(["compile", str(spec), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert (f"error[{code}]: {named.format(tmp=tmp_path)}: its vertices lie in one plane, and MuJoCo "
+            "computes the convex hull of a collision mesh\n") in err
+    assert ("  hint: give the link a primitive collision instead (`collisions: {<link>: {shape: box}}`), "
+            "as MuJoCo suggests\n") in err
+    visual = ARM_URDF.replace("meshes/tetra.stl", f"meshes/{mesh}")
+    arm(tmp_path / "visual", visual)
+    (tmp_path / "visual/meshes" / mesh).write_bytes(path.read_bytes())
+    spec = write(tmp_path / "visual/model.yml", definition("arm.urdf") + MJCF.format(fmt=fmt))
+    assert main(["compile", str(spec), "-o", str(tmp_path / "visual/out")]) == 0, capsys.readouterr().err
+    _mujoco_mesh(tmp_path / "visual/out/mjcf/robot.xml")  # MuJoCo compiles it
