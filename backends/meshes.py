@@ -108,7 +108,7 @@ def plan(robot: Robot, mesh_format: str, sink: Sink, export_span: Span,
     ok = True
     wanted: dict[MeshKey, str] = {}
     uses = list(mesh_uses(robot))
-    collided = {key(u.mesh) for u in uses if u.element == "collision"}  # MuJoCo needs their hulls
+    collided = _collided(uses) if mujoco else set()
     if any(use.mesh.source.path is None for use in uses):  # a package not found: once each
         for diagnostic in unfound_packages(((u.link, u.element, u.mesh) for u in uses), export_span):
             if diagnostic not in sink.diagnostics:  # said once, not once per export
@@ -192,6 +192,12 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
     return out
 
 
+def _collided(uses: list[MeshUse]) -> set[MeshKey]:
+    """The meshes of collisions (whose convex hulls MuJoCo computes), of those found."""
+    return {key(u.mesh) for u in uses
+            if u.element == "collision" and (u.mesh.source.path is not None or is_generated(u.mesh.source))}
+
+
 def _mujoco_verdict(path: Path, collision: bool) -> str:
     """backends/mujoco_meshes.py `verdict`; READS for a file that cannot be read (copying it
     says why)."""
@@ -268,7 +274,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     found: dict[str, bytes | Path] = {}
     uses = list(mesh_uses(robot)) if robot is not None else []
     users = {(key(u.mesh)): u for u in uses}
-    collided = {key(u.mesh) for u in uses if u.element == "collision"}  # MuJoCo needs their hulls
+    collided = _collided(uses) if mujoco else set()
 
     def where(src: Path, ops: tuple[MeshOp, ...]) -> tuple[Span, str]:
         use = users.get((src, ops))
@@ -374,7 +380,8 @@ def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> 
     every vertex again."""
     from mpc.core.cache import cache_dir, read_entry
 
-    mark = cache_dir("verdicts") / "mujoco" / (entry.name + (".collision" if collision else ""))
+    name = f"{entry.name}.collision" if collision else entry.name
+    mark = cache_dir("verdicts") / "mujoco" / name
     if mark.is_file():
         return None
     if data is None:
