@@ -166,22 +166,28 @@ def _corner_problem(corner: bytes, before: int, total: int) -> str:
     found = _LEADING_INT.match(parts[0])  # tinyobjloader reads the leading digits, as atoi does
     if found is None:
         return f"a face corner '{_shown(corner)}' names no vertex"
-    index = int(found[0])
-    if index == 0:
+    digits = found[0].lstrip(b"+-")
+    if not digits.strip(b"0"):
         return f"a face corner '{_shown(corner)}' names vertex 0 (an OBJ counts its vertices from 1)"
-    if index > total:
-        return f"a face corner '{_shown(corner)}' names vertex {index} of the file's {total}"
-    if -index > before:
+    magnitude = _magnitude(digits)
+    if found[0][:1] != b"-" and magnitude > total:
+        return f"a face corner '{_shown(corner)}' names vertex {_shown(digits)} of the file's {total}"
+    if found[0][:1] == b"-" and magnitude > before:
         return f"a face corner '{_shown(corner)}' counts back beyond the {before} vertices above it"
     return ""
+
+
+def _magnitude(digits: bytes) -> int:
+    """The number the digits write, or 10^18 for more than 18 of them (more than any file has
+    vertices; Python refuses to read past 4,300 digits as an int)."""
+    return int(digits) if len(digits) <= 18 else 10**18
 
 
 def _names_a_normal(corner: bytes, before: int) -> bool:
     """Whether the face corner (`v//vn`, `v/vt/vn`) names one of the `before` normals above it."""
     parts = corner.split(b"/")
     found = _LEADING_INT.match(parts[2]) if len(parts) == 3 else None
-    index = int(found[0]) if found else 0
-    return 0 < index <= before or 0 < -index <= before
+    return found is not None and 0 < _magnitude(found[0].lstrip(b"+-")) <= before
 
 
 def _shown(text: bytes) -> str:

@@ -125,6 +125,8 @@ def _with(value: float) -> bytes:
      "a face corner '0' names vertex 0 (an OBJ counts its vertices from 1) (line 6)"),
     ("beyond.obj", TETRA_OBJ.replace("f 1 2 4", "f 1 2 9"),
      "a face corner '9' names vertex 9 of the file's 4 (line 6)"),
+    ("huge.obj", TETRA_OBJ.replace("f 1 2 4", "f 1 2 " + "9" * 5000),  # the fuzz run's: exit 3
+     f"a face corner '{'9' * 37}...' names vertex {'9' * 37}... of the file's 4 (line 6)"),
     ("back.obj", TETRA_OBJ.replace("f 1 2 4", "f -1 -2 -5"),
      "a face corner '-5' counts back beyond the 4 vertices above it (line 6)"),
     ("corner.obj", TETRA_OBJ.replace("f 1 2 4", "f 1/1/1/1 2 4"),
