@@ -15,7 +15,9 @@ on tinyobjloader), stricter than trimesh and than the URDF consumers that read t
   that is not finite is refused by both readers, or read as another shape by trimesh: such a
   file is not written.
 
-A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it does not),
+Of any mesh, MuJoCo wants 4 vertices or more (an STL's equal vertices counted once) and
+triangles of some area (1e-15 m² in all): a mesh of one triangle, or of triangles with no area,
+is refused. A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it does not),
 and refuses one whose vertices lie in one plane or on one line ("coplanar vertices, cannot
 compute convex hull").
 
@@ -28,6 +30,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 READS = "0"  # MuJoCo reads the file as it is
 REWRITE = "1"  # the same mesh, written again, is one MuJoCo reads
@@ -35,6 +38,8 @@ REFUSED = "2"  # the file is refused (`problem` says why)
 
 MAX_STL_TRIANGLES = 200_000  # plugin/stl_decoder/stl_decoder.cc
 BOUND = 2.0**30  # the same: the largest coordinate it reads
+MIN_VERTICES = 4  # the same: "at least 4 vertices required"
+MIN_AREA = 1e-15  # src/user/user_mesh.cc (mjMINVAL): the least surface of a mesh it reads
 SIZE_HINT = ("reduce the mesh (`reduce_meshes`) or write OBJ meshes (`mesh_format: obj`), which have no "
              "such limit")
 REPAIR_HINT = "export the mesh again from its modelling tool"
@@ -69,25 +74,36 @@ def problem(path: Path, collision: bool = False) -> tuple[str, str]:
 
 def judge(data: bytes, suffix: str, collision: bool = False) -> tuple[str, str, str]:
     """(verdict, why refused, hint) for a mesh file's bytes, of a visual or of a `collision`."""
-    verdict, why, hint, vertices = _stl(data) if suffix == ".stl" else _obj(data)
-    if verdict == READS and collision and _flat(vertices):
+    import numpy as np
+
+    verdict, why, hint, triangles, vertices = _stl(data) if suffix == ".stl" else _obj(data)
+    if verdict != READS:
+        return verdict, why, hint
+    if vertices < MIN_VERTICES:
+        return (REFUSED, f"it has {vertices} vertices; MuJoCo reads a mesh of {MIN_VERTICES} or more",
+                REPAIR_HINT)
+    corners = np.asarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
+                                axis=1).sum()
+    if not area >= MIN_AREA:
+        return (REFUSED, f"its triangles have no area ({area:.3g} m² in all; MuJoCo refuses a mesh of "
+                f"less than {MIN_AREA:g})", REPAIR_HINT)
+    if collision and _flat(corners.reshape(-1, 3)):
         return (REFUSED, "its vertices lie in one plane, and MuJoCo computes the convex hull of a "
                 "collision mesh", FLAT_HINT)
     return verdict, why, hint
 
 
-def _flat(vertices: object) -> bool:
+def _flat(points: Any) -> bool:
     """Whether the points lie in one plane (or on one line), as MuJoCo's hull finds them."""
     import numpy as np
 
-    points = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
-    if len(points) < 4:
-        return True
     spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
     return bool(spread[2] <= _FLAT * spread[0])
 
 
-Judged = tuple[str, str, str, object]  # verdict, why, hint, the vertices (for `_flat`)
+# verdict, why, hint, the triangles' corners ((n, 3, 3)), the vertices as MuJoCo counts them
+Judged = tuple[str, str, str, Any, int]
 
 
 def _stl(data: bytes) -> Judged:
@@ -95,21 +111,22 @@ def _stl(data: bytes) -> Judged:
 
     count = int.from_bytes(data[80:84], "little") if len(data) >= 84 else 0
     if count < 1 or len(data) != 84 + 50 * count:
-        return REWRITE, "", "", ()  # ASCII, or binary of another length: MuJoCo reads neither
+        return REWRITE, "", "", (), 0  # ASCII, or binary of another length: MuJoCo reads neither
     if count > MAX_STL_TRIANGLES:
         return (REFUSED, f"it has {count:,} triangles; MuJoCo reads at most {MAX_STL_TRIANGLES:,} "
-                "from an STL file", SIZE_HINT, ())
+                "from an STL file", SIZE_HINT, (), 0)
     record = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attributes", "<u2")])
     vertices = np.frombuffer(data, record, offset=84)["vertices"].reshape(count, 9)
     bad = ~np.isfinite(vertices).all(axis=1)
     if bad.any():
         why = f"triangle {int(bad.argmax()) + 1} has a coordinate that is not finite"
-        return REFUSED, why, REPAIR_HINT, ()
+        return REFUSED, why, REPAIR_HINT, (), 0
     far = (np.abs(vertices) > BOUND).any(axis=1)
     if far.any():
         return (REFUSED, f"triangle {int(far.argmax()) + 1} has a coordinate beyond ±2^30, the largest "
-                "MuJoCo reads", REPAIR_HINT, ())
-    return READS, "", "", vertices
+                "MuJoCo reads", REPAIR_HINT, (), 0)
+    distinct = len(np.unique(np.ascontiguousarray(vertices.reshape(-1, 3)).view(np.dtype((np.void, 12)))))
+    return READS, "", "", vertices, distinct  # MuJoCo merges equal vertices of an STL
 
 
 def _obj(data: bytes) -> Judged:
@@ -119,6 +136,7 @@ def _obj(data: bytes) -> Judged:
     # shapes) with faces so far
     faces_here = rewrite = False
     points: list[tuple[float, float, float]] = []
+    triangles: list[tuple[int, int, int]] = []  # as tinyobjloader makes them of each face
     for number, raw in enumerate(data.split(b"\n"), 1):
         words = raw.split()
         if not words:
@@ -136,25 +154,31 @@ def _obj(data: bytes) -> Judged:
                     continue  # read as 0 by tinyobjloader (trimesh reports it)
                 if not math.isfinite(point[axis]):
                     return (REFUSED, f"vertex {vertices} has a coordinate that is not finite "
-                            f"('{_shown(text)}', line {number})", REPAIR_HINT, ())
+                            f"('{_shown(text)}', line {number})", REPAIR_HINT, (), 0)
             points.append((point[0], point[1], point[2]))
         elif word == b"vn":
             normals += 1
         elif word == b"f":
             if not faces_here:
                 faces_here, objects = True, objects + 1
+            face: list[int] = []
             for corner in words[1:]:
                 if corner.startswith(b"#"):
                     rewrite = True  # a comment: tinyobjloader reads it as a corner
                     break
                 why = _corner_problem(corner, vertices, total)
                 if why:
-                    return REFUSED, f"{why} (line {number})", REPAIR_HINT, ()
+                    return REFUSED, f"{why} (line {number})", REPAIR_HINT, (), 0
                 if with_normals and not _names_a_normal(corner, normals):
                     rewrite = True
+                index = int(_LEADING_INT.match(corner)[0])  # type: ignore[index]  # checked above
+                face.append(index - 1 if index > 0 else vertices + index)
+            triangles += [(face[0], face[k], face[k + 1]) for k in range(1, len(face) - 1)]
         elif word in (b"o", b"g"):
             faces_here = False
-    return (REWRITE if rewrite or objects > 1 else READS), "", "", points
+    if rewrite or objects > 1:
+        return REWRITE, "", "", (), 0
+    return READS, "", "", [[points[i] for i in triangle] for triangle in triangles], vertices
 
 
 def _corner_problem(corner: bytes, before: int, total: int) -> str:

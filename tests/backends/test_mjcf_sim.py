@@ -131,17 +131,23 @@ def test_menagerie_policy(model: str, tmp_path: Path, capfd: pytest.CaptureFixtu
     _step_one_second(scene, 0)
 
 
-def test_a_scene_of_a_robot_mujoco_refuses_is_e0696(tmp_path: Path) -> None:
-    """A visual mesh of one triangle: mpc copies it, MuJoCo wants 4 vertices at least."""
+def _flat_robot(folder: Path, mass: str = "") -> Path:
+    """A robot whose base has a visual mesh of one triangle, and a link of `mass` below it."""
     import struct
 
-    (tmp_path / "flat.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 1)
-                                        + struct.pack("<12fH", 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 0))
-    write(tmp_path / "flat.urdf", """<robot name="flat">
-  <link name="base"><visual><geometry><mesh filename="flat.stl"/></geometry></visual></link>
+    (folder / "flat.stl").write_bytes(b"\0" * 80 + struct.pack("<I", 1)
+                                      + struct.pack("<12fH", 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 0))
+    visual = '<visual><geometry><mesh filename="flat.stl"/></geometry></visual>'
+    inertial = f'<inertial><mass value="{mass}"/><inertia ixx="{mass}" ixy="0" ixz="0" iyy="{mass}" ' \
+        f'iyz="0" izz="{mass}"/></inertial>'
+    write(folder / "flat.urdf", f"""<robot name="flat">
+  <link name="base">{visual if not mass else ""}</link>
+  <link name="arm">{inertial if mass else ""}</link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>
 """)
-    definition = write(tmp_path / "flat.yml", """\
+    return write(folder / "flat.yml", """\
         model:
           robotname: flat
           modelname: flat
@@ -152,13 +158,32 @@ def test_a_scene_of_a_robot_mujoco_refuses_is_e0696(tmp_path: Path) -> None:
               mesh_format: stl
               scene: true
         """)
+
+
+def test_a_scene_of_a_robot_mujoco_refuses_is_e0696(tmp_path: Path) -> None:
+    """A moving link of 1e-30 kg: E0504 says MuJoCo refuses it, and the scene, which loads the
+    robot in MuJoCo to place its floor, cannot."""
     sink = Diags()
-    compile_model(definition, sink, Options(out=tmp_path / "out"))
+    compile_model(_flat_robot(tmp_path, "1e-30"), sink, Options(out=tmp_path / "out"))
+    sink.take_error("E0504")
     error = sink.take_error("E0696")
     assert error.message.startswith("MuJoCo refuses the MJCF of robot 'flat', so its scene cannot place "
-                                    "the floor: Error: at least 4 vertices required")
+                                    "the floor: Error: mass and inertia of moving bodies must be larger "
+                                    "than mjMINVAL")
     assert (error.span.line, error.span.col) == (7, 7)  # the entry
     assert not (tmp_path / "out").exists()  # the build failed: nothing is written
+
+
+def test_a_mesh_mujoco_refuses_is_said_before_the_scene_loads_it(tmp_path: Path) -> None:
+    """A visual mesh of one triangle (MuJoCo wants 4 vertices at least): E0585, the file is not
+    written, and the scene does not try MuJoCo with it."""
+    sink = Diags()
+    compile_model(_flat_robot(tmp_path), sink, Options(out=tmp_path / "out"))
+    error = sink.take_error("E0585")
+    assert error.message == (f"mesh '{tmp_path}/flat.stl' of a visual of link 'base' cannot be copied into "
+                             "the build: it has 3 vertices; MuJoCo reads a mesh of 4 or more")
+    assert not any(d.code == "E0696" for d in sink.diagnostics)
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("model", [UR5, PANDA])

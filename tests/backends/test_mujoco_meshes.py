@@ -120,6 +120,12 @@ def _with(value: float) -> bytes:
 @pytest.mark.parametrize(("mesh", "data", "problem"), [
     ("nan.stl", _with(float("nan")), "triangle 2 has a coordinate that is not finite"),
     ("far.stl", _with(2.0**31), "triangle 2 has a coordinate beyond ±2^30, the largest MuJoCo reads"),
+    ("few.stl", _stl([[(0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.0, 0.1, 0.0)]] * 4),
+     "it has 3 vertices; MuJoCo reads a mesh of 4 or more"),
+    ("few.obj", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n",
+     "it has 3 vertices; MuJoCo reads a mesh of 4 or more"),
+    ("line.obj", "v 0 0 0\nv 0.1 0 0\nv 0.2 0 0\nv 0.3 0 0\nf 1 2 3\nf 2 3 4\n",
+     "its triangles have no area (0 m² in all; MuJoCo refuses a mesh of less than 1e-15)"),
     ("word.obj", TETRA_OBJ.replace("f 1 2 4", "f 2 [[["), "a face corner '[[[' names no vertex (line 6)"),
     ("zero.obj", TETRA_OBJ.replace("f 1 2 4", "f 0 1 2"),
      "a face corner '0' names vertex 0 (an OBJ counts its vertices from 1) (line 6)"),
