@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.backends.missing_packages import unfound_packages
-from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, REWRITE, judge
+from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, REWRITE, RULES, judge
 from mpc.backends.mujoco_meshes import problem as mujoco_problem
 from mpc.backends.mujoco_meshes import verdict as mujoco_verdict
 from mpc.backends.smurf_forms import named_shapes
@@ -375,13 +375,13 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
 def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> tuple[str, str] | None:
     """(why, hint) when MuJoCo refuses the mesh computed into the cache entry `entry` (its bytes
     `data`, read when not given) for a visual or a `collision`, else None. The verdict on an
-    entry it reads is kept in the cache (`verdicts/mujoco/<entry's name>`: an entry's name is
+    entry it reads is kept in the cache (`verdicts/mujoco-1/<entry's name>`: an entry's name is
     its content's), as `_copy_problem` keeps its own, so that a warm build does not look at
     every vertex again."""
     from mpc.core.cache import cache_dir, read_entry
 
     name = f"{entry.name}.collision" if collision else entry.name
-    mark = cache_dir("verdicts") / "mujoco" / name
+    mark = cache_dir("verdicts") / RULES.replace(" ", "-") / name
     if mark.is_file():
         return None
     if data is None:

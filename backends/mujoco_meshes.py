@@ -17,12 +17,12 @@ on tinyobjloader), stricter than trimesh and than the URDF consumers that read t
 
 Of any mesh, MuJoCo wants 4 vertices or more (an STL's equal vertices counted once) and
 triangles of some area (1e-15 m² in all): a mesh of one triangle, or of triangles with no area,
-is refused. A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it does not),
-and refuses one whose vertices lie in one plane or on one line ("coplanar vertices, cannot
-compute convex hull").
+is refused. A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it
+does not), and refuses one whose vertices lie in one plane or on one line ("coplanar vertices,
+cannot compute convex hull").
 
 `verdict` says which of the three a file is, remembered by the file's status (core/cache.py);
-`problem` says why a refused file is refused.
+`problem` says why a refused file is refused. RULES names these rules in what is remembered.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+RULES = "mujoco 1"  # changes when the rules change, so that no verdict of older ones is used
 READS = "0"  # MuJoCo reads the file as it is
 REWRITE = "1"  # the same mesh, written again, is one MuJoCo reads
 REFUSED = "2"  # the file is refused (`problem` says why)
@@ -63,7 +64,7 @@ def verdict(path: Path, collision: bool = False) -> str:
     suffix = path.suffix.lower()
     if suffix not in (".stl", ".obj"):
         return READS
-    what = "mujoco collision" if collision else "mujoco"
+    what = f"{RULES} collision" if collision else RULES
     return remembered(path, what, lambda f: judge(f.read(), suffix, collision)[0], 1)
 
 

@@ -106,8 +106,8 @@ SITES: dict[tuple[str, str, str], str] = {
     ("xacro_origins.py", "_recording", "Path(stack[-1])"): READ,
     ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae'"): CACHE,
     ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest"): CACHE,
-    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / 'mujoco'"): CACHE,
-    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / 'mujoco' / name"): CACHE,
+    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / RULES.replace(' ', '-')"): CACHE,
+    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / RULES.replace(' ', '-') / name"): CACHE,
     ("meshes.py", "key", "Path(mesh.source.uri.removeprefix(GENERATED))"):
         "a made mesh's key (`<link>_joined`); its output path goes through copy's confined",
 }
