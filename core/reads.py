@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import itertools
 import os
+import re
 import stat
 import sys
 from collections.abc import Iterable, Iterator
@@ -24,6 +25,9 @@ from typing import Any
 # File types that are code, not inputs: modules imported while building.
 _CODE_SUFFIXES = frozenset({".py", ".pyc", ".so", ".pyd", ".pth", ".pyi", ".typed", ".lark"})
 _SYSTEM = ("/proc/", "/sys/", "/dev/", "/etc/")
+# Installed distributions' metadata (their entry points, which pydantic reads for plugins): an
+# editable install's `.egg-info` lies in the checkout, and a wheel built there rewrites it.
+_METADATA = re.compile(r"\.(?:dist|egg)-info" + re.escape(os.sep))
 
 _active: list[ReadRecorder] = []
 _hooked = False
@@ -77,7 +81,7 @@ class ReadRecorder:
             if text in self.written or text.startswith(_SYSTEM) or text.startswith(self.ignore):
                 continue
             if os.path.splitext(text)[1] in _CODE_SUFFIXES or f"{os.sep}__pycache__{os.sep}" in text \
-                    or ".dist-info" + os.sep in text:
+                    or _METADATA.search(text):
                 continue
             data = f"{os.sep}share{os.sep}" in text
             if text.startswith(self.code_as_named) and not data:
