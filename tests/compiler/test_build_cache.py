@@ -120,7 +120,7 @@ def test_a_second_compile_in_a_new_process_imports_no_schema(tmp_path: Path, tra
     done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
                           env=os.environ, timeout=120)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines()[-1] == "[] False"
+    assert done.stdout.splitlines()[-1] == "[] False", trace.read_text()  # the trace says why
     assert _events(trace)[1:] == events
     assert _files(tmp_path / "out2") == _files(tmp_path / "out1")
 
