@@ -644,12 +644,12 @@ def write(robot: Robot, mesh_format: str, additional: tuple[str, ...], out: Path
 
 
 def for_export(robot: Robot, export: UrdfExport | SdfExport | MjcfExport, out: Path,
-               sink: Sink) -> tuple[Robot, dict[MeshKey, str]] | None:
+               sink: Sink, mujoco: bool = False) -> tuple[Robot, dict[MeshKey, str]] | None:
     """Write the meshes of a urdf, sdf or mjcf export (`write`); the robot to write (numbers
     near zero made 0 with `enforce_zero`; every unnamed visual and collision named as the
-    SMURF names it, `named_shapes`) and where each mesh went, or None after an error."""
-    files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span,
-                  export.type == "mjcf")
+    SMURF names it, `named_shapes`) and where each mesh went, or None after an error.
+    mujoco: MuJoCo reads the meshes (`plan`)."""
+    files = write(robot, export.mesh_format, export.additional_meshes, out, sink, export.span, mujoco)
     if files is None:
         return None
     return named_shapes(zero_small(robot) if export.enforce_zero else robot), files

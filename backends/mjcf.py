@@ -655,7 +655,7 @@ def emit(robot: Robot, export: MjcfExport, out: Path, sink: Sink) -> None:
         return
     if not _diagnose(robot, sink, export.span, export.actuators):
         return
-    prepared = meshes.for_export(coloured(robot), export, out, sink)
+    prepared = meshes.for_export(coloured(robot), export, out, sink, mujoco=True)
     if prepared is None:
         return
     robot, files = prepared

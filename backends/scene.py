@@ -120,12 +120,14 @@ def side_by_side(robots: list[Robot]) -> Robot:
 
 def _mesh_files(robot: Robot, workdir: Path, sink: Sink, span: Span) -> dict[Any, str] | None:
     """The robot's meshes in `workdir`: STL files stay STL (MuJoCo reads them fastest, with
-    shared vertices), the others become OBJ (MuJoCo reads no DAE); None after an error."""
-    as_obj, as_stl = meshes.plan(robot, "obj", sink, span), meshes.plan(robot, "stl", sink, span)
+    shared vertices), the others become OBJ (MuJoCo reads no DAE); each a file MuJoCo reads
+    whole (backends/mujoco_meshes.py); None after an error."""
+    as_obj = meshes.plan(robot, "obj", sink, span, mujoco=True)
+    as_stl = meshes.plan(robot, "stl", sink, span, mujoco=True)
     if as_obj is None or as_stl is None:
         return None
     files = {k: as_stl[k] if not k[1] and k[0].suffix.lower() == ".stl" else rel for k, rel in as_obj.items()}
-    return files if meshes.copy(files, workdir, sink, span, robot) else None
+    return files if meshes.copy(files, workdir, sink, span, robot, mujoco=True) else None
 
 
 def _gl_context(width: int, height: int) -> Any:

@@ -236,3 +236,23 @@ def test_a_flat_collision_mesh_is_an_error_for_mjcf_and_a_flat_visual_is_not(
     spec = write(tmp_path / "visual/model.yml", definition("arm.urdf") + MJCF.format(fmt=fmt))
     assert main(["compile", str(spec), "-o", str(tmp_path / "visual/out")]) == 0, capsys.readouterr().err
     _mujoco_mesh(tmp_path / "visual/out/mjcf/robot.xml")  # MuJoCo compiles it
+
+
+def test_a_render_draws_every_object_of_an_obj(tmp_path: Path) -> None:
+    """A render loads the robot in MuJoCo too (backends/scene.py): the OBJ of two objects is
+    written again for it, and MuJoCo has both."""
+    from mpc.backends import urdf
+    from mpc.backends.scene import Scene
+    from mpc.core.diagnostics import Sink
+    from mpc.core.span import Span
+
+    second = "".join(f"v {x + 1} {y} {z}\n" for x, y, z in TETRA) + "f 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n"
+    arm(tmp_path, ARM_URDF.replace("meshes/tetra.stl", "meshes/two.obj"))
+    (tmp_path / "meshes/two.obj").write_text(f"o a\n{TETRA_OBJ}o b\n{second}")
+    sink = Sink()
+    robot = urdf.read(tmp_path / "arm.urdf", sink)
+    assert robot is not None
+    scene = Scene.build(robot, tmp_path / "work", sink, Span("model.yml", 1, 1))
+    assert scene is not None, [d.message for d in sink.diagnostics]
+    assert (tmp_path / "work/meshes/obj/two_mujoco.obj").is_file()
+    assert [int(n) for n in scene.model.mesh_facenum] == [8]
