@@ -21,6 +21,7 @@ import pytest
 
 from mpc.compiler import front_end
 from mpc.compiler.driver import Options, Result, compile_model
+from mpc.core.blas import user_environment
 from mpc.core.diagnostics import Severity, Sink
 from tests.conftest import write
 from tests.fixtures import ARM_URDF, arm, tetra_stl
@@ -117,8 +118,10 @@ def test_a_second_compile_in_a_new_process_imports_no_schema(tmp_path: Path, tra
             "print(sorted({m.split('.')[0] for m in sys.modules} & set(sys.argv[1].split(','))), "
             "'mpc.compiler.front_end' in sys.modules); sys.exit(code)")
     args = [",".join(heavy), str(spec), "-o", str(tmp_path / "out2"), *(["--force"] if force else [])]
+    # The environment as a user has it: a `main()` run earlier in this process (another test's)
+    # set OPENBLAS_NUM_THREADS for itself (core/blas.py), which a child would take for the user's.
     done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
-                          env=os.environ, timeout=120)
+                          env=user_environment(), timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "[] False", trace.read_text()  # the trace says why
     assert _events(trace)[1:] == events
