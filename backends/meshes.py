@@ -334,6 +334,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
             touch_entry(cached)
         plan_.append((cached, rel))
     problems = _compute(list(todo.values()))
+    key_of = {rel: k for k, rel in files.items()}
     for source, rel in plan_:
         if source in problems:
             src, ops, _ = todo[source]
@@ -351,18 +352,17 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
                 continue
             entries[source] = data, digest
         ignored = notes_file(source)
+        src, ops = key_of[rel]
         if source in entries and ignored.is_file():  # the entry records what computing it ignored
-            src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
             span, of = where(src, ops)
             sink.warning(span, "W0605", f"mesh '{src}'{of} has broken references, ignored to read "
                          f"its triangles: {'; '.join(ignored.read_text(encoding='utf-8').splitlines())}",
                          hint="the geometry is complete; only materials or textures are missing")
-        if source in entries and mujoco:
-            src, ops = next((s, o) for (s, o), r in files.items() if r == rel)
-            if refusal := _mujoco_refusal(source, (src, ops) in collided, entries[source][0]):
-                refused(src, ops, rel, *refusal)
-                ok = False
-                continue
+        if source in entries and mujoco and (
+                refusal := _mujoco_refusal(source, (src, ops) in collided, entries[source][0])):
+            refused(src, ops, rel, *refusal)
+            ok = False
+            continue
         if source in entries:
             found[rel], digest = entries[source]
             if entries_used is not None:
@@ -378,10 +378,9 @@ def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> 
     entry it reads is kept in the cache (`verdicts/mujoco-1/<entry's name>`: an entry's name is
     its content's), as `_copy_problem` keeps its own, so that a warm build does not look at
     every vertex again."""
-    from mpc.core.cache import cache_dir, read_entry
+    from mpc.core.cache import read_entry
 
-    name = f"{entry.name}.collision" if collision else entry.name
-    mark = cache_dir("verdicts") / RULES.replace(" ", "-") / name
+    mark = _sound_mark(RULES.replace(" ", "-"), f"{entry.name}.collision" if collision else entry.name)
     if mark.is_file():
         return None
     if data is None:
@@ -391,10 +390,22 @@ def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> 
     verdict, why, hint = judge(data, entry.suffix.lower(), collision)
     if verdict != READS:
         return why, hint
+    _note_sound(mark)
+    return None
+
+
+def _sound_mark(kind: str, name: str) -> Path:
+    """The file whose presence says the content `name` was judged sound by the rules `kind`
+    (a verdict kept in the cache, as pipeline/verdicts.py keeps its own)."""
+    from mpc.core.cache import cache_dir
+
+    return cache_dir("verdicts") / kind / name
+
+
+def _note_sound(mark: Path) -> None:
     with contextlib.suppress(OSError):  # a read-only cache: judged again next time
         mark.parent.mkdir(parents=True, exist_ok=True)
         mark.touch()
-    return None
 
 
 def _copy_problem(src: Path) -> str | None:
@@ -407,12 +418,11 @@ def _copy_problem(src: Path) -> str | None:
         return None
     from lxml import etree
 
-    from mpc.core.cache import cache_dir, file_digest
+    from mpc.core.cache import file_digest
     from mpc.core.span import hardened_parser
 
     try:
-        digest = file_digest(src)
-        mark = cache_dir("verdicts") / "dae" / digest
+        mark = _sound_mark("dae", file_digest(src))
         if mark.is_file():
             return None
         data = src.read_bytes()
@@ -425,9 +435,7 @@ def _copy_problem(src: Path) -> str | None:
         if not math.isfinite(float(m[1])):
             line = data.count(b"\n", 0, m.start(1)) + 1
             return f"it holds a number that is not finite ('{m[1].decode()}', line {line})"
-    with contextlib.suppress(OSError):  # a read-only cache: parsed again next time
-        mark.parent.mkdir(parents=True, exist_ok=True)
-        mark.touch()
+    _note_sound(mark)
     return None
 
 

@@ -104,10 +104,8 @@ SITES: dict[tuple[str, str, str], str] = {
     ("xacro_guard.py", "checked_file", "Path(path)"): READ,
     ("xacro_origins.py", "start_element_handler", "Path(stack[-1])"): READ,
     ("xacro_origins.py", "_recording", "Path(stack[-1])"): READ,
-    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae'"): CACHE,
-    ("meshes.py", "_copy_problem", "cache_dir('verdicts') / 'dae' / digest"): CACHE,
-    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / RULES.replace(' ', '-')"): CACHE,
-    ("meshes.py", "_mujoco_refusal", "cache_dir('verdicts') / RULES.replace(' ', '-') / name"): CACHE,
+    ("meshes.py", "_sound_mark", "cache_dir('verdicts') / kind"): CACHE,
+    ("meshes.py", "_sound_mark", "cache_dir('verdicts') / kind / name"): CACHE,
     ("meshes.py", "key", "Path(mesh.source.uri.removeprefix(GENERATED))"):
         "a made mesh's key (`<link>_joined`); its output path goes through copy's confined",
 }
