@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 import os
 import subprocess
@@ -192,12 +193,15 @@ def test_the_program_ends_with_mains_status_its_atexit_work_done_and_its_output_
         tmp_path: Path) -> None:
     """`mpc` skips the interpreter's teardown (cli/main.py: program); what users see of the
     end stays: the exit status, every byte written to a pipe (by Python or by C's stdio), and
-    the atexit functions run (multiprocessing's and tempfile's among them)."""
+    the atexit functions run (multiprocessing's and tempfile's among them). The cyclic
+    collector paused for a compile stays off to the end (turned on, it would scan everything
+    once more); main() called in a process that goes on leaves it as it was."""
     arm(tmp_path)
     good = write(tmp_path / "good.yml", definition("arm.urdf"))
     bad = write(tmp_path / "bad.yml", definition("arm.urdf").replace("robotname:", "robtname:"))
-    probe = ("import atexit, ctypes, sys\nfrom mpc.cli.main import program\n"
+    probe = ("import atexit, ctypes, gc, sys\nfrom mpc.cli.main import program\n"
              "atexit.register(lambda: print('atexit ran', file=sys.stderr))\n"
+             "atexit.register(lambda: print('collector on:', gc.isenabled(), file=sys.stderr))\n"
              "print('before mpc', end='')  # left in the buffer of a pipe\n"
              "ctypes.CDLL(None).printf(b' and C')  # in C's, as a C library prints\n"
              "sys.argv = ['mpc', *sys.argv[1:]]\nprogram()\n")
@@ -207,6 +211,9 @@ def test_the_program_ends_with_mains_status_its_atexit_work_done_and_its_output_
                              capture_output=True, text=True, timeout=600, env=buffered)
         assert run.returncode == status, run.stderr
         assert run.stdout.startswith("before mpc") and run.stdout.endswith(" and C")
-        assert run.stderr.endswith("atexit ran\n")
+        assert run.stderr.endswith(f"collector on: {status == 2}\natexit ran\n")
     assert (tmp_path / "out/urdf/robot.urdf").is_file()
+    assert gc.isenabled()
+    assert mpc("compile", good, "-o", tmp_path / "again").returncode == 0
+    assert gc.isenabled()
     assert mpc_process("compile", bad).stderr.endswith(f"error: could not compile '{bad}' (2 errors)\n")
