@@ -1,7 +1,8 @@
 """Cold wall time of `mpc check` on the bundled example: a fresh process, so imports count.
 
-Target (issue 20, the schema on pydantic): at most 450 ms (issue 3 had 250 ms with mpc's own
-validator), and never importing Pinocchio, PyBullet, trimesh or numpy.
+Target (issue 20): at most 450 ms (issue 3 had 250 ms with mpc's first validator; issue
+20 moved the schema to pydantic, issue 34 back to checks of mpc's own), and never importing
+Pinocchio, PyBullet, trimesh or numpy.
 Run: python bench/bench_check.py [runs]
 """
 

@@ -24,8 +24,8 @@ def run(args: argparse.Namespace) -> int:
 def without_openssl_hashes() -> None:
     """The server's process hashes with Python's own hash functions, not OpenSSL's.
 
-    pydantic imports `secrets`, which imports `hmac` and so `hashlib`, which loads OpenSSL's
-    libcrypto through `_hashlib`: 3.5 MiB of the server's memory, to hash nothing in a check
+    mpc's own modules import `hashlib` (core/version.py, core/cache.py), which loads OpenSSL's
+    libcrypto through `_hashlib`: 3.5 MiB of the server's memory, to hash little in a check
     (mpc's build cache hashes; the server builds nothing). `None` in `sys.modules` makes an
     import fail, as the import system documents; `hashlib` and `hmac` then give their
     functions from Python's built-in modules (the same digests, slower on large data). Nothing

@@ -260,11 +260,9 @@ def _json_on_stdout(args: argparse.Namespace) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from mpc.cli import pydantic_plugins
     from mpc.core import blas
 
     blas.one_thread()  # before anything imports numpy
-    pydantic_plugins.install()  # before anything builds a pydantic validator
     if not os.environ.get("MPC_DEBUG"):
         # The libraries' own warnings (numpy's RuntimeWarning in trimesh on a mesh with a
         # coordinate of 3.4e38) name their source lines, not the user's file: what they point

@@ -5,7 +5,7 @@ A build is a function of what it reads. What the front end and the ops compute (
 front_end.py: load, merge defaults, validate, lower, run the passes, read the inputs, apply
 the ops) depends only on:
 - mpc (its version with the digest of its sources, core/version.py), the Python running it
-  and the distributions installed beside it (xacro, lxml, pydantic, trimesh shape results);
+  and the distributions installed beside it (xacro, lxml, trimesh shape results);
 - the definition's path as given, the working folder, `--package` and the environment, less
   the variables a shell sets by itself (`_SESSION`);
 - the files it opened (core/reads.py records them): the definition, its defaults, the

@@ -1,9 +1,9 @@
 """The definition language as JSON Schema (draft 2020-12), documented from specs/, for editors.
 
-Input: the pydantic models of compiler/schema/ (`model_json_schema()`) and the key tables
+Input: the node classes of compiler/schema/ (their fields' types, `_shapes`) and the key tables
 of specs/*.md. Output: the schema `mpc schema` prints and specs/model-definition.schema.json
 holds (a test keeps the committed file equal to what this module generates). What it adds
-to pydantic's schema: closed sections (`additionalProperties: false`), the old spellings
+to the shapes of the classes: closed sections (`additionalProperties: false`), the old spellings
 (deprecated), titles a user knows (a section's name or a property's key, never a class
 name), a description for every property taken from the key tables of
 specs/ (meaning, type and default), and examples from the runnable examples of specs/.
@@ -15,8 +15,12 @@ Point an editor at it with a first line
 
 from __future__ import annotations
 
+import functools
+import inspect
 import json
 import re
+import types
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -237,9 +241,7 @@ def definition_schema() -> dict[str, Any]:
     from mpc.compiler.schema import Definition
     from mpc.compiler.schema.base import Node
 
-    schema = Definition.model_json_schema(by_alias=True)
-    defs = schema.pop("$defs")
-    defs["Definition"] = schema
+    defs = _shapes(Definition)
     # specs/ is beside the code in a checkout; an installed mpc without it describes less
     tables, examples = (_tables(), _examples()) if SPECS.is_dir() else ({}, {})
     classes = {c.__name__: c for c in _subclasses(Node)}
@@ -247,7 +249,7 @@ def definition_schema() -> dict[str, Any]:
         cls = classes[name]
         node["title"] = TITLES.get(name) or re.sub(r"^(a|an|the) ", "", cls.SECTION) or name
         node["additionalProperties"] = node.get("additionalProperties", cls.ANNOTATIONS) \
-            if cls.model_config.get("extra") == "allow" else False
+            if cls.ENTRIES else False
         props = node.get("properties", {})
         for key, prop in props.items():
             _untitle(prop)
@@ -278,6 +280,74 @@ def definition_schema() -> dict[str, Any]:
     schema["$id"] = SCHEMA_ID
     schema["title"] = "mpc model definition"
     return schema
+
+
+def _shapes(root: type) -> dict[str, dict[str, Any]]:
+    """The JSON Schema of each node class `root` reaches, by class name: its properties by key,
+    each of its field's type and default; the shapes other tools give such classes."""
+    defs: dict[str, dict[str, Any]] = {}
+
+    def of_node(cls: type) -> dict[str, Any]:
+        if cls.__name__ not in defs:
+            defs[cls.__name__] = {}  # being made: the classes may refer to each other
+            defs[cls.__name__] = node(cls)
+        return {"$ref": f"#/$defs/{cls.__name__}"}
+
+    def node(cls: Any) -> dict[str, Any]:
+        props, required = {}, []
+        for f in cls.fields().values():
+            prop = of_type(f.annotation, f.names)
+            if f.is_required():
+                required.append(f.key)
+            else:
+                prop["default"] = f.default
+            props[f.key] = prop
+        out: dict[str, Any] = {"properties": props, "title": cls.__name__, "type": "object"}
+        if required:
+            out["required"] = required
+        if cls.__doc__:
+            out["description"] = inspect.cleandoc(cls.__doc__)
+        if cls.ENTRIES:
+            entry = cls.entry_type()
+            out["additionalProperties"] = True if entry is Any else of_type(entry, {})
+        return out
+
+    def of_type(tp: Any, names: dict[str, Any]) -> dict[str, Any]:
+        if isinstance(tp, str | typing.ForwardRef):
+            tp = eval(tp if isinstance(tp, str) else tp.__forward_arg__, names)
+        origin = typing.get_origin(tp)
+        if origin is typing.Annotated:
+            source, *markers = typing.get_args(tp)
+            shape = of_type(source, names)
+            for i, marker in enumerate(markers):  # each wraps what is left of it
+                if hasattr(marker, "json_schema"):
+                    below = typing.Annotated[(source, *markers[:i])] if i else source
+                    shape = marker.json_schema(below, functools.partial(dict, shape))
+            return shape
+        if origin in (typing.Union, types.UnionType):  # a member that is a union: its members
+            members = [of_type(m, names) for m in typing.get_args(tp)]
+            return {"anyOf": [m for member in members
+                              for m in (member["anyOf"] if set(member) == {"anyOf"} else [member])]}
+        if origin is typing.Literal:
+            values = list(typing.get_args(tp))
+            kind = "integer" if isinstance(values[0], int) else "string"
+            return {"const": values[0], "type": kind} if len(values) == 1 else {"enum": values, "type": kind}
+        if origin is list:
+            return {"items": of_type(typing.get_args(tp)[0], names), "type": "array"}
+        if origin is dict:
+            key, value = typing.get_args(tp)
+            out = {"additionalProperties": True if value is Any else of_type(value, names), "type": "object"}
+            if typing.get_origin(key) is typing.Literal:
+                out["propertyNames"] = {"enum": list(typing.get_args(key))}
+            return out
+        if tp is type(None):
+            return {"type": "null"}
+        if hasattr(tp, "fields"):
+            return of_node(tp)
+        return {Any: {}, str: {"type": "string"}, bool: {"type": "boolean"}, int: {"type": "integer"}}[tp]
+
+    of_node(root)
+    return defs
 
 
 def render() -> str:
@@ -321,7 +391,7 @@ def _simplify(schema: Any) -> Any:
 
 
 def _untitle(schema: Any) -> None:
-    """Drop pydantic's titles (`Eff`, class names) from a property and what it nests."""
+    """Drop titles (class names) from a property and what it nests."""
     if isinstance(schema, dict):
         schema.pop("title", None)
         for key in ("anyOf", "oneOf", "allOf", "items", "additionalProperties", "prefixItems"):

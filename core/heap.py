@@ -2,7 +2,7 @@
 
 glibc keeps what a program frees in its heap for the next allocation; after a library freed a
 large working set (MuJoCo compiling a model of many meshes frees three times the model's
-size; a check of `mpc lsp` frees libxml2's parse and pydantic's validation), the process's
+size; a check of `mpc lsp` frees libxml2's parse and the schema's walk), the process's
 resident size stays at its peak until `malloc_trim` returns the free pages.
 """
 

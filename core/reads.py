@@ -25,7 +25,7 @@ from typing import Any
 # File types that are code, not inputs: modules imported while building.
 _CODE_SUFFIXES = frozenset({".py", ".pyc", ".so", ".pyd", ".pth", ".pyi", ".typed", ".lark"})
 _SYSTEM = ("/proc/", "/sys/", "/dev/", "/etc/")
-# Installed distributions' metadata (their entry points, which pydantic reads for plugins): an
+# Installed distributions' metadata (their entry points, which libraries read for plugins): an
 # editable install's `.egg-info` lies in the checkout, and a wheel built there rewrites it.
 _METADATA = re.compile(r"\.(?:dist|egg)-info" + re.escape(os.sep))
 

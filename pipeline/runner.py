@@ -473,9 +473,10 @@ def _preload(shared: set[str]) -> None:
 
     from mpc.backends import urdf  # noqa: F401
     from mpc.compiler import driver, front_end  # noqa: F401
-    from mpc.compiler.schema.definition import Definition
+    from mpc.compiler.schema import definition  # noqa: F401  # every node class declared
+    from mpc.compiler.schema.base import prepare
 
-    Definition.model_rebuild()  # built on first use (schema/base.py): once here, not in every worker
+    prepare()  # made on first use (schema/base.py): once here, not in every worker
     environment = dict(os.environ)  # what a build is kept by (compiler/build_cache.py): unchanged
     for module in sorted(shared - set(sys.modules)):
         with contextlib.suppress(Exception):  # one that cannot be imported here is imported there

@@ -1,6 +1,6 @@
 """A loaded pipeline file → whether the schema accepts it, remembered across runs.
 
-Validating a pipeline file imports the schema (pydantic and every node class), most of the
+Validating a pipeline file imports the schema (every node class and its checks), most of the
 time of a run where all is cached. A file that the schema accepted without any diagnostic
 is remembered by a digest of mpc's version (with the digest of its own sources) and of the
 file's data: the same mpc accepts the same data again, the same way, so the next run need

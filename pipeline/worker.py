@@ -49,7 +49,7 @@ def main(job: StageJob, run: list[str], cached: list[str], conn: Connection, ign
 # forks the next worker, so that each worker does not import them again (pxr and numpy are
 # 0.2 s of a USD build's start). No module of a command, a test or a stage's tool is here.
 SHARED_LAYERS = ("mpc.backends.", "mpc.compiler.", "mpc.core.", "mpc.ir.")
-SHARED_LIBRARIES = frozenset({"numpy", "pxr", "lxml", "trimesh", "scipy", "mujoco", "pydantic", "yaml"})
+SHARED_LIBRARIES = frozenset({"numpy", "pxr", "lxml", "trimesh", "scipy", "mujoco", "yaml"})
 
 
 def shareable(module: str) -> bool:

@@ -2,8 +2,6 @@
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import ConfigDict
-
 from mpc.compiler.schema.base import ONE_OF, Expr, Field, Length, Node, OneOrMore, Vec3
 from mpc.compiler.schema.editing import ConstraintAxis
 
@@ -24,8 +22,8 @@ class SensorDef(Node):
 
     SECTION: ClassVar[str] = "a sensor"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     type: SensorType | None = None
     name: str
     link: str | None = None
@@ -55,8 +53,8 @@ class PoseDef(Node):
     """A named joint configuration: joint → position; `$default` fills the other joints."""
 
     SECTION: ClassVar[str] = "a pose"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Expr] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Expr]
     default: Expr | None = Field(None, alias="$default")
 
 
@@ -65,8 +63,8 @@ class PosesSection(Node):
     position of the movable joints it does not list, where the pose has no `$default`."""
 
     SECTION: ClassVar[str] = "poses"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, PoseDef] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, PoseDef]
     default: Expr | None = Field(None, alias="$default")
 
 

@@ -88,7 +88,7 @@ class Mirror(Node):
 
     SECTION: ClassVar[str] = "mirror"
     plane: Vec3 = [0, 1, 0]
-    # pydantic takes true for 1; the language does not
+    # true would be taken for 1; the language does not
     flip_axis: Annotated[Literal[0, 1, 2], Before(lambda v: str(v) if isinstance(v, bool) else v)] = 1
     exclude_meshes: OneOrMore = []
     name_replacements: Replacements | None = None

@@ -1,50 +1,47 @@
-"""Located YAML data → typed AST nodes (pydantic v2 models), every problem a located diagnostic.
+"""Located YAML data → typed AST nodes, every problem a located diagnostic.
 
-The language is declared as pydantic models (`class Transform(Node): xyz: Vec3 = …`);
-pydantic walks the data and builds the nodes. This module adds what the language needs on
-top, so that one mistake never hides another and every problem has a file, line and column:
+The language is declared as classes (`class Transform(Node): xyz: Vec3 = …`); their
+annotations are read once into checks (compiler/schema/checking.py) that walk the data and
+build the nodes. This module adds what the language needs on top, so that one mistake never
+hides another and every problem has a file, line and column:
 
-- Each node validates itself in a wrap validator that knows where its mapping was written
-  (the document's mappings are indexed by identity before the walk). It reports its own
-  keys' problems (an unknown key with did-you-mean, an old spelling given twice, a likely
-  typo of an annotation: W0201), lets pydantic check its fields, and turns pydantic's
-  errors, located by their `loc` below the node, into diagnostics with our messages. What a
-  nested node reports it reports itself; its parent sees only that it failed.
-- Leaf types raise `PydanticCustomError("mpc", …)` carrying the message and code.
+- Each node validates itself in a walk that knows where its mapping was written (the
+  document's mappings are indexed by identity before the walk). It reports its own keys'
+  problems (an unknown key with did-you-mean, an old spelling given twice, a likely typo of
+  an annotation: W0201), checks its fields, and turns their problems, located by their `loc`
+  below the node, into diagnostics with our messages. What a nested node reports it reports
+  itself; its parent sees only that it failed.
+- Leaf types raise `problem(…)`: an `Invalid` carrying the message and code.
 - Lists and mappings of entries validate every entry: a bad one does not hide its
   neighbours' problems.
 
 Three kinds of mapping appear in the language:
 - closed sections (most of them): every key is declared; others are errors;
 - sections keyed by names (`frames`, `joints`, …): declared `$keys`, and any other key
-  is an entry named after a link, joint or collision (`__pydantic_extra__` gives its type);
+  is an entry named after a link, joint or collision (`__entries__` gives its type);
 - annotated entries: declared keys plus free annotations that travel to SMURF
   (`ANNOTATIONS`); an annotation key close to a declared one is a warning, since it
   is most likely a typo of an operation.
 
 Unions are told apart by the shape of the data (`Annotated[A | B, ONE_OF]`): a mapping goes
 to the member that takes mappings, a list to the one that takes lists, and a union of nodes
-by their `type` (`BY_TYPE`). The models build on first use (`defer_build`), so importing the schema
-costs no schema building: `mpc check` starts cold on every save of an editor.
+by their `type` (`BY_TYPE`). A class's fields are read on its first use, so importing the
+schema costs little: `mpc check` starts cold on every save of an editor.
+
+The schema was declared in pydantic until 2026-11-28; building its models was a quarter of a
+cold build (issue 34). The checks keep what the language took from it: its conversions of
+scalars and the problems its messages are made from.
 """
 
+import copy
+import functools
+import inspect
+import sys
 import typing
 from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import (
-    BaseModel,
-    BeforeValidator,
-    ConfigDict,
-    Discriminator,
-    PrivateAttr,
-    Tag,
-    ValidationError,
-    model_validator,
-)
-from pydantic import Field as Field
-from pydantic_core import PydanticCustomError, core_schema
-
+from mpc.compiler.schema.checking import Check, Invalid, checker, invalid
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document, Path_
@@ -53,14 +50,16 @@ KEY = "\x00key\x00"  # stands for the key in a message made before the key is kn
 
 
 def problem(text: str, code: str = "E0203", *, at: str = "value", sub: str | None = None,
-            hint: str | None = None) -> PydanticCustomError:
+            hint: str | None = None, value: Any = None) -> Invalid:
     """An error of the value being validated. text: the message (KEY stands for its key);
     at: 'value' (its value's span) or 'key' (its key's span); sub: a key inside it to point at."""
-    return PydanticCustomError("mpc", "{text}", {"text": text, "code": code, "at": at, "sub": sub,
-                                                  "hint": hint})
+    return invalid("mpc", value, text, text=text, code=code, at=at, sub=sub, hint=hint)
 
 
-def wrong(wanted: str, value: Any) -> PydanticCustomError:
+REPORTED = "mpc_reported"  # a node's problem, said by the node itself
+
+
+def wrong(wanted: str, value: Any) -> Invalid:
     return problem(f"'{KEY}' must be {wanted}, got {describe(value)}")
 
 
@@ -71,20 +70,28 @@ class After:
     def __init__(self, fn: Callable[[Any], Any], code: str = "E0203") -> None:
         self.fn, self.code = fn, code
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
-        return core_schema.no_info_after_validator_function(self._check, handler(source))
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
+        first = inner()
 
-    def _check(self, value: Any) -> Any:
-        try:
-            self.fn(value)
-        except ValueError as e:
-            raise problem(f"'{KEY}': {e}", getattr(e, "code", self.code)) from None
-        return value
+        def check(value: Any, walk: Any) -> Any:
+            value = first(value, walk)
+            try:
+                self.fn(value)
+            except ValueError as e:
+                raise problem(f"'{KEY}': {e}", getattr(e, "code", self.code), value=value) from None
+            return value
+        return check
 
 
-def Before(fn: Callable[[Any], Any]) -> BeforeValidator:
+class Before:
     """Reshape the value before it is checked."""
-    return BeforeValidator(fn)
+
+    def __init__(self, fn: Callable[[Any], Any]) -> None:
+        self.fn = fn
+
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
+        then = inner()
+        return lambda value, walk: then(self.fn(value), walk)
 
 
 class JsonSchema:
@@ -93,8 +100,8 @@ class JsonSchema:
     def __init__(self, schema: dict[str, Any]) -> None:
         self.schema = schema
 
-    def __get_pydantic_json_schema__(self, cs: Any, handler: Any) -> dict[str, Any]:
-        return dict(self.schema)
+    def json_schema(self, source: Any, inner: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        return copy.deepcopy(self.schema)
 
 
 def _items(n: int) -> str:
@@ -108,40 +115,44 @@ class Length:
     def __init__(self, low: int | None = None, high: int | None = None) -> None:
         self.low, self.high = low, high
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
-        while typing.get_origin(source) is Annotated:
-            source = typing.get_args(source)[0]
-        kind = typing.get_origin(source) or source
-        check = self._list if kind is list else self._other(dict if kind is dict else str)
-        return core_schema.no_info_wrap_validator_function(check, handler(source))
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
+        then = inner()
+        if _bare(source) is list:
+            return functools.partial(self._list, then)
+        kind = dict if _bare(source) is dict else str
+        return functools.partial(self._other, kind, then)
 
-    def __get_pydantic_json_schema__(self, cs: Any, handler: Any) -> dict[str, Any]:
-        js = handler(cs)
-        kind = handler.resolve_ref_schema(js).get("type")
-        names = {"array": ("minItems", "maxItems"), "string": ("minLength", "maxLength"),
-                 "object": ("minProperties", "maxProperties")}.get(kind)
+    def json_schema(self, source: Any, inner: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        js = inner()
+        names = {list: ("minItems", "maxItems"), str: ("minLength", "maxLength"),
+                 dict: ("minProperties", "maxProperties")}.get(_bare(source))
         if names:
             js.update({n: v for n, v in zip(names, (self.low, self.high), strict=True) if v})
         return js
 
-    def _list(self, value: Any, handler: Any) -> Any:
+    def _list(self, then: Check, value: Any, walk: Any) -> Any:
         if isinstance(value, list):
             if self.high is not None and len(value) > self.high:
-                raise problem(f"'{KEY}' must have at most {_items(self.high)}, got {len(value)}")
-            out = handler(value)
+                raise problem(f"'{KEY}' must have at most {_items(self.high)}, got {len(value)}", value=value)
+            out = then(value, walk)
             if self.low and len(value) < self.low:
                 if not value:
-                    raise problem(f"'{KEY}' must not be empty")
-                raise problem(f"'{KEY}' must have at least {_items(self.low)}, got {len(value)}")
+                    raise problem(f"'{KEY}' must not be empty", value=value)
+                raise problem(f"'{KEY}' must have at least {_items(self.low)}, got {len(value)}", value=value)
             return out
-        return handler(value)
+        return then(value, walk)
 
-    def _other(self, kind: type) -> Callable[[Any, Any], Any]:
-        def check(value: Any, handler: Any) -> Any:
-            if isinstance(value, kind) and self.low and len(value) < self.low:
-                raise problem(f"'{KEY}' must not be empty")
-            return handler(value)
-        return check
+    def _other(self, kind: type, then: Check, value: Any, walk: Any) -> Any:
+        if isinstance(value, kind) and self.low and len(value) < self.low:
+            raise problem(f"'{KEY}' must not be empty", value=value)
+        return then(value, walk)
+
+
+def _bare(tp: Any) -> Any:
+    """The class of values a type annotation takes: `list` for `Annotated[list[str], …]`."""
+    while typing.get_origin(tp) is Annotated:
+        tp = typing.get_args(tp)[0]
+    return typing.get_origin(tp) or tp
 
 
 # -- leaf types ------------------------------------------------------------------------------
@@ -149,15 +160,15 @@ class Length:
 class _Expression:
     """A number as users write it: 1.5, "2*pi", ["deg", 90]; evaluated by compiler/expr.py."""
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
-        return core_schema.no_info_plain_validator_function(self._check)
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
+        return self._check
 
-    def __get_pydantic_json_schema__(self, cs: Any, handler: Any) -> dict[str, Any]:
+    def json_schema(self, source: Any, inner: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         return {"anyOf": [{"type": "number"}, {"type": "string"},
                           {"type": "array", "minItems": 2, "maxItems": 2}]}
 
     @staticmethod
-    def _check(value: Any) -> Any:
+    def _check(value: Any, walk: Any) -> Any:
         if isinstance(value, bool | dict) or value is None:
             raise wrong("a number or an expression", value)
         return value
@@ -224,7 +235,7 @@ class _Shape:
         self.values: tuple[Any, ...] = ()
         if origin is list:
             self.kind, self.wanted = "list", "a list"
-        elif origin is dict or (isinstance(tp, type) and issubclass(tp, BaseModel)):
+        elif origin is dict or (isinstance(tp, type) and issubclass(tp, Node)):
             self.kind, self.wanted = "dict", "a mapping"
         elif origin is Literal:
             self.values = typing.get_args(tp)
@@ -261,24 +272,34 @@ class OneOf:
     are then the ones shown); a scalar to the first member it is exactly, else the first it
     converts to."""
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
         members = typing.get_args(source)
         shapes = [_Shape(m) for m in members]
         wanted = " or ".join(dict.fromkeys(s.wanted for s in shapes))
+        checks: list[Check | None] = [None] * len(members)
 
-        def pick(v: Any) -> str | None:
+        def pick(v: Any) -> int | None:
             fitting = [i for i, s in enumerate(shapes) if s.fits(v)]
             if len(fitting) == 1 and isinstance(v, list | dict):
-                return f"<{fitting[0]}>"
+                return fitting[0]
             for test in ("exact", "takes"):
                 for i in fitting:
                     if getattr(shapes[i], test)(v):
-                        return f"<{i}>"
+                        return i
             return None
 
-        tagged = tuple(Annotated[m, Tag(f"<{i}>")] for i, m in enumerate(members))
-        return handler.generate_schema(Annotated[typing.Union[tagged], Discriminator(  # noqa: UP007
-            pick, custom_error_type="mpc_union", custom_error_message=wanted)])
+        def check(value: Any, walk: Any) -> Any:
+            i = pick(value)
+            if i is None:
+                raise invalid("mpc_union", value, wanted)
+            member = checks[i]
+            if member is None:
+                member = checks[i] = checker(members[i])
+            return member(value, walk)
+        return check
+
+    def json_schema(self, source: Any, inner: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        return {"oneOf": inner()["anyOf"]}
 
 
 ONE_OF = OneOf()
@@ -288,77 +309,109 @@ class ByType:
     """A union of nodes told apart by their `type` literal (export entries), as
     `Annotated[A | B, BY_TYPE]`."""
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+    def check(self, source: Any, inner: Callable[[], Check]) -> Check:
         members: tuple[type[Node], ...] = typing.get_args(source)
         tags: dict[str, type[Node]] = {}
 
-        def kinds() -> dict[str, type[Node]]:  # on first use: the members may contain this union
-            if not tags:
-                tags.update((t, m) for m in members for t in typing.get_args(_type_literal(m)))
-            return tags
-
-        def check(value: Any, handler: Any) -> Any:
+        def check(value: Any, walk: Any) -> Any:
             if not isinstance(value, dict):
                 raise wrong("a mapping", value)
+            if not tags:  # on first use: the members may contain this union
+                tags.update((t, m) for m in members for t in typing.get_args(_type_literal(m)))
             kind = value.get("type")
-            known = kinds()
-            if not (isinstance(kind, str) and kind in known):
+            if not (isinstance(kind, str) and kind in tags):
                 if kind is None:
-                    raise problem("this entry has no 'type'; one of " + ", ".join(f"'{t}'" for t in known)
+                    raise problem("this entry has no 'type'; one of " + ", ".join(f"'{t}'" for t in tags)
                                   + " is required", at="value" if "type" in value else "key",
-                                  sub="type" if "type" in value else None)
+                                  sub="type" if "type" in value else None, value=value)
                 word = members[0].TYPE_WORD
-                raise problem(f"unknown {word} '{kind}'{did_you_mean(str(kind), set(known))}", sub="type",
-                              hint=f"{word}s: " + ", ".join(known))
-            return handler(value)
+                raise problem(f"unknown {word} '{kind}'{did_you_mean(str(kind), set(tags))}", sub="type",
+                              hint=f"{word}s: " + ", ".join(tags), value=value)
+            return tags[kind].node_check()(value, walk)
+        return check
 
-        union = typing.Union[tuple(Annotated[m, Tag(m.__name__)] for m in members)]  # noqa: UP007
-        return handler.generate_schema(Annotated[union, Discriminator(
-            lambda v: kinds()[v["type"]].__name__), _Wrap(check)])
+    def json_schema(self, source: Any, inner: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        return {"oneOf": inner()["anyOf"]}
 
 
 BY_TYPE = ByType()
 
 
-class _Wrap:
-    def __init__(self, fn: Callable[[Any, Any], Any]) -> None:
-        self.fn = fn
-
-    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
-        return core_schema.no_info_wrap_validator_function(self.fn, handler(source))
-
-
 def _type_literal(cls: type) -> Any:
-    """The class's own `type: Literal[…]` annotation, evaluated alone (the rest of the
-    class may refer to the union being built)."""
-    import inspect
-    import sys
-
-    hint = inspect.get_annotations(cls).get("type")
-    return eval(hint, vars(sys.modules[cls.__module__])) if isinstance(hint, str) else hint
+    """The class's own `type: Literal[…]` annotation."""
+    return inspect.get_annotations(cls)["type"]
 
 
 # -- nodes -----------------------------------------------------------------------------------
 
-class Node(BaseModel):
+_REQUIRED: Any = object()  # a field without a default
+
+
+class _FieldSpec:
+    """What `Field(…)` declares beside a field's type: its default and its key."""
+
+    def __init__(self, default: Any, alias: str | None) -> None:
+        self.default, self.alias = default, alias
+
+
+def Field(default: Any = _REQUIRED, *, alias: str | None = None) -> Any:
+    """A field's default and the key that gives it in the document, when not its name
+    (`default: FrameDef | None = Field(None, alias="$default")`)."""
+    return _FieldSpec(default, alias)
+
+
+class FieldInfo:
+    """A field of a node: its attribute, key, type, default and check (made on first use)."""
+
+    def __init__(self, name: str, tp: Any, default: Any, alias: str | None, names: dict[str, Any]) -> None:
+        self.name, self.annotation, self.default, self.alias = name, tp, default, alias
+        self.names = names  # the module it was declared in
+        self.key = alias or name
+        self._check: Check | None = None
+
+    def is_required(self) -> bool:
+        return self.default is _REQUIRED
+
+    def check(self, value: Any, walk: Any) -> Any:
+        return (self._check or self.compiled())(value, walk)
+
+    def compiled(self) -> Check:
+        if self._check is None:
+            self._check = checker(self.annotation, self.names)
+        return self._check
+
+    def default_value(self) -> Any:
+        """The default, a fresh copy of a list or mapping for each node."""
+        value = self.default
+        if isinstance(value, list | dict | set):
+            return copy.deepcopy(value) if value else value.copy()
+        return value
+
+
+class Node:
     """Base of every AST node: knows the document and path it was read from.
 
     SECTION: how messages name this part of the language.
     ANNOTATIONS: whether undeclared keys are kept as free annotations.
     ALIASES: old spellings still accepted, mapped to the declared key.
-    Sections keyed by names declare `__pydantic_extra__: dict[str, EntryType]`.
+    ENTRIES: whether undeclared keys are entries (sections keyed by names, annotations);
+    `__entries__: dict[str, EntryType]` declares their type.
+    Fields are the class's annotated attributes; a value is the default.
     """
-
-    model_config = ConfigDict(defer_build=True, frozen=True, extra="ignore",
-                              protected_namespaces=(), populate_by_name=False,
-                              arbitrary_types_allowed=True)
 
     SECTION: ClassVar[str] = ""
     ANNOTATIONS: ClassVar[bool] = False
     ALIASES: ClassVar[dict[str, str]] = {}
     TYPE_WORD: ClassVar[str] = "type"
-    _doc: Document | None = PrivateAttr(None)
-    _path: Path_ = PrivateAttr(())
+    ENTRIES: ClassVar[bool] = False
+    _fields: ClassVar[dict[str, FieldInfo]]  # each made on first use, for its own class
+    _keys: ClassVar[dict[str, str]]
+    _check: ClassVar[Check]
+    _entry_check: ClassVar[Check]
+    _doc: Document | None
+    _path: Path_
+    _given: frozenset[str]
+    _entries: dict[str, Any]
 
     def problem(self) -> str | None:
         """What is wrong with the node as a whole, once its fields are right (None: nothing)."""
@@ -370,24 +423,103 @@ class Node(BaseModel):
         return []
 
     @classmethod
+    def fields(cls) -> dict[str, FieldInfo]:
+        """The fields, in the order the class and its bases declare them, by attribute name."""
+        made = cls.__dict__.get("_fields")
+        if made is None:
+            made = {}
+            for base in reversed(cls.__mro__):
+                for name, tp in inspect.get_annotations(base).items():
+                    if name.startswith("_") or typing.get_origin(tp) is ClassVar or tp is ClassVar:
+                        continue
+                    value = getattr(cls, name, _REQUIRED)
+                    spec = value if isinstance(value, _FieldSpec) else _FieldSpec(value, None)
+                    made.pop(name, None)
+                    made[name] = FieldInfo(name, tp, spec.default, spec.alias,
+                                           vars(sys.modules[base.__module__]))
+            cls._fields = made
+        return made
+
+    @classmethod
+    def entry_type(cls) -> Any:
+        """The type of the entries (`__entries__`), Any when not declared."""
+        for base in cls.__mro__:
+            tp = inspect.get_annotations(base).get("__entries__")
+            if tp is not None:
+                return typing.get_args(tp)[1]
+        return Any
+
+    @classmethod
     def declared(cls) -> dict[str, str]:
         """Declared key in the document → attribute name."""
         plan = cls.__dict__.get("_keys")
         if plan is None:
-            plan = {f.alias or n: n for n, f in cls.model_fields.items()}
+            plan = {f.key: n for n, f in cls.fields().items()}
             cls._keys = plan
         return plan
 
     @classmethod
     def has_entries(cls) -> bool:
-        return cls.model_config.get("extra") == "allow" and not cls.ANNOTATIONS
+        return cls.ENTRIES and not cls.ANNOTATIONS
+
+    @classmethod
+    def node_check(cls) -> Check:
+        """The check of a mapping as this node, in a walk (Walk.node)."""
+        made: Check | None = cls.__dict__.get("_check")
+        if made is None:
+            def check(value: Any, walk: Any) -> Any:
+                if not isinstance(value, dict):
+                    raise wrong("a mapping", value)
+                return walk.node(cls, value)
+            made = cls._check = check
+        return made
+
+    @classmethod
+    def build(cls, clean: dict[str, Any], walk: Any) -> "Node":
+        """The node of a mapping whose keys the walk has screened; Invalid with every
+        problem of its fields and entries."""
+        errors: list[dict[str, Any]] = []
+        values: dict[str, Any] = {}
+        given = []
+        for name, f in cls.fields().items():
+            if f.key in clean:
+                given.append(name)
+                try:
+                    values[name] = f.check(clean[f.key], walk)
+                except Invalid as e:
+                    errors += e.below(f.key)
+            elif f.is_required():
+                errors.append({"type": "missing", "loc": (f.key,), "input": clean, "msg": "", "ctx": {}})
+            else:
+                values[name] = f.default_value()
+        entries: dict[str, Any] = {}
+        if cls.ENTRIES:
+            declared = cls.declared()
+            entry = cls.__dict__.get("_entry_check")
+            if entry is None:
+                entry = cls._entry_check = checker(cls.entry_type())
+            for key, value in clean.items():
+                if key not in declared:
+                    try:
+                        entries[key] = entry(value, walk)
+                    except Invalid as e:
+                        errors += e.below(key)
+        if errors:
+            raise Invalid(errors)
+        node = cls.__new__(cls)
+        node.__dict__.update(values)
+        node.__dict__.update(_given=frozenset(given), _entries=entries, _doc=None, _path=())
+        return node
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if not name.startswith("_"):
+            raise AttributeError(f"{type(self).__name__} is frozen: '{name}' cannot be set")
+        object.__setattr__(self, name, value)
 
     def _place(self) -> tuple[Document, Path_]:
-        """The document and path the node was read from. Read from pydantic's store of private
-        attributes directly: its `__getattr__` fallback took a third of lowering's time."""
-        private = self.__pydantic_private__
-        assert private is not None and private["_doc"] is not None
-        return private["_doc"], private["_path"]
+        """The document and path the node was read from."""
+        assert self._doc is not None
+        return self._doc, self._path
 
     @property
     def span(self) -> Span:
@@ -412,41 +544,42 @@ class Node(BaseModel):
     @property
     def entries(self) -> dict[str, Any]:
         """The named entries of a section keyed by names (or the free annotations)."""
-        return dict(self.__pydantic_extra__ or {})
+        return dict(self._entries)
 
     @property
     def given(self) -> frozenset[str]:
         """The names of the fields the document sets (the others hold their defaults)."""
-        return frozenset(self.model_fields_set)
+        return self._given
 
     def to_data(self) -> dict[str, Any]:
         """Plain data: the fields that differ from their defaults, then the entries."""
-        out = {n: _plain(getattr(self, n)) for n, f in type(self).model_fields.items()
+        out = {n: _plain(getattr(self, n)) for n, f in type(self).fields().items()
                if f.is_required() or getattr(self, n) != f.default}
         return out | {k: _plain(v) for k, v in self.entries.items()}
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return all(getattr(self, n) == getattr(other, n) for n in type(self).model_fields) \
+        return all(getattr(self, n) == getattr(other, n) for n in type(self).fields()) \
             and self.entries == other.entries
 
-    __hash__ = None  # equal by value, and lists are not hashable
+    __hash__ = None  # type: ignore[assignment]  # equal by value, and lists are not hashable
 
     def __repr__(self) -> str:
-        items = [f"{n}={getattr(self, n)!r}" for n in type(self).model_fields]
+        items = [f"{n}={getattr(self, n)!r}" for n in type(self).fields()]
         items += [f"{k!r}: {v!r}" for k, v in self.entries.items()]
         return f"{type(self).__name__}({', '.join(items)})"
 
-    @model_validator(mode="wrap")
-    @classmethod
-    def _located(cls, data: Any, handler: Any, info: Any) -> Any:
-        walk = info.context
-        if not isinstance(walk, Walk):
-            return handler(data)
-        if not isinstance(data, dict):
-            raise wrong("a mapping", data)
-        return walk.node(cls, data, handler)
+
+def prepare() -> None:
+    """Every node's fields and checks made now, not on first use (before `mpc run` forks its
+    workers, which then share them)."""
+    todo: list[type[Node]] = [Node]
+    while todo:
+        cls = todo.pop()
+        todo += cls.__subclasses__()
+        for f in cls.fields().values():
+            f.compiled()
 
 
 def _plain(value: Any) -> Any:
@@ -468,7 +601,7 @@ _WANTED = {"string_type": "a string", "bool_type": "true or false", "bool_parsin
 
 
 class Walk:
-    """One validation of a document: the context of pydantic's walk; reports into the sink."""
+    """One validation of a document: what the checks carry down; reports into the sink."""
 
     def __init__(self, doc: Document, sink: Sink, what: str) -> None:
         self.doc, self.sink, self.what = doc, sink, what  # what: the document, for messages
@@ -496,7 +629,7 @@ class Walk:
                 out = (*out, step)
         return out
 
-    def node(self, cls: type[Node], data: dict, handler: Any) -> Any:
+    def node(self, cls: type[Node], data: dict) -> Node:
         path = self.where.get(id(data), ())
         keys = cls.declared()
         clean: dict[str, Any] = {}
@@ -528,26 +661,26 @@ class Walk:
                 self.sink.error(self.doc.span(self.written((*path, key))), "E0201",
                                 f"unknown key '{key}' in {cls.SECTION}{did_you_mean(key, pool)}")
         try:
-            node = handler(clean)
-        except ValidationError as e:
-            for err in e.errors(include_url=False):
+            node = cls.build(clean, self)
+        except Invalid as e:
+            for err in e.errors:
                 self.report(err, path)
-            raise PydanticCustomError("mpc_reported", "reported") from None
+            raise invalid(REPORTED, data) from None
         if failed:
-            raise PydanticCustomError("mpc_reported", "reported")
+            raise invalid(REPORTED, data)
         node._doc, node._path = self.doc, path
         if (why := node.problem()) is not None:
             self.sink.error(self.doc.value_span(self.written(path)), "E0203",
                             f"'{_key(self.written(path))}': {why}")
-            raise PydanticCustomError("mpc_reported", "reported")
+            raise invalid(REPORTED, data)
         for code, key, message in node.no_effect():
             self.sink.warning(self.doc.span(self.written((*path, key))), code, message)
         return node
 
     def report(self, err: Any, base: Path_) -> None:
-        """One of pydantic's errors, `loc` below the node at `base`, as a diagnostic."""
+        """One problem of a check, `loc` below the node at `base`, as a diagnostic."""
         kind, loc = err["type"], tuple(err["loc"])
-        if kind == "mpc_reported":
+        if kind == REPORTED:
             return
         doc = self.doc
         if loc and loc[-1] == "[key]":  # a mapping's key: shown at the key
@@ -586,7 +719,7 @@ class Walk:
         if kind == "mpc":
             return ctx["text"].replace(KEY, key)
         wanted = _WANTED.get(kind)
-        if wanted is None:  # a pydantic error the language does not expect: mpc's bug
+        if wanted is None:  # a problem the language does not expect: mpc's bug
             raise AssertionError(f"unexpected validation error {err!r}")
         return f"'{key}' must be {wanted}, got {describe(value)}"
 
@@ -600,7 +733,7 @@ class Walk:
 
 
 def _literal_options(expected: str) -> set[str]:
-    """The options of pydantic's "'a', 'b' or 'c'" as their texts."""
+    """The options of "'a', 'b' or 'c'" (checking.py: _expected) as their texts."""
     import re
 
     return {m.group(1) if m.group(1) is not None else m.group(2)
@@ -651,7 +784,7 @@ def validate_as(cls: type["Node"], doc: Document, sink: Sink, what: str) -> Node
         return None
     errors = sink.error_count
     try:
-        ast = cls.model_validate(doc.data, context=Walk(doc, sink, what))
-    except ValidationError:
+        ast = cls.node_check()(doc.data, Walk(doc, sink, what))
+    except Invalid:
         return None
     return None if sink.error_count > errors else ast

@@ -6,8 +6,6 @@ Entries keep undeclared keys as free annotations for SMURF.
 
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import ConfigDict
-
 from mpc.compiler.schema.assembly import JointTypeName, NameEditing
 from mpc.compiler.schema.base import ONE_OF, Before, Expr, Field, Length, Node, OneOrMore, Vec3, str_or_list
 
@@ -27,8 +25,8 @@ class MaterialDef(Node):
 
     SECTION: ClassVar[str] = "a material"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     ALIASES: ClassVar[dict[str, str]] = {"diffuseColor": "diffuse", "ambientColor": "ambient",
                                          "specularColor": "specular", "emissionColor": "emissive",
                                          "diffuseTexture": "texture"}
@@ -59,8 +57,8 @@ class FrameDef(Node):
 
     SECTION: ClassVar[str] = "a frame"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     ALIASES: ClassVar[dict[str, str]] = {"estimate_missing_com": "estimate_missing_coms"}
     transform_link: Transform | None = None
     transform_frame: Transform | None = None
@@ -98,8 +96,8 @@ class FramesSection(Node):
     """`frames` (alias `links`): per-link operations, `$default` for every link."""
 
     SECTION: ClassVar[str] = "frames"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, FrameDef] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, FrameDef]
     default: FrameDef | None = Field(None, alias="$default")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
 
@@ -119,8 +117,8 @@ class MotorDef(Node):
 
     SECTION: ClassVar[str] = "a motor"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     name: str | None = None
     type: str | None = None
     p: Expr | None = None
@@ -154,8 +152,8 @@ class JointDef(Node):
 
     SECTION: ClassVar[str] = "a joint"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     ALIASES: ClassVar[dict[str, str]] = {"lower": "min", "upper": "max", "effort": "eff",
                                          "velocity": "vel"}
     min: Expr | None = None
@@ -204,8 +202,8 @@ class JointsSection(Node):
     """`joints`: per-joint settings plus section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "joints"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, JointDef] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, JointDef]
     default: JointDef | None = Field(None, alias="$default")
     replace_joint_types: dict[JointTypeName, JointTypeName] | None = Field(
         None, alias="$replace_joint_types")
@@ -240,8 +238,8 @@ class CollisionDef(Node):
 
     SECTION: ClassVar[str] = "a collision entry"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     remove: RemoveWhat = False
     shape: ShapeName | None = None
     oriented: bool = True
@@ -255,8 +253,8 @@ class CollisionsSection(Node):
     """`collisions`: per-link (or per-collision) entries, bitmasks, section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "collisions"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, CollisionDef] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, CollisionDef]
     default: CollisionDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")
@@ -274,8 +272,8 @@ class VisualDef(Node):
 
     SECTION: ClassVar[str] = "a visual entry"
     ANNOTATIONS: ClassVar[bool] = True
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, Any] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, Any]
     remove: RemoveWhat = False
     material: str | None = None
 
@@ -284,8 +282,8 @@ class VisualsSection(Node):
     """`visuals`: per-link entries and section-wide `$keys`."""
 
     SECTION: ClassVar[str] = "visuals"
-    model_config = ConfigDict(extra="allow")
-    __pydantic_extra__: dict[str, VisualDef] = Field(init=False)
+    ENTRIES: ClassVar[bool] = True
+    __entries__: dict[str, VisualDef]
     default: VisualDef | None = Field(None, alias="$default")
     exclude: OneOrMore = Field([], alias="$exclude")
     name_editing: NameEditing | None = Field(None, alias="$name_editing")

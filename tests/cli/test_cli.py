@@ -126,8 +126,8 @@ def test_usage_errors_exit_2() -> None:
 
 
 def test_check_imports_no_heavy_library() -> None:
-    """`mpc check` runs on every save in editors: YAML, the schema (pydantic, issue 20) and
-    URDF names, nothing more."""
+    """`mpc check` runs on every save in editors: YAML, the schema and URDF names, nothing
+    more."""
     heavy = ("pinocchio", "pybullet", "trimesh", "numpy", "scipy", "lark", "git")
     probe = ("import sys\nfrom mpc.cli.main import main\n"
              f"code = main(['check', {str(ROOT / 'examples/talos.yml')!r}])\n"
