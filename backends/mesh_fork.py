@@ -1,12 +1,20 @@
-"""A build's plain mesh jobs on two cores: half in the build's own process, half in one child
-forked for them (backends/meshes.py `_compute`).
+"""A build's plain mesh jobs on two cores: in the build's own process and in one child forked
+for them (backends/meshes.py `_compute`), each taking the next job from a queue they share.
 
 A pool of workers (ProcessPoolExecutor) costs more to start and feed than it saves on the
-plain path's tens of milliseconds (bench/README.md); one `fork` costs about 2 ms. The child makes
-its cache entries as the build itself would (single flight, atomic stores) and sends back only
-its problems, as JSON through a pipe, then ends with `os._exit` (no atexit handler, no buffer
-of the build's flushed twice). When the child fails in any way, the build does its half
-itself: what the child stored is found in the cache, what it did not is computed.
+plain path's tens of milliseconds (bench/README.md); one `fork` costs about 2 ms. The queue is
+a pipe holding the jobs' numbers, the costliest first, written whole before the fork: each
+process reads the next number (4 bytes, which a pipe hands to one reader whole) until it is
+empty, so that neither waits long for the other at the end (halves fixed beforehand by their
+bytes left one process 30 ms behind the other: a DAE costs more per byte than an STL).
+
+The child makes its cache entries as the build itself would (single flight, atomic stores)
+and sends back, as JSON through a second pipe, the numbers of the jobs it finished, their
+problems and the SHA-256 of each entry it stored (the build then does not hash them again
+when it reads them back); it ends with `os._exit` (no atexit handler, no buffer of the
+build's flushed twice). A job the child did not say it finished, because it failed in any
+way, the build does itself: what the child stored is found in the cache, what it did not is
+computed.
 """
 
 from __future__ import annotations
@@ -15,12 +23,15 @@ import json
 import os
 import sys
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TypeVar
 
 Task = TypeVar("Task")
 Problems = dict[Path, tuple[str, str]]  # cache entry → (code, problem)
+
+_NUMBER = 4  # bytes of a job's number in the queue
+_QUEUE = 65536  # bytes a pipe holds (Linux's default) before a write waits for a reader
 
 
 def may_fork() -> bool:
@@ -30,46 +41,63 @@ def may_fork() -> bool:
     return threading.active_count() == 1 and "mujoco" not in sys.modules
 
 
-def halves(tasks: Sequence[Task], sizes: Sequence[int]) -> tuple[list[Task], list[Task]]:
-    """The tasks in two halves of about the same bytes, the largest first into the lighter."""
-    mine: list[Task] = []
-    theirs: list[Task] = []
-    weight = [0, 0]
-    for i in sorted(range(len(tasks)), key=lambda i: -sizes[i]):
-        half = 0 if weight[0] <= weight[1] else 1
-        (mine, theirs)[half].append(tasks[i])
-        weight[half] += sizes[i]
-    return mine, theirs
+def beside_a_fork(tasks: Sequence[Task], costs: Sequence[float], run: Callable[[Task], Problems],
+                  entries: Callable[[Task], list[Path]]) -> list[Problems]:
+    """`run` of each task, here and in a forked child, the costliest first. entries: the cache
+    entries a task makes (whose digests the child sends back)."""
+    from mpc.core.cache import note_written, written_digest
 
-
-def beside_a_fork(tasks: Sequence[Task], sizes: Sequence[int],
-                  run: Callable[[Task], Problems]) -> list[Problems]:
-    """`run` of each task: about half of the bytes (`sizes`) in a forked child, the rest here."""
-    mine, theirs = halves(tasks, sizes)
+    order = sorted(range(len(tasks)), key=lambda i: -costs[i])
+    if len(order) * _NUMBER > _QUEUE:
+        return [run(task) for task in tasks]
+    queue, queued = os.pipe()
+    os.write(queued, b"".join(i.to_bytes(_NUMBER, "little") for i in order))
+    os.close(queued)
     read, write = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child
         code = 1
         try:
             os.close(read)
-            found = {str(entry): problem for task in theirs for entry, problem in run(task).items()}
+            done, problems, digests = [], {}, {}
+            for i in _taken(queue):
+                problems.update((str(entry), problem) for entry, problem in run(tasks[i]).items())
+                digests.update((str(entry), digest) for entry in entries(tasks[i])
+                               if (digest := written_digest(entry)) is not None)
+                done.append(i)
             with os.fdopen(write, "w", encoding="utf-8") as pipe:
-                json.dump(found, pipe)
+                json.dump({"done": done, "problems": problems, "digests": digests}, pipe)
             code = 0
         finally:
             os._exit(code)
     os.close(write)
+    results, here = [], set()
     try:
-        results = [run(task) for task in mine]
+        for i in _taken(queue):
+            results.append(run(tasks[i]))
+            here.add(i)
     finally:
+        os.close(queue)
         with os.fdopen(read, encoding="utf-8") as pipe:
             sent = pipe.read()
         _, status = os.waitpid(pid, 0)
+    there: set[int] = set()
     try:
         if os.waitstatus_to_exitcode(status) != 0:
             raise ValueError("the child failed")
-        found = json.loads(sent)
-        results.append({Path(entry): (code, problem) for entry, (code, problem) in found.items()})
-    except (ValueError, TypeError):
-        results.extend(run(task) for task in theirs)
+        answer = json.loads(sent)
+        results.append({Path(entry): (code, problem)
+                        for entry, (code, problem) in answer["problems"].items()})
+        for entry, digest in answer["digests"].items():
+            note_written(Path(entry), digest)
+        there = set(answer["done"])
+    except (ValueError, TypeError, KeyError, OSError):
+        pass
+    results.extend(run(tasks[i]) for i in range(len(tasks)) if i not in here and i not in there)
     return results
+
+
+def _taken(queue: int) -> Iterator[int]:
+    """The numbers of the jobs this process takes from the queue, one at a time."""
+    while len(number := os.read(queue, _NUMBER)) == _NUMBER:
+        yield int.from_bytes(number, "little")
