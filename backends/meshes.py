@@ -182,13 +182,14 @@ def _disambiguate(wanted: dict[MeshKey, str]) -> dict[MeshKey, str]:
             continue
         paths = {p for p, _ in keys}
         first = keys[0][0]
+        digests = {k: _digest(k) for k in keys}  # each file read once for these and its own digest
         # The same bytes: by their digests, which a warm build knows without reading the files.
         if len(set(ops for _, ops in keys)) == 1 and not any(_made(p) for p in paths) and all(
                 file_digest(first) == file_digest(p) for p in paths):
             continue
         stem, ext = name.rsplit(".", 1)
         for k in keys:
-            out[k] = f"{stem}_{_digest(k)}.{ext}"
+            out[k] = f"{stem}_{digests[k]}.{ext}"
     return out
 
 
@@ -210,12 +211,12 @@ def _mujoco_verdict(path: Path, collision: bool) -> str:
 def _digest(k: MeshKey) -> str:
     """Ten hex digits of the source's bytes and the ops, which tell apart meshes of one name;
     remembered with the file's digest (core/cache.py), so that a warm build does not read them."""
-    from mpc.core.cache import remembered
+    from mpc.core.cache import digest_with
 
     ops = repr(k[1]).encode()
     if _made(k[0]):
         return hashlib.sha256(str(k[0]).encode() + ops).hexdigest()[:10]
-    return remembered(k[0], f"name {k[1]!r}", lambda f: hashlib.sha256(f.read() + ops).hexdigest()[:10], 10)
+    return digest_with(k[0], f"name {k[1]!r}", ops, 10)
 
 
 def copy(files: dict[MeshKey, str], out: Path, sink: Sink, export_span: Span,

@@ -266,6 +266,20 @@ def remembered(path: Path, what: str, compute: Callable[[BufferedReader], str], 
         return _remembered_in(f, path, what, compute, length)
 
 
+def digest_with(path: Path, what: str, suffix: bytes, length: int) -> str:
+    """`length` hex digits of the sha256 of the file's bytes followed by `suffix`, remembered as
+    `what` (as `remembered` does); the file's own sha256 (`file_digest`) is remembered from the
+    same read: the bytes are hashed once for both."""
+    def both(f: BufferedReader) -> str:
+        own = hashlib.file_digest(f, "sha256")
+        _remembered_in(f, path, "", lambda _: own.hexdigest(), 64)
+        own.update(suffix)
+        return own.hexdigest()[:length]
+
+    with open(path, "rb") as f:
+        return _remembered_in(f, path, what, both, length)
+
+
 def digest_of_read(f: BufferedReader, path: Path, data: bytes) -> str:
     """The sha256 (hex) of `data`, just read whole from `f`, the open file `path`: remembered
     as `file_digest` remembers it, by the status of the file as it is after the read (a write

@@ -256,16 +256,19 @@ def _told_empty(path: Path) -> str:
     return "1" if has_no_triangles(path) else "0"
 
 
-@pytest.mark.parametrize(("ask", "expected", "other"), [
-    (_name_digits, lambda mesh: hashlib.sha256(mesh.read_bytes() + b"()").hexdigest()[:10], "0123456789"),
-    (_told_empty, lambda mesh: "0", "1"),
+@pytest.mark.parametrize(("ask", "what", "expected", "other"), [
+    (_name_digits, "name ()", lambda mesh: hashlib.sha256(mesh.read_bytes() + b"()").hexdigest()[:10],
+     "0123456789"),
+    (_told_empty, "no triangles", lambda mesh: "0", "1"),
 ], ids=["name digits", "no triangles"])
 def test_what_a_warm_build_would_read_a_whole_mesh_for_is_remembered(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ask: Any, expected: Any, other: str) -> None:
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ask: Any, what: str, expected: Any,
+        other: str) -> None:
     """The ten digits that tell apart meshes of one name, and whether a mesh that is not a binary
     STL holds triangles, are remembered beside its digest (core/cache.py `remembered`), by the
     file's status: the next process gives what is remembered without reading the file, and
-    computes again what is remembered in another form."""
+    computes again what is remembered in another form. The name's digits are made in the read
+    that makes the file's digest (`digest_with`)."""
     from mpc.core import cache
 
     monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
@@ -276,9 +279,12 @@ def test_what_a_warm_build_would_read_a_whole_mesh_for_is_remembered(
     cache.keep_digests()
     [memo] = (tmp_path / "cache/digests").glob("*")
 
+    if ask is _name_digits:
+        assert json.loads(memo.read_text())[mesh.name][5][""] == hashlib.sha256(mesh.read_bytes()).hexdigest()
+
     def remember(value: str) -> None:
         memos = json.loads(memo.read_text())
-        memos[mesh.name][5] = {what: value for what in memos[mesh.name][5]}
+        memos[mesh.name][5][what] = value
         memo.write_text(json.dumps(memos))
         _another_process(monkeypatch)
 
@@ -288,7 +294,7 @@ def test_what_a_warm_build_would_read_a_whole_mesh_for_is_remembered(
         remember(damaged)
         assert ask(mesh) == expected(mesh)
         cache.keep_digests()
-        assert list(json.loads(memo.read_text())[mesh.name][5].values()) == [expected(mesh)]
+        assert json.loads(memo.read_text())[mesh.name][5][what] == expected(mesh)
 
 
 @pytest.mark.parametrize("same_bytes", [True, False])
