@@ -376,7 +376,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
 def _mujoco_refusal(entry: Path, collision: bool, data: bytes | None = None) -> tuple[str, str] | None:
     """(why, hint) when MuJoCo refuses the mesh computed into the cache entry `entry` (its bytes
     `data`, read when not given) for a visual or a `collision`, else None. The verdict on an
-    entry it reads is kept in the cache (`verdicts/mujoco-1/<entry's name>`: an entry's name is
+    entry it reads is kept in the cache (`verdicts/mujoco-2/<entry's name>`: an entry's name is
     its content's), as `_copy_problem` keeps its own, so that a warm build does not look at
     every vertex again."""
     from mpc.core.cache import read_entry

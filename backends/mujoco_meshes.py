@@ -17,9 +17,11 @@ on tinyobjloader), stricter than trimesh and than the URDF consumers that read t
 
 Of any mesh, MuJoCo wants 4 vertices or more (an STL's equal vertices counted once) and
 triangles of some area (1e-15 m² in all): a mesh of one triangle, or of triangles with no area,
-is refused. A collision mesh has one more rule: MuJoCo computes its convex hull (a visual's it
+is refused. A collision mesh has more rules: MuJoCo computes its convex hull (a visual's it
 does not), and refuses one whose vertices lie in one plane or on one line ("coplanar vertices,
-cannot compute convex hull").
+cannot compute convex hull"), and one of an OBJ file with a coordinate far out (qhull fails on
+a box with a corner at 1e20, and so MuJoCo; an STL's coordinates are bounded by ±2^30 already):
+beyond ±2^30, a collision mesh is refused.
 
 `verdict` says which of the three a file is, remembered by the file's status (core/cache.py);
 `problem` says why a refused file is refused. RULES names these rules in what is remembered.
@@ -32,7 +34,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-RULES = "mujoco 1"  # changes when the rules change, so that no verdict of older ones is used
+RULES = "mujoco 2"  # changes when the rules change, so that no verdict of older ones is used
 READS = "0"  # MuJoCo reads the file as it is
 REWRITE = "1"  # the same mesh, written again, is one MuJoCo reads
 REFUSED = "2"  # the file is refused (`problem` says why)
@@ -89,6 +91,10 @@ def judge(data: bytes, suffix: str, collision: bool = False) -> tuple[str, str, 
     if not area >= MIN_AREA:
         return (REFUSED, f"its triangles have no area ({area:.3g} m² in all; MuJoCo refuses a mesh of "
                 f"less than {MIN_AREA:g})", REPAIR_HINT)
+    far = (np.abs(corners) > BOUND).any(axis=(1, 2)) if collision else np.zeros(0, dtype=bool)
+    if far.any():
+        return (REFUSED, f"triangle {int(far.argmax()) + 1} has a coordinate beyond ±2^30, where MuJoCo "
+                "cannot compute the convex hull of a collision mesh", REPAIR_HINT)
     if collision and _flat(corners.reshape(-1, 3)):
         return (REFUSED, "its vertices lie in one plane, and MuJoCo computes the convex hull of a "
                 "collision mesh", FLAT_HINT)
@@ -100,6 +106,10 @@ def _flat(points: Any) -> bool:
     import numpy as np
 
     centred = points - points.mean(axis=0)
+    size = np.abs(centred).max()
+    if not size > 0:
+        return True
+    centred = centred / size  # of any size: the squares below stay finite
     moments = np.linalg.eigvalsh(centred.T @ centred)  # the squared spreads, least first
     return bool(moments[0] <= _FLAT**2 * moments[2])
 

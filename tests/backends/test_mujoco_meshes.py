@@ -238,6 +238,45 @@ def test_a_flat_collision_mesh_is_an_error_for_mjcf_and_a_flat_visual_is_not(
     _mujoco_mesh(tmp_path / "visual/out/mjcf/robot.xml")  # MuJoCo compiles it
 
 
+def _far_tetra(z: str) -> str:
+    """The tetrahedron as OBJ with its top corner at height `z`, written as given."""
+    return TETRA_OBJ.replace("v 0.0 0.0 0.1\n", f"v 0.0 0.0 {z}\n")
+
+
+@pytest.mark.parametrize("z", ["1e20", "3.4e38", "0.1000001e308"])
+def test_a_collision_mesh_with_a_coordinate_far_out_is_an_error_for_mjcf_and_a_visual_is_not(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], z: str) -> None:
+    """MuJoCo's convex hull (qhull) of a collision mesh with a corner at 1e20 fails, and so does
+    MuJoCo; at 1e307 the test for flatness overflowed (an exit 3, found by the fuzz run). A visual
+    mesh MuJoCo reads as it is. The rule is the bound of its STL reader, ±2^30."""
+    import mujoco
+
+    def loads(collision: bool) -> bool:
+        (tmp_path / "probe.obj").write_text(_far_tetra(z))
+        contact = 'contype="1" conaffinity="1"' if collision else 'contype="0" conaffinity="0"'
+        try:
+            mujoco.MjModel.from_xml_string(
+                f'<mujoco><compiler meshdir="{tmp_path}"/><asset><mesh file="probe.obj"/></asset>'
+                f'<worldbody><body><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+                f'<geom type="mesh" mesh="probe" {contact} mass="0"/></body></worldbody></mujoco>')
+        except ValueError:
+            return False
+        return True
+
+    assert not loads(collision=True) and loads(collision=False)  # MuJoCo's own verdicts
+    urdf = ARM_URDF.replace('<box size="0.05 0.05 0.4"/>', '<mesh filename="meshes/far.obj"/>')
+    arm(tmp_path / "collision", urdf)
+    (tmp_path / "collision/meshes/far.obj").write_text(_far_tetra(z))
+    spec = write(tmp_path / "collision/model.yml", definition("arm.urdf") + MJCF.format(fmt="input_type"))
+    assert main(["compile", str(spec), "-o", str(tmp_path / "collision/out")]) == 1
+    assert (f"error[E0585]: mesh '{tmp_path}/collision/meshes/far.obj' of a collision of link 'upper' "
+            "cannot be copied into the build: triangle 2 has a coordinate beyond ±2^30, where MuJoCo "
+            "cannot compute the convex hull of a collision mesh\n") in capsys.readouterr().err
+    code, err = _compile(tmp_path / "visual", "far.obj", _far_tetra(z), MJCF.format(fmt="input_type"), capsys)
+    assert code == 0, err
+    _mujoco_mesh(tmp_path / "visual/out/mjcf/robot.xml")
+
+
 def test_a_render_draws_every_object_of_an_obj(tmp_path: Path) -> None:
     """A render loads the robot in MuJoCo too (backends/scene.py): the OBJ of two objects is
     written again for it, and MuJoCo has both."""
