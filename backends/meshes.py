@@ -15,15 +15,16 @@ import hashlib
 import math
 import os
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from mpc.backends.missing_packages import unfound_packages
 from mpc.backends.mujoco_meshes import READS, REFUSED, REPAIR_HINT, REWRITE, RULES, judge
 from mpc.backends.mujoco_meshes import problem as mujoco_problem
 from mpc.backends.mujoco_meshes import verdict as mujoco_verdict
+from mpc.backends.plain_meshes import Job
 from mpc.backends.smurf_forms import named_shapes
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Sink
@@ -456,7 +457,7 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
     return cache_dir("meshes") / f"{digest}{suffix}"
 
 
-Task = tuple[bool, list[tuple[Path, tuple[MeshOp, ...], Path]]]  # by the plain path or not; its jobs
+Task = tuple[bool, list[Job]]  # by the plain path or not; its jobs
 
 
 def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
@@ -486,7 +487,14 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     workers = min(len(tasks), mesh_workers())
     sizes = _plain_sizes(tasks)
     size = sum(sizes) if sizes is not None else LIGHT  # not all plain: the pool's
-    if workers < 2 or len(jobs) < 3 or size < FORKED:
+    from mpc.backends import mesh_worker
+
+    if mesh_worker.active() and sizes is not None and size >= FORKED:  # beside the forked worker
+        costs = _costs(tasks, sizes)
+        mesh_worker.offer([(group, cost) for (_, group), cost in zip(tasks, costs, strict=True)])
+        results = [_materialise_all(tasks[i]) for i in sorted(range(len(tasks)), key=costs.__getitem__)]
+        mesh_worker.note_digests()
+    elif workers < 2 or len(jobs) < 3 or size < FORKED:
         results = [_materialise_all(task) for task in tasks]
     elif sizes is not None and size < LIGHT:
         from mpc.backends.mesh_fork import beside_a_fork, may_fork
@@ -556,6 +564,49 @@ def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:
 
 WORKERS = "MPC_MESH_WORKERS"
 _share: int | None = None  # the cores of one of `mpc run`'s builds side by side (share_cores)
+
+
+def forks_beside() -> bool:
+    """Whether a build may make its plain meshes in a process forked beside it (mesh_fork.py,
+    mesh_worker.py): it has two cores or more of its own (not one of `mpc run`'s builds), and
+    MPC_MESH_WORKERS asks for no number of processes."""
+    return _share is None and not os.environ.get(WORKERS, "").isdigit() and usable_cores() >= 2
+
+
+def likely_tasks(robots: list[Robot], exports: Sequence[Any]) -> list[tuple[list[Job], float]]:
+    """The plain mesh jobs the exports will most likely ask of the input models' meshes, grouped
+    by source, with their costs: each mesh as read, in each export's mesh format, when that is
+    a conversion the plain path makes and its entry is not in the cache (mesh_worker.py: given
+    to the worker ahead of the ops, which may change some of them)."""
+    from mpc.backends.plain_meshes import plain
+
+    formats = {fmt for e in exports if (fmt := getattr(e, "mesh_format", None)) is not None}
+    formats |= {fmt for e in exports for fmt in getattr(e, "additional_meshes", ())}
+    groups: dict[Path, dict[Path, Job]] = {}
+    for robot in robots:
+        for use in mesh_uses(robot):
+            source, ops = use.mesh.source, use.mesh.ops
+            src = source.path
+            if src is None or _made(src) or not src.is_file():
+                continue
+            for mesh_format in formats:
+                fmt = source.format if mesh_format == KEEP_FORMAT else mesh_format
+                if (not ops and fmt == source.format) or fmt not in EXTENSIONS:
+                    continue
+                suffix = "." + EXTENSIONS[fmt].rsplit(".", 1)[-1]
+                if not plain(src, ops, suffix):
+                    continue
+                try:
+                    dest = _cached_path(src, ops, suffix)
+                except OSError:
+                    continue
+                if not dest.exists():
+                    groups.setdefault(src, {})[dest] = (src, ops, dest)
+    tasks: list[Task] = [(True, list(jobs.values())) for jobs in groups.values()]
+    sizes = _plain_sizes(tasks) or []
+    if sum(sizes) < FORKED:
+        return []
+    return [(group, cost) for (_, group), cost in zip(tasks, _costs(tasks, sizes), strict=True)]
 
 
 def mesh_workers() -> int:

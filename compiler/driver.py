@@ -244,34 +244,39 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         if done is not None:
             return done
     before = len(sink.diagnostics)
-    with kept.recording(sink) if kept is not None else contextlib.nullcontext():
-        with stage("lower"):
-            definition = Span.of_file(str(path))
-            if kept is not None and kept.header is not None and kept.model_holds(sink, definition):
-                if kept.force:                                 # its program, the ops run anew
-                    program = kept.replay_program(sink)
-                    kept.program_done()
-                    program, robot = _robot(program, path, sink, options)
-                    kept.front_end_done()
+    try:  # a mesh worker the build starts (backends/mesh_worker.py) ends with its mesh stages
+        with kept.recording(sink) if kept is not None else contextlib.nullcontext():
+            with stage("lower"):
+                definition = Span.of_file(str(path))
+                if kept is not None and kept.header is not None and kept.model_holds(sink, definition):
+                    if kept.force:                                 # its program, the ops run anew
+                        program = kept.replay_program(sink)
+                        kept.program_done()
+                        program, robot = _robot(program, path, sink, options)
+                        kept.front_end_done()
+                    else:
+                        program, robot = kept.replay_model(sink)   # its program and robot
                 else:
-                    program, robot = kept.replay_model(sink)   # its program and robot
-            else:
-                program, robot = _program_and_robot(path, sink, options,
-                                                    kept.program_done if kept is not None else None)
-                if kept is not None:
-                    kept.front_end_done()
-        if program is None or robot is None:
-            return Result(program)
-        model_end = len(sink.diagnostics)
-        from mpc.backends.empty_meshes import check_empty
-        from mpc.backends.solid_checks import check_closed
+                    program, robot = _program_and_robot(path, sink, options,
+                                                        kept.program_done if kept is not None else None)
+                    if kept is not None:
+                        kept.front_end_done()
+            if program is None or robot is None:
+                return Result(program)
+            model_end = len(sink.diagnostics)
+            from mpc.backends.empty_meshes import check_empty
+            from mpc.backends.solid_checks import check_closed
 
-        with stage("apply ops"):
-            check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
-            check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
-        out = _out(options, program.modelname)
-        with stage("write"):
-            written = emit(program, robot, out, sink, options.target)  # emit, rename into place
+            with stage("apply ops"):
+                check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
+                check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
+            out = _out(options, program.modelname)
+            with stage("write"):
+                written = emit(program, robot, out, sink, options.target)  # emit, rename into place
+    finally:
+        from mpc.backends import mesh_worker
+
+        mesh_worker.stop()
     if not written:
         return Result(program, robot)
     if kept is not None:
@@ -318,6 +323,11 @@ def _program_and_robot(path: Path, sink: Sink, options: Options,
                        ) -> tuple[Program | None, Robot | None]:
     """The front end and the ops: (program, robot), either None after errors. `program_done`
     is called when the front end has said all it says."""
+    from mpc.backends import mesh_worker
+    from mpc.backends.meshes import forks_beside
+
+    if forks_beside():
+        mesh_worker.start()  # imports numpy while the front end runs, then makes meshes given it
     from mpc.compiler.front_end import input_loader, load_program
 
     try:
@@ -325,6 +335,10 @@ def _program_and_robot(path: Path, sink: Sink, options: Options,
         program = load_program(path, sink, options, Severity.ERROR, loader)  # front end
     except OSError as e:
         return _unreadable(path, sink, e)
+    if program is not None and mesh_worker.active():
+        from mpc.backends.meshes import likely_tasks
+
+        mesh_worker.offer(likely_tasks(loader.loaded(), program.exports))
     if program_done is not None:
         program_done()
     if program is not None and not options.post_processing:  # --no-post-processing

@@ -71,6 +71,10 @@ class InputLoader:
                 self._robots[key] = self._load(inp)
         return self._robots[key]
 
+    def loaded(self) -> list[Robot]:
+        """The input models read so far."""
+        return [robot for robot in self._robots.values() if robot is not None]
+
     def _load(self, inp: Input) -> Robot | None:
         if inp.kind == "basefile":
             if inp.path is None:  # its package was not found; reported when lowering

@@ -55,6 +55,9 @@ SITES: dict[tuple[str, str, str], str] = {
     ("meshes.py", "copy", "confined_files(out, found)"): "confined: mesh paths mpc makes (meshes/…)",
     ("meshes.py", "copy", "out / rel"): "only whether it is there (a name inside); written through confined",
     ("meshes.py", "_cached_path", "cache_dir('meshes') / f'{digest}{suffix}'"): CACHE,
+    ("mesh_worker.py", "note_digests", "Path(entry)"):
+        "the worker's answer: the cache entries `_cached_path` named, as keys; nothing is written",
+    ("mujoco_meshes.py", "_flat", "centred / size"): MATH,
     ("mesh_fork.py", "beside_a_fork", "Path(entry)"):
         "the forked child's answer: the cache entries `_cached_path` named, as keys; nothing is written",
     ("mjcf.py", "cut_axis", "a / np.linalg.norm(a)"): MATH,
