@@ -567,7 +567,7 @@ _share: int | None = None  # the cores of one of `mpc run`'s builds side by side
 
 
 def forks_beside() -> bool:
-    """Whether a build may make its plain meshes in a process forked beside it (mesh_fork.py,
+    """Whether a build may make its plain meshes in a process beside it (mesh_fork.py,
     mesh_worker.py): it has two cores or more of its own (not one of `mpc run`'s builds), and
     MPC_MESH_WORKERS asks for no number of processes."""
     return _share is None and not os.environ.get(WORKERS, "").isdigit() and usable_cores() >= 2

@@ -327,7 +327,7 @@ def _program_and_robot(path: Path, sink: Sink, options: Options,
     from mpc.backends.meshes import forks_beside
 
     if forks_beside():
-        mesh_worker.start()  # imports numpy while the front end runs, then makes meshes given it
+        mesh_worker.start()  # imports numpy while the front end runs, then makes the meshes it is given
     from mpc.compiler.front_end import input_loader, load_program
 
     try:

@@ -95,7 +95,7 @@ def _two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def test_a_build_makes_half_its_plain_meshes_in_one_forked_child(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Megabytes of the plain path's jobs (STL → OBJ) on two cores, with no worker forked ahead
+    """Megabytes of the plain path's jobs (STL → OBJ) on two cores, with no worker started ahead
     (backends/mesh_worker.py): the mesh stage forks a child, and both take jobs from the queue
     (the largest here, the other three in the child); the same bytes as in one process."""
     from mpc.backends import mesh_worker
@@ -112,15 +112,22 @@ def test_a_build_makes_half_its_plain_meshes_in_one_forked_child(
 @pytest.mark.parametrize("worker", [True, False], ids=["the worker", "the fork of the mesh stage"])
 def test_a_build_makes_the_jobs_of_a_child_that_failed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                        worker: bool) -> None:
-    """The worker forked as the build starts (backends/mesh_worker.py), or, without it, the
-    child forked at the mesh stage (backends/mesh_fork.py), dies at its first job: the build
-    makes every mesh itself, the same bytes."""
+    """The worker started as the build starts (backends/mesh_worker.py) is killed at once, or,
+    without it, the child forked at the mesh stage (backends/mesh_fork.py) dies at its first
+    job: the build makes every mesh itself, the same bytes."""
+    import signal
+
     from mpc.backends import mesh_worker, plain_meshes
 
     alone, _ = _built(tmp_path, "1", monkeypatch, fine=True)
     _two_cores(monkeypatch)
-    if not worker:
-        monkeypatch.setattr(mesh_worker, "start", lambda: None)
+    start = mesh_worker.start
+
+    def killed() -> None:
+        start()
+        os.kill(mesh_worker._pid, signal.SIGKILL)
+
+    monkeypatch.setattr(mesh_worker, "start", killed if worker else lambda: None)
     parent, materialise = os.getpid(), plain_meshes.materialise
 
     def dies_in_the_child(jobs: list[plain_meshes.Job]) -> dict[Path, tuple[str, str]] | None:
@@ -180,8 +187,11 @@ def test_the_worker_makes_the_input_models_meshes_and_ends_with_the_build(
 
 def test_what_the_forked_child_cannot_make_is_said_as_one_process_says_it(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A broken STL among the child's jobs (the three smaller meshes): the build says what it
-    says when one process makes every mesh, word for word."""
+    """A broken STL among the child's jobs (the three smaller meshes; no worker started ahead):
+    the build says what it says when one process makes every mesh, word for word."""
+    from mpc.backends import mesh_worker
+
+    monkeypatch.setattr(mesh_worker, "start", lambda: None)
     said, derived = [], []
     for workers in ("1", None):
         folder = tmp_path / f"workers-{workers}"
