@@ -16,6 +16,7 @@ What USD (with UsdPhysics and Newton's mimic schema) cannot hold is named in one
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
@@ -181,6 +182,23 @@ def _metadata(layer: Layer, root: str) -> None:
         layer.customLayerData = info
 
 
+FLOAT_MAX = 3.4028234663852886e38  # the largest 32-bit float: UsdPhysics's masses, moments and points
+# A number that is not finite as usd-core writes it in text: a word inf, -inf or nan.
+_NOT_FINITE = re.compile(r"[\s(\[,=]-?(?:inf|nan)(?=[\s)\],])")
+
+
+def _beyond_floats(inertial: Inertial) -> str | None:
+    """Why UsdPhysics's 32-bit floats cannot hold the inertial (a mass, a moment or a centre of
+    mass beyond ±3.4e38 becomes infinite in them), or None."""
+    from mpc.backends.mjcf import principal
+
+    xyz = inertial.origin.xyz if inertial.origin is not None else (0.0, 0.0, 0.0)
+    if any(abs(x) > FLOAT_MAX for x in (inertial.mass, *xyz, *principal(inertial)[0])):
+        return ("its mass, principal moments or centre of mass hold a number beyond ±3.4e38, the largest "
+                "of the 32-bit floats UsdPhysics keeps them in")
+    return None
+
+
 def emit(robot: Robot, export: UsdExport, out: Path, sink: Sink) -> None:
     """Write `out/usd/<filename or robot.name>.usda` (and its payload's layers, `layered`)."""
     from mpc.backends import meshes, usd_meshes
@@ -188,8 +206,8 @@ def emit(robot: Robot, export: UsdExport, out: Path, sink: Sink) -> None:
     from mpc.backends.mjcf import unusable_inertial
     from mpc.backends.smurf_forms import named_shapes
 
-    unusable = [(name, problem) for name, link in robot.links.items() if link.inertial is not None
-                and (problem := unusable_inertial(link.inertial)) is not None]
+    unusable = [(name, problem) for name, link in robot.links.items() if link.inertial is not None and (
+        problem := unusable_inertial(link.inertial) or _beyond_floats(link.inertial)) is not None]
     for name, problem in unusable:
         sink.error(robot.links[name].span or export.span, "E0587", f"link '{name}' has an inertial "
                    f"UsdPhysics cannot hold: {problem}; no USD is written", hint="fix its <inertial>")
@@ -207,7 +225,16 @@ def emit(robot: Robot, export: UsdExport, out: Path, sink: Sink) -> None:
     def triangles(mesh: Mesh) -> usd_meshes.Triangles:
         return found[meshes.key(mesh)]
 
-    for rel, text in layers_text(robot, export.layout, triangles, f"{name}_payload").items():
+    texts = layers_text(robot, export.layout, triangles, f"{name}_payload")
+    for rel, text in texts.items():  # a crate layer (bytes) holds the meshes, checked as read
+        if isinstance(text, str) and (found_at := _NOT_FINITE.search(text)) is not None:
+            line = text.count("\n", 0, found_at.start()) + 1
+            sink.error(export.span, "E0589", "the USD would hold a number that is not finite, beyond "
+                       f"±3.4e38 (the 32-bit floats of UsdGeom and UsdPhysics): '{found_at[0].strip()}' "
+                       f"in line {line} of '{rel or name + '.usda'}'; no USD is written",
+                       hint="a length, mass or angle of the model is out of any physical range")
+            return
+    for rel, text in texts.items():
         path = confined(out, "usd", f"{name}.usda") if not rel else confined(out, "usd", rel)
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, text)

@@ -97,4 +97,12 @@ def triangles(robot: Robot, sink: Sink, span: Span) -> dict[meshes.MeshKey, Tria
     found, ok = meshes.contents(files, sink, span, robot)
     if not ok:
         return None
-    return {k: _read(found[rel]) for k, rel in files.items()}
+    read = {k: _read(found[rel]) for k, rel in files.items()}
+    for (source, _), mesh in read.items():
+        if not np.isfinite(mesh.points).all():  # a coordinate beyond ±3.4e38 became infinite
+            sink.error(span, "E0589", "the USD would hold a number that is not finite, beyond ±3.4e38 "
+                       f"(the 32-bit floats of UsdGeom and UsdPhysics): a point of mesh '{source}'; "
+                       "no USD is written", hint="a length, mass or angle of the model is out of any "
+                       "physical range")
+            return None
+    return read

@@ -378,6 +378,62 @@ def test_an_inertial_that_is_no_number_is_refused(tmp_path: Path, diags: Diags) 
     assert not (tmp_path / "usd").exists()
 
 
+def test_an_inertial_beyond_32_bit_floats_is_refused(tmp_path: Path, diags: Diags) -> None:
+    """UsdPhysics keeps masses, moments and centres of mass in 32-bit floats: a mass of 1e308
+    (an MJCF's `boundmass`, found by the fuzz run) was written as `inf`."""
+    write(tmp_path / "toy.urdf", URDF.replace('<mass value="0.5"/>', '<mass value="1e308"/>', 1))
+    robot = urdf_reader.read(tmp_path / "toy.urdf", Sink())
+    assert robot is not None
+    usd.emit(robot, UsdExport(span=Span("toy.yml", 1, 1)), tmp_path, diags)
+    error = diags.take_error("E0587")
+    assert error.message.endswith(
+        ": its mass, principal moments or centre of mass hold a number beyond ±3.4e38, the largest of the "
+        "32-bit floats UsdPhysics keeps them in; no USD is written")
+    assert not (tmp_path / "usd").exists()
+
+
+def test_a_number_the_usd_would_hold_as_infinite_is_refused(tmp_path: Path, diags: Diags) -> None:
+    """Any 32-bit float of the stage beyond ±3.4e38 (here a joint's origin at 1e39 m, its
+    localPos0) is E0589, and nothing is written: usd-core writes such a number as `inf`."""
+    write(tmp_path / "toy.urdf", URDF.replace('<origin xyz="0.1 0 0.05"', '<origin xyz="0.1 0 1e39"', 1))
+    robot = urdf_reader.read(tmp_path / "toy.urdf", Sink())
+    assert robot is not None
+    usd.emit(robot, UsdExport(span=Span("toy.yml", 1, 1), layout="single"), tmp_path, diags)
+    error = diags.take_error("E0589")
+    assert error.message.startswith("the USD would hold a number that is not finite, beyond ±3.4e38 (the "
+                                    "32-bit floats of UsdGeom and UsdPhysics): 'inf' in line ")
+    assert error.message.endswith(" of 'toy bot.usda'; no USD is written")
+    diags.take("W0500", Severity.WARNING)  # the toy's mimic, as in every USD of it
+    assert not (tmp_path / "usd").exists()
+
+
+def test_a_mesh_point_the_usd_would_hold_as_infinite_is_refused(tmp_path: Path) -> None:
+    """A mesh's points are 32-bit floats in UsdGeom: an OBJ corner at 1e39 m is E0589 naming the
+    mesh, and no USD is written (the URDF export of the same model writes it as it is)."""
+    write(tmp_path / "meshes/far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e39\n"
+          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    write(tmp_path / "far.urdf", """
+        <robot name="far"><link name="base"><visual><geometry><mesh filename="meshes/far.obj"/>
+        </geometry></visual></link></robot>""")
+    definition = write(tmp_path / "far.yml", """
+        model:
+          robotname: far
+          modelname: far
+          input_models: {far: {basefile: far.urdf}}
+          assemble: {model: far}
+          export_config:
+            - {type: usd, layout: single}
+        """)
+    sink = Sink()
+    assert compile_model(definition, sink, Options(out=tmp_path / "out")).out is None
+    [error] = [d for d in sink.diagnostics if d.severity is Severity.ERROR]
+    assert error.code == "E0589"
+    assert error.message == (
+        "the USD would hold a number that is not finite, beyond ±3.4e38 (the 32-bit floats of UsdGeom and "
+        f"UsdPhysics): a point of mesh '{tmp_path}/meshes/far.obj'; no USD is written")
+    assert not (tmp_path / "out").exists()
+
+
 MESHES = """\
 <robot name="meshy">
   <link name="base">
