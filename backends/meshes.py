@@ -270,7 +270,7 @@ def contents(files: dict[MeshKey, str], sink: Sink, export_span: Span, robot: Ro
     from mpc.core.files import describe
 
     ok = True
-    todo: dict[Path, tuple[Path, tuple[MeshOp, ...], Path]] = {}
+    todo: dict[Path, Job] = {}
     entries: dict[Path, tuple[bytes, str]] = {}
     plan_: list[tuple[Path, str]] = []
     found: dict[str, bytes | Path] = {}
@@ -460,7 +460,7 @@ def _cached_path(src: Path, ops: tuple[MeshOp, ...], suffix: str) -> Path:
 Task = tuple[bool, list[Job]]  # by the plain path or not; its jobs
 
 
-def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tuple[str, str]]:
+def _compute(jobs: list[Job]) -> dict[Path, tuple[str, str]]:
     """Materialise each job into its cache path; {cache path: (code, problem)} for those
     that failed. The jobs of one source go together: all of them by the plain path
     (backends/plain_meshes.py: one read of the file, no trimesh) when it takes each of them,
@@ -471,7 +471,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
         return {}
     from mpc.backends.plain_meshes import plain
 
-    groups: dict[Path, list[tuple[Path, tuple[MeshOp, ...], Path]]] = {}
+    groups: dict[Path, list[Job]] = {}
     for job in jobs:
         groups.setdefault(job[0], []).append(job)
     tasks: list[Task] = []
@@ -489,7 +489,7 @@ def _compute(jobs: list[tuple[Path, tuple[MeshOp, ...], Path]]) -> dict[Path, tu
     size = sum(sizes) if sizes is not None else LIGHT  # not all plain: the pool's
     from mpc.backends import mesh_worker
 
-    if mesh_worker.active() and sizes is not None and size >= FORKED:  # beside the forked worker
+    if mesh_worker.active() and sizes is not None and size >= FORKED:  # beside the worker
         costs = _costs(tasks, sizes)
         mesh_worker.offer([(group, cost) for (_, group), cost in zip(tasks, costs, strict=True)])
         results = [_materialise_all(tasks[i]) for i in sorted(range(len(tasks)), key=costs.__getitem__)]
@@ -589,7 +589,7 @@ def likely_tasks(robots: list[Robot], exports: Sequence[Any]) -> list[tuple[list
             src = source.path
             if src is None or _made(src) or not src.is_file():
                 continue
-            for mesh_format in formats:
+            for mesh_format in sorted(formats):
                 fmt = source.format if mesh_format == KEEP_FORMAT else mesh_format
                 if (not ops and fmt == source.format) or fmt not in EXTENSIONS:
                     continue
