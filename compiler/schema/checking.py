@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 import types
 import typing
 from collections.abc import Callable
@@ -62,8 +63,8 @@ def _str(value: Any, walk: Any) -> Any:
 def _bool(value: Any, walk: Any) -> Any:
     if isinstance(value, bool):
         return value
-    if isinstance(value, str):
-        text = value.strip().lower()
+    if isinstance(value, str):  # "Yes", "off"; not " yes " (YAML strips what it does not quote)
+        text = value.lower()
         if text in _TRUE or text in _FALSE:
             return text in _TRUE
         raise invalid("bool_parsing", value)
@@ -72,6 +73,9 @@ def _bool(value: Any, walk: Any) -> Any:
             return value == 1
         raise invalid("bool_parsing", value)
     raise invalid("bool_type", value)
+
+
+_INT_TEXT = re.compile(r"[+-]?[0-9]+(?:_[0-9]+)*(?:\.0+)?")  # an integer as text, as the language reads it
 
 
 def _int(value: Any, walk: Any) -> Any:
@@ -83,17 +87,9 @@ def _int(value: Any, walk: Any) -> Any:
         if math.isfinite(value) and value.is_integer():
             return int(value)
         raise invalid("int_from_float", value)
-    if isinstance(value, str):  # as Python reads it ("1_000", " +3"), or a whole float ("1.0")
-        try:
-            return int(value)
-        except ValueError:
-            pass
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if math.isfinite(number) and number.is_integer():
-            return int(number)
+    if isinstance(value, str):  # " +3", "1_000", "1.00"; not "1e3", "1.", nor other scripts' digits
+        if _INT_TEXT.fullmatch(text := value.strip()):
+            return int(text.partition(".")[0])
         raise invalid("int_parsing", value)
     raise invalid("int_type", value)
 

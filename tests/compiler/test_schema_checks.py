@@ -37,6 +37,7 @@ def test_a_bool_takes_what_yaml_users_write_for_one(value: Any, expected: bool) 
 
 @pytest.mark.parametrize(("value", "kind"), [
     (2, "bool_parsing"), (0.5, "bool_parsing"), (math.nan, "bool_parsing"), ("maybe", "bool_parsing"),
+    (" yes ", "bool_parsing"),
     ("", "bool_parsing"), (None, "bool_type"), ([], "bool_type"), ({}, "bool_type")])
 def test_a_bool_refuses_the_rest(value: Any, kind: str) -> None:
     assert _problem(bool, value) == kind
@@ -44,7 +45,7 @@ def test_a_bool_refuses_the_rest(value: Any, kind: str) -> None:
 
 @pytest.mark.parametrize(("value", "expected"), [
     (3, 3), (-3, -3), (True, 1), (3.0, 3), ("3", 3), (" +3 ", 3), ("-0", 0), ("1_000", 1000),
-    ("1.0", 1), ("1e3", 1000), (10**30, 10**30)])
+    ("1.0", 1), ("-0.00", 0), ("00012", 12), (10**30, 10**30)])
 def test_an_integer_takes_whole_numbers_however_written(value: Any, expected: int) -> None:
     result = _check(int, value)
     assert result == expected and type(result) is int
@@ -52,7 +53,9 @@ def test_an_integer_takes_whole_numbers_however_written(value: Any, expected: in
 
 @pytest.mark.parametrize(("value", "kind"), [
     (1.5, "int_from_float"), (math.inf, "int_from_float"), (math.nan, "int_from_float"),
-    ("1.5", "int_parsing"), ("three", "int_parsing"), ("inf", "int_parsing"), (None, "int_type"),
+    ("1.5", "int_parsing"), ("three", "int_parsing"), ("inf", "int_parsing"), ("1e3", "int_parsing"),
+    ("1.", "int_parsing"), ("1__0", "int_parsing"), ("\u0661\u0662", "int_parsing"), ("", "int_parsing"),
+    (None, "int_type"),
     ([1], "int_type")])
 def test_an_integer_refuses_the_rest_and_says_so(value: Any, kind: str) -> None:
     assert _problem(int, value) == kind
