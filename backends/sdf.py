@@ -234,7 +234,9 @@ class _Writer:
         for kind, items in (("visual", link.visuals), ("collision", link.collisions)):
             used: set[str] = set()
             for i, item in enumerate(items):
-                name = item.name or (f"{link.name}_{kind}" + (f"_{i}" if i else ""))
+                # sdformat trims a name: one of spaces only (a tab in an SDF input, which XML reads
+                # as a space) is read as none, and refused; it gets the name of an unnamed shape
+                name = (item.name or "").strip() or (f"{link.name}_{kind}" + (f"_{i}" if i else ""))
                 name = _unique(name, f"_{i}", used) if name in used else name
                 used.add(name)
                 self._emit_shape(d, kind, name, item)

@@ -187,6 +187,26 @@ def test_writing_twice_gives_identical_bytes(tmp_path: Path, diags: Diags) -> No
     assert sdf.to_string(robot, _uri, "1.6") == again.replace('<sdf version="1.9">', '<sdf version="1.6">')
 
 
+def test_a_shape_named_by_spaces_only_gets_a_name_sdformat_reads(tmp_path: Path, diags: Diags) -> None:
+    """sdformat trims a name, and refuses a shape whose name is then empty ("Empty string used
+    when setting a required parameter"): a visual named " " (a tab in an SDF input, read by XML
+    as a space; found by the fuzz run of seed 1132) was written so. It gets the name an unnamed
+    shape gets, and a name with spaces around is written as sdformat reads it."""
+    write(tmp_path / "in/spaced.urdf", """
+        <robot name="spaced"><link name="base">
+          <visual name=" "><geometry><box size="1 1 1"/></geometry></visual>
+          <collision name=" hull "><geometry><box size="1 1 1"/></geometry></collision>
+        </link></robot>""")
+    robot = _read_urdf(tmp_path / "in/spaced.urdf")
+    sdf.emit(robot, _export(), tmp_path / "out", diags)
+    _take_expected_warnings(robot, diags)
+    written = tmp_path / "out/sdf/spaced.sdf"
+    check = _check(written)
+    text = written.read_text()
+    assert '<visual name="base_visual">' in text and '<collision name="hull">' in text
+    assert _complaints(check) == ["Valid."]
+
+
 UNIT_INERTIA = '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
 ROTATED = """\
 <robot name="rotated">
