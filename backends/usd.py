@@ -229,10 +229,8 @@ def emit(robot: Robot, export: UsdExport, out: Path, sink: Sink) -> None:
     for rel, text in texts.items():  # a crate layer (bytes) holds the meshes, checked as read
         if isinstance(text, str) and (found_at := _NOT_FINITE.search(text)) is not None:
             line = text.count("\n", 0, found_at.start()) + 1
-            sink.error(export.span, "E0589", "the USD would hold a number that is not finite, beyond "
-                       f"±3.4e38 (the 32-bit floats of UsdGeom and UsdPhysics): '{found_at[0].strip()}' "
-                       f"in line {line} of '{rel or name + '.usda'}'; no USD is written",
-                       hint="a length, mass or angle of the model is out of any physical range")
+            usd_meshes.not_finite(sink, export.span, f"'{found_at[0].strip()}' in line {line} of "
+                                  f"'{rel or name + '.usda'}'")
             return
     for rel, text in texts.items():
         path = confined(out, "usd", f"{name}.usda") if not rel else confined(out, "usd", rel)

@@ -88,6 +88,13 @@ def _read(content: bytes | Path) -> Triangles:
     return Triangles(points, np.asarray(mesh.faces, dtype=np.int32), extent)
 
 
+def not_finite(sink: Sink, span: Span, where: str) -> None:
+    """E0589: the USD would hold a number that is not finite (at `where`); none is written."""
+    sink.error(span, "E0589", "the USD would hold a number that is not finite, beyond ±3.4e38 (the "
+               f"32-bit floats of UsdGeom and UsdPhysics): {where}; no USD is written",
+               hint="a length, mass or angle of the model is out of any physical range")
+
+
 def triangles(robot: Robot, sink: Sink, span: Span) -> dict[meshes.MeshKey, Triangles] | None:
     """The triangles of every mesh of `robot` by its key (backends/meshes.py `key`), unscaled
     (the element's scale is the USD prim's); None after an error (reported)."""
@@ -100,9 +107,6 @@ def triangles(robot: Robot, sink: Sink, span: Span) -> dict[meshes.MeshKey, Tria
     read = {k: _read(found[rel]) for k, rel in files.items()}
     for (source, _), mesh in read.items():
         if not np.isfinite(mesh.points).all():  # a coordinate beyond ±3.4e38 became infinite
-            sink.error(span, "E0589", "the USD would hold a number that is not finite, beyond ±3.4e38 "
-                       f"(the 32-bit floats of UsdGeom and UsdPhysics): a point of mesh '{source}'; "
-                       "no USD is written", hint="a length, mass or angle of the model is out of any "
-                       "physical range")
+            not_finite(sink, span, f"a point of mesh '{source}'")
             return None
     return read

@@ -285,6 +285,8 @@ def definition_schema() -> dict[str, Any]:
 def _shapes(root: type) -> dict[str, dict[str, Any]]:
     """The JSON Schema of each node class `root` reaches, by class name: its properties by key,
     each of its field's type and default; the shapes other tools give such classes."""
+    from mpc.compiler.schema.checking import resolved, wrapping
+
     defs: dict[str, dict[str, Any]] = {}
 
     def of_node(cls: type) -> dict[str, Any]:
@@ -313,15 +315,13 @@ def _shapes(root: type) -> dict[str, dict[str, Any]]:
         return out
 
     def of_type(tp: Any, names: dict[str, Any]) -> dict[str, Any]:
-        if isinstance(tp, str | typing.ForwardRef):
-            tp = eval(tp if isinstance(tp, str) else tp.__forward_arg__, names)
+        tp = resolved(tp, names)
         origin = typing.get_origin(tp)
         if origin is typing.Annotated:
             source, *markers = typing.get_args(tp)
             shape = of_type(source, names)
-            for i, marker in enumerate(markers):  # each wraps what is left of it
+            for below, marker in wrapping(source, markers):
                 if hasattr(marker, "json_schema"):
-                    below = typing.Annotated[(source, *markers[:i])] if i else source
                     shape = marker.json_schema(below, functools.partial(dict, shape))
             return shape
         if origin in (typing.Union, types.UnionType):  # a member that is a union: its members

@@ -41,7 +41,7 @@ import typing
 from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
 
-from mpc.compiler.schema.checking import Check, Invalid, checker, invalid
+from mpc.compiler.schema.checking import FALSE_WORDS, TRUE_WORDS, Check, Invalid, checker, invalid
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document, Path_
@@ -216,10 +216,6 @@ OneOrMore = Annotated[list[str], Before(str_or_list),
 
 # -- unions ----------------------------------------------------------------------------------
 
-_TRUE = {"1", "on", "t", "true", "y", "yes"}
-_FALSE = {"0", "off", "f", "false", "n", "no"}
-
-
 class _Shape:
     """What a union member takes: whether a value has its shape (`fits`), is of it as it
     is (`exact`), or converts to it (`takes`); and how messages name it (`wanted`)."""
@@ -259,7 +255,7 @@ class _Shape:
     def takes(self, v: Any) -> bool:
         if self.kind == "bool":
             return (isinstance(v, int | float) and v in (0, 1)) or (
-                isinstance(v, str) and v.lower() in _TRUE | _FALSE)
+                isinstance(v, str) and (v.lower() in TRUE_WORDS or v.lower() in FALSE_WORDS))
         if self.kind == "int":
             return isinstance(v, int) or (isinstance(v, float) and v.is_integer()) or (
                 isinstance(v, str) and v.strip().lstrip("+-").isdigit())

@@ -18,10 +18,9 @@ import math
 import re
 import types
 import typing
-from collections.abc import Callable
-from typing import Annotated, Any, Literal, Protocol
+from collections.abc import Callable, Iterator
+from typing import Annotated, Any, Literal
 
-Loc = tuple[str | int, ...]
 Check = Callable[[Any, Any], Any]  # (value, walk) → the value as the AST holds it
 
 
@@ -42,12 +41,8 @@ def invalid(kind: str, value: Any, msg: str = "", **ctx: Any) -> Invalid:
     return Invalid([{"type": kind, "loc": (), "input": value, "msg": msg, "ctx": ctx}])
 
 
-class Marker(Protocol):
-    def check(self, source: Any, inner: Callable[[], Check]) -> Check: ...
-
-
-_TRUE = frozenset({"1", "on", "t", "true", "y", "yes"})
-_FALSE = frozenset({"0", "off", "f", "false", "n", "no"})
+TRUE_WORDS = frozenset({"1", "on", "t", "true", "y", "yes"})  # true or false as text, any case
+FALSE_WORDS = frozenset({"0", "off", "f", "false", "n", "no"})
 
 
 def _any(value: Any, walk: Any) -> Any:
@@ -65,8 +60,8 @@ def _bool(value: Any, walk: Any) -> Any:
         return value
     if isinstance(value, str):  # "Yes", "off"; not " yes " (YAML strips what it does not quote)
         text = value.lower()
-        if text in _TRUE or text in _FALSE:
-            return text in _TRUE
+        if text in TRUE_WORDS or text in FALSE_WORDS:
+            return text in TRUE_WORDS
         raise invalid("bool_parsing", value)
     if isinstance(value, int | float):
         if value in (0, 1):
@@ -172,18 +167,30 @@ def _made_or_new(made: Check | None, tp: Any, names: dict[str, Any] | None) -> C
 _LEAVES: dict[Any, Check] = {Any: _any, str: _str, bool: _bool, int: _int}
 
 
+def resolved(tp: Any, names: dict[str, Any] | None) -> Any:
+    """The type an annotation names, a quoted one (`list["AssembleChild"]`) looked up in
+    `names`, the module it was written in."""
+    if isinstance(tp, str | typing.ForwardRef):
+        return eval(tp if isinstance(tp, str) else tp.__forward_arg__, names)  # the schema's own text
+    return tp
+
+
+def wrapping(source: Any, markers: list[Any]) -> Iterator[tuple[Any, Any]]:
+    """Each marker of `Annotated[source, *markers]` with what it wraps: the type left of it."""
+    for i, marker in enumerate(markers):
+        yield (Annotated[(source, *markers[:i])] if i else source), marker
+
+
 def checker(tp: Any, names: dict[str, Any] | None = None) -> Check:
     """The check of values of the type `tp`; `names`: the module its annotations were
-    written in (for the names they quote: `list["AssembleChild"]`)."""
-    if isinstance(tp, str | typing.ForwardRef):
-        tp = eval(tp if isinstance(tp, str) else tp.__forward_arg__, names)  # the schema's own text
+    written in (for the names they quote)."""
+    tp = resolved(tp, names)
     origin = typing.get_origin(tp)
     if origin is Annotated:
         source, *markers = typing.get_args(tp)
         check: Check | None = None
-        for i, marker in enumerate(markers):  # each wraps what is left of it
+        for below, marker in wrapping(source, markers):
             if hasattr(marker, "check"):
-                below = Annotated[(source, *markers[:i])] if i else source
                 check = marker.check(below, functools.partial(_made_or_new, check, below, names))
         return check if check is not None else checker(source, names)
     if origin in (typing.Union, types.UnionType):
