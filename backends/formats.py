@@ -16,10 +16,10 @@ Adding a format: specs/layers.md, "Adding a format".
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from mpc.core.record import record
 from mpc.ir import program
 from mpc.ir.float_format_keys import MJCF_KEYS, SDF_KEYS, URDF_KEYS
 
@@ -33,7 +33,7 @@ Write = Callable[["Robot", Any, Path, "Sink"], None]
 Read = Callable[[Path, "Sink", "PackageResolver | None"], "Robot | None"]
 
 
-@dataclass(frozen=True)
+@record
 class Meshes:
     """A format that writes the meshes its file references (backends/meshes.py `for_export`):
     what `mesh_format: input_type` becomes for it (empty: each mesh's own format)."""
@@ -41,7 +41,7 @@ class Meshes:
     input_type: str = ""
 
 
-@dataclass(frozen=True)
+@record
 class Format:
     """One format (see the module's docstring).
 

@@ -10,15 +10,15 @@ tally may yield a count of 0 to hold a phrase's place) and names those counted a
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
+from mpc.core.record import record
 from mpc.ir.robot import Robot
 
 Options = Mapping[str, Any]
 
 
-@dataclass(frozen=True)
+@record
 class Counted:
     """`3 motors`, `1 annotated link or joint`: a number and its noun (`many` when not 1)
     after `before`."""
@@ -36,7 +36,7 @@ def noun(word: str, before: str = "") -> Counted:
     return Counted(word, word + "s", before)
 
 
-@dataclass(frozen=True)
+@record
 class Named:
     """A phrase said as it is, once (a joint by name, the submechanisms file)."""
 

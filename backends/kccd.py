@@ -20,7 +20,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +30,7 @@ from mpc.backends.urdf_writer import to_string
 from mpc.backends.xml import write_path
 from mpc.core.diagnostics import Sink, did_you_mean
 from mpc.core.files import confined, file_name
+from mpc.core.record import record
 from mpc.ir.geometry import Mesh, MeshSource
 from mpc.ir.kinematics import links_in_root, pose_matrix
 from mpc.ir.program import KccdExport
@@ -41,7 +42,7 @@ MESH_DIR = "meshes/iv"
 SHAPE_POINTS = {"cylinder": 2, "box": 8, "sphere": 1}
 
 
-@dataclass(frozen=True)
+@record
 class Body:
     """A KCCD body: its link, the links merged into it (depth-first) and each one's pose X_BL."""
 

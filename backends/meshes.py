@@ -16,7 +16,6 @@ import math
 import os
 import re
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -31,6 +30,7 @@ from mpc.core.diagnostics import Sink
 from mpc.core.files import why_absent
 from mpc.core.numbers import zero_small
 from mpc.core.packages import package_of
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.geometry import (
     GENERATED,
@@ -72,7 +72,7 @@ def _made(path: Path) -> bool:
     return not path.is_absolute()
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class MeshUse:
     """A mesh and where the robot uses it: link name and element kind."""
 

@@ -23,9 +23,9 @@ gain is left to MuJoCo's default (1).
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 from mpc.backends import holds
+from mpc.core.record import record
 from mpc.ir.robot import Joint, Robot
 from mpc.ir.tree import depth_first
 
@@ -43,7 +43,7 @@ USED = {"position": {"type", "p", "d", "maxEffort", "maxSpeed"},
         "velocity": {"type", "p", "maxEffort", "maxSpeed"}, "motor": {"type", "maxEffort", "maxSpeed"}}
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Actuator:
     """One actuator element: tag (position, velocity, motor), name, joint and its attributes
     (name → number or text; None: left out)."""

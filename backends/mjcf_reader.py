@@ -34,7 +34,7 @@ from __future__ import annotations
 import os
 import re
 from collections import Counter
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +45,7 @@ from mpc.core.diagnostics import Sink
 from mpc.core.files import resolved, why_absent
 from mpc.core.names import free_name
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint, Motor
@@ -159,7 +160,7 @@ def _not_finite(model: Any) -> str | None:
                  if not np.all(np.isfinite(np.asarray(getattr(model, name))))), None)
 
 
-@dataclass
+@record(frozen=False)
 class _Files:
     """The MJCF's files: the main one, those it includes, its meshes; read here, under the
     read rule, and handed to MuJoCo."""

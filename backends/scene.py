@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -28,6 +28,7 @@ from mpc.backends.dae_colours import coloured
 from mpc.backends.mjcf import COLLISION_GROUP, VISUAL_GROUP
 from mpc.core.diagnostics import Sink
 from mpc.core.heap import give_back
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.program import RENDER_VIEWS
 from mpc.ir.rename import rename_robot
@@ -46,7 +47,7 @@ class GLMissing(Exception):
     """No headless OpenGL (EGL) context could be made; the message says why."""
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Camera:
     """MuJoCo's free camera: what it looks at, from how far, from which direction."""
 

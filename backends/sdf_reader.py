@@ -15,7 +15,7 @@ from __future__ import annotations
 import heapq
 import math
 from copy import deepcopy
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,7 @@ from mpc.backends.xml import NOT_FINITE, XmlSource, finite_floats, load, parse_f
 from mpc.core.diagnostics import Sink
 from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.fragments import Fragment, FragmentRef
@@ -68,7 +69,7 @@ def _pose_dict(X: np.ndarray) -> dict[str, list[float]]:
     return {"xyz": list(pose.xyz), "rpy": list(pose.rpy)}
 
 
-@dataclass
+@record(frozen=False)
 class _Joint:
     """An SDF joint as read, before the tree is chosen. axis: (xyz, the frame it is
     expressed in, None for the joint frame)."""

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -39,6 +38,7 @@ from mpc.backends.usd_meshes import Triangles
 from mpc.backends.usd_names import sibling_names, unique_identifiers
 from mpc.backends.usd_pxr import Gf, Layer, PrimPath, Quat, Sdf, Vt
 from mpc.backends.usd_specs import PrimSpec, T
+from mpc.core.record import record
 from mpc.ir import transforms as tf
 from mpc.ir.extras import CutJoint
 from mpc.ir.geometry import Box, ConvexHull, ConvexPart, Cylinder, Geometry, Mesh, Sphere
@@ -51,7 +51,7 @@ _AXES = ("X", "Y", "Z")
 DEG = 180.0 / math.pi
 
 
-@dataclass(frozen=True)
+@record
 class Layers:
     """Where each part is authored (the same layer for `layout: single`)."""
 

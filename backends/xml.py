@@ -13,13 +13,13 @@ import itertools
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from lxml import etree
 
 from mpc.core.diagnostics import Sink
-from mpc.core.record import maker
+from mpc.core.record import maker, record
 from mpc.core.span import Span, hardened_parser, located_span
 
 # Comments, CDATA, processing instructions, doctype and start tags (`<` and the name), in
@@ -47,7 +47,7 @@ class XmlError(Exception):
         self.message, self.line, self.col = message, line, col
 
 
-@dataclass
+@record(frozen=False)
 class XmlSource:
     """A parsed XML file that can say where each of its elements and attributes is.
 

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
+from mpc.core.record import record
 
-@dataclass(frozen=True)
+
+@record
 class Change:
     """element: what changed (link, joint, collision, visual, material, motor, sensor, pose,
     submechanism, annotation, robot); name: its name in the new model (in the old one when

@@ -10,17 +10,18 @@ renamed chain is found link by link; what stays unpaired was removed or added.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from mpc.core.record import record
 from mpc.ir.kinematics import links_in_root
 from mpc.ir.program import Tolerances
 from mpc.ir.robot import Robot
 from mpc.ir.tree import parent_joint
 
 
-@dataclass
+@record(frozen=False)
 class Matching:
     """links, joints: {old name: new name} of the elements in both models (renamed or not)."""
 

@@ -12,7 +12,7 @@ of inertia by `default` relative to the link's largest.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import numpy as np
@@ -22,13 +22,14 @@ from mpc.checks.diff_extras import extras
 from mpc.checks.diff_match import Matching, match
 from mpc.checks.diff_shapes import link_shapes
 from mpc.checks.pictures import turned
+from mpc.core.record import record
 from mpc.ir.inertia import body, combine, placed
 from mpc.ir.kinematics import links_in_root
 from mpc.ir.program import Tolerances
 from mpc.ir.robot import Inertial, Joint, Link, Robot
 
 
-@dataclass
+@record(frozen=False)
 class Diff:
     """The changes from `old` to `new`, in report order, and how their links and joints pair."""
 

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import tarfile
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.robot import Robot
 
@@ -26,7 +26,7 @@ class BadSide(Exception):
     """The command line names no side that can exist (exit 2, as for any bad argument)."""
 
 
-@dataclass
+@record(frozen=False)
 class Side:
     """robot: the model; path: the file it was read from; label: the side as given."""
 

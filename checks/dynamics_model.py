@@ -17,11 +17,11 @@ torque of the joint it follows includes its load (τ_j = g_j + multiplier · g_k
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from mpc.core.record import record
 from mpc.ir.kinematics import pose_matrix
 from mpc.ir.robot import Pose, Robot
 
@@ -32,7 +32,7 @@ class DynamicsError(Exception):
     """The model cannot be built or moved in Pinocchio; the message says why."""
 
 
-@dataclass(frozen=True)
+@record
 class MimicCoupling:
     """q_follower = multiplier · q_leader + offset; Pinocchio joint ids of one-coordinate joints."""
 
@@ -42,7 +42,7 @@ class MimicCoupling:
     offset: float
 
 
-@dataclass
+@record(frozen=False)
 class Dynamics:
     """A Pinocchio model of a robot, its loop constraints and which joints are actuated.
 

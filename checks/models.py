@@ -9,18 +9,19 @@ from __future__ import annotations
 
 import hashlib
 import shutil
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any
 
 from mpc.core.diagnostics import Sink
 from mpc.core.files import resolved
+from mpc.core.record import record
 from mpc.ir.extras import Submechanism
 from mpc.ir.program import CompareTarget, Program, SdfExport, UrdfExport
 from mpc.ir.robot import Robot
 
 
-@dataclass
+@record(frozen=False)
 class Model:
     """A model under test: its robot value and the file it was read from.
 

@@ -15,12 +15,13 @@ from __future__ import annotations
 import hashlib
 import math
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 import numpy as np
 
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir import transforms as tf
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere, is_generated
@@ -37,7 +38,7 @@ SIDES = ("release", "new", "overlay")
 TREE = "kinematic_tree.pdf"  # the model's pdf export, its changed links coloured
 
 
-@dataclass
+@record(frozen=False)
 class VisualDiff:
     """The pictures of a test run. files: {file name: PNG bytes} (written into FOLDER);
     views: the views drawn, in order; changed: {link: why}; problem: why nothing was drawn;

@@ -10,11 +10,12 @@ from __future__ import annotations
 import json
 import re
 import shutil
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 from mpc.backends import xml_escape
+from mpc.core.record import record
 
 if TYPE_CHECKING:
     from mpc.checks.pictures import VisualDiff
@@ -26,7 +27,7 @@ _SIDES = ("release", "new", "overlay")  # the pictures of each view (checks/pict
 _SIGN = {"passed": "✅ passed", "failed": "❌ failed", "waived": "⚠️ waived", "skipped": "⏭️ skipped"}
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Tolerance:
     """A bound a figure was held to: `|figure| ≤ value` in `unit`, always absolute (a
     tolerance is never a fraction of the compared value). name: its key in `tolerances`."""
@@ -39,7 +40,7 @@ class Tolerance:
         return f"`{self.name}` ≤ {self.value:g}{' ' + self.unit if self.unit else ''}"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@record(slots=True, kw_only=True)
 class Result:
     """The outcome of one test.
 
@@ -82,7 +83,7 @@ def verdict(name: str, ok: bool, reason: str, **kw: object) -> Result:
     return (passed if ok else failed)(name, reason, **kw)
 
 
-@dataclass(slots=True)
+@record(slots=True, frozen=False)
 class Protocol:
     """Every test's result of one model, in the order they ran."""
 

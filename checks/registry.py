@@ -9,12 +9,13 @@ needs="both" `ctx.compare`); else its result says why.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Literal
 
 from mpc.checks.models import Model
 from mpc.checks.protocol import Result, Tolerance, failed, skipped
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.ir.program import ModelTest, Program, TestPlan, Tolerances
 from mpc.ir.robot import Robot
 
@@ -40,7 +41,7 @@ def register(name: str, dynamics: bool = False, needs: Literal["built", "both"] 
     return add
 
 
-@dataclass
+@record(frozen=False)
 class Context:
     """What the tests of one model share.
 

@@ -15,10 +15,10 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-from dataclasses import dataclass
 
 import numpy as np
 
+from mpc.core.record import record
 from mpc.ir.geometry import Geometry, Mesh
 from mpc.ir.shape_keys import shape_key
 
@@ -26,7 +26,7 @@ VERSION = "1"  # changes when what is computed changes, so that old entries go u
 Vec3 = tuple[float, float, float]
 
 
-@dataclass(frozen=True)
+@record
 class Figures:
     """bounds: (least, greatest) corner in the shape's frame, None when its mesh cannot be read;
     closed: a closed solid (volume and moments mean something only then)."""

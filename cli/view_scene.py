@@ -7,7 +7,7 @@ applied, as every export does.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from mpc.backends import meshes
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.kinematics import pose_matrix
@@ -68,7 +69,7 @@ def node_name(text: str) -> str:
     return text.replace("/", "_") or "_"
 
 
-@dataclass
+@record(frozen=False)
 class RobotScene:
     """A robot drawn in a viser server under `/<prefix>/`: handles by link and by kind."""
 

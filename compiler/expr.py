@@ -9,12 +9,12 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import lru_cache
 
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
 from mpc.compiler.expr_syntax import ExprSyntaxError, parse_text
 from mpc.core.diagnostics import Sink, did_you_mean
+from mpc.core.record import record
 from mpc.core.span import Span, source_line
 
 CONSTANTS: dict[str, float] = {"pi": math.pi}
@@ -146,7 +146,7 @@ def _expression(text: str, where: _Where, sink: Sink, what: str) -> float | None
     return result
 
 
-@dataclass
+@record(frozen=False)
 class _Evaluator:
     """Computes a node tree; reports every bad name and call in it, not only the first."""
 

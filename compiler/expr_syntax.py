@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from mpc.compiler.expr_nodes import Binary, Call, Name, Node, Num, Unary
+from mpc.core.record import record
 
 _CHAR_HINTS = {"^": "use ** for powers", "π": "write pi"}
 
@@ -37,7 +37,7 @@ class ExprSyntaxError(Exception):
         self.offset, self.found, self.hint = offset, found, hint
 
 
-@dataclass(frozen=True)
+@record
 class _Token:
     kind: str  # a terminal's name, the punctuation itself, or "$END"
     text: str
@@ -45,7 +45,7 @@ class _Token:
     end: int
 
 
-@dataclass(frozen=True)
+@record
 class _Part:
     """A parsed operand and the span it takes in the expression around it (its parentheses)."""
 

@@ -8,12 +8,13 @@ of derived_base definitions is a diagnostic naming the loop.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from mpc.compiler.options import Options
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import project_root, why_absent
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.geometry import Mesh
 from mpc.ir.names import Names
@@ -26,7 +27,7 @@ Build = Callable[[Path, Sink, Options, tuple[Path, ...]], Robot | None]
 FindNames = Callable[[Path, Sink, Options, tuple[Path, ...]], Names | None]
 
 
-@dataclass
+@record(frozen=False)
 class InputLoader:
     """Loads input models for one compilation (and the derived_base definitions below it).
 

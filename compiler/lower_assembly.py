@@ -8,19 +8,18 @@ reads no model: names in `joint:` are edited by the rules of their part, as writ
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from mpc.compiler.expr import evaluate
 from mpc.compiler.lower_context import LowerContext, items_span
 from mpc.compiler.schema.assembly import AssembleChild, AssemblyEntry, AttachJoint
 from mpc.core.diagnostics import did_you_mean
+from mpc.core.record import record
 from mpc.ir.naming import LINK_SUFFIX, NameRule, edit_name, takes_link_suffix
 from mpc.ir.ops import ROOT, Attach, EditNames, LoadModel, Mirror, Op, RemoveBeyond, TakeLeaf
 from mpc.ir.program import Input
 from mpc.ir.robot import Limit, Pose
 
 
-@dataclass(frozen=True)
+@record
 class _Part:
     """A lowered part of the assembly: its name rules and `append_link_suffix` (which the
     names of its attaching follow), and its ops with its children's."""

@@ -9,7 +9,7 @@ puts them together. It reads no file.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -19,11 +19,12 @@ from mpc.compiler.schema.base import Node
 from mpc.core.diagnostics import Severity, Sink
 from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.naming import SCOPES, NameRule, bad_pattern
 
 
-@dataclass(frozen=True)
+@record
 class LowerContext:
     """The definition being lowered. `later`: how a part of the language that compiling does
     not support yet is reported (an error for `compile`, a warning for `check`)."""

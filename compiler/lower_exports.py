@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 import shlex
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +23,7 @@ from mpc.compiler.lower_smurf import SmurfLowering
 from mpc.compiler.schema import exports as schema
 from mpc.compiler.schema.base import Node
 from mpc.core.diagnostics import did_you_mean
+from mpc.core.record import record
 from mpc.ir.program import (
     CommandExport,
     Export,
@@ -349,7 +350,7 @@ class _Exports:
 Lower = Callable[[_Exports, Any, str, str, bool], list[Export]]
 
 
-@dataclass(frozen=True)
+@record
 class Lowering:
     """How the compiler takes an export type: its schema node (the `export_config` entry) and the
     function that lowers an entry (the exports, the entry, the robot's name, the submodel that

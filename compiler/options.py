@@ -6,20 +6,21 @@ from __future__ import annotations
 
 from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.core.diagnostics import Diagnostic, Sink
 from mpc.core.files import resolved
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 
 if TYPE_CHECKING:
     from mpc.core import yaml_source as source
     from mpc.ir.robot import Robot
 
 
-@dataclass
+@record(frozen=False)
 class Options:
     """How to compile: where outputs go, how packages are found."""
 
@@ -40,7 +41,7 @@ class Options:
     post_processing: bool = True
 
 
-@dataclass
+@record(frozen=False)
 class ModelCache:
     """Input models read once and kept while their file stays the same (modification time and
     size): a server re-checks a definition on every keystroke without re-reading a URDF.

@@ -8,7 +8,7 @@ Exceptions are for compiler bugs only. The codes are listed in specs/diagnostics
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import Enum
 
 from mpc.core.record import record
@@ -48,7 +48,7 @@ class FailFast(Exception):
         self.diagnostic = diagnostic
 
 
-@dataclass
+@record(frozen=False)
 class Sink:
     """Collects diagnostics.
 
@@ -92,7 +92,7 @@ class Sink:
         return iter(self.diagnostics)
 
 
-@dataclass
+@record(frozen=False)
 class LocatedSink:
     """A Sink bound to a span (MakePolicyForNode in Drake's terms)."""
 

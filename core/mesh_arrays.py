@@ -16,16 +16,18 @@ from __future__ import annotations
 
 import re
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
+
+from mpc.core.record import record
 
 TOL_ZERO = float(np.finfo(np.float64).resolution * 100)  # trimesh's: a degenerate triangle's normal is 0
 TRIMESH_HEADER = "# https://github.com/mikedh/trimesh"  # the first line of every OBJ mpc has written
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Arrays:
     """A triangle mesh: (n, 3) float64 vertices and (m, 3) int64 triangles."""
 

@@ -25,11 +25,12 @@ import re
 import stat
 import sys
 import sysconfig
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mpc.core.reads import note_package
+from mpc.core.record import record
 
 if TYPE_CHECKING:
     from mpc.core.files import Roots
@@ -170,7 +171,7 @@ def _path_list(variable: str) -> list[str]:
 MODEL_FOLDERS = frozenset({"urdf", "sdf", "smurf", "mjcf"})
 
 
-@dataclass
+@record(frozen=False)
 class PackageResolver:
     """Finds the folder of a ROS package by name (see the module docstring)."""
 

@@ -292,15 +292,22 @@ def _check_defaults(cls: type) -> None:
 @overload
 def record(cls: T, /) -> T: ...
 @overload
-def record(*, slots: bool = False, kw_only: bool = False, bulk: bool = False) -> Callable[[T], T]: ...
+def record(*, slots: bool = False, kw_only: bool = False, bulk: bool = False,
+           frozen: bool = True) -> Callable[[T], T]: ...
 
 
 @dataclass_transform(frozen_default=True)
-def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bulk: bool = False) -> Any:
+def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bulk: bool = False,
+           frozen: bool = True) -> Any:
     """`@dataclass(frozen=True, …)` with its methods from this module. bulk: a class a reader
-    makes by the thousand, given a `maker` (needs slots)."""
+    makes by the thousand, given a `maker` (needs slots). frozen=False: `@dataclass(…)`, a
+    mutable class (`_mutable`)."""
     if bulk and not slots:
         raise TypeError("@record(bulk=True) needs slots=True")
+    if not frozen:
+        if bulk:
+            raise TypeError("@record(bulk=True) is frozen")
+        return (lambda c: _mutable(c, slots, kw_only)) if cls is None else _mutable(cls, slots, kw_only)
 
     def wrap(c: T) -> T:
         written = "__init__" in c.__dict__
@@ -330,3 +337,24 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bu
         return out
 
     return wrap if cls is None else wrap(cls)
+
+
+def _mutable(c: T, slots: bool, kw_only: bool) -> T:
+    """`@dataclass(slots=…, kw_only=…)` with repr and == from this module and `__init__` compiled
+    for the first object made, as a record's: dataclass would compile three methods when the
+    class is made (0.2–0.5 ms each class; most of mpc's state classes are imported by every
+    process). Unhashable, as dataclass makes a mutable class with ==; no record (`is_record`):
+    the build cache reads none back."""
+    written = "__init__" in c.__dict__
+    classic = _needs_dataclass_init(c)
+    out = dataclass(c, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
+    for name, method in (("__repr__", _repr), ("__eq__", _eq), ("__hash__", None)):
+        if name not in c.__dict__:
+            setattr(out, name, method)
+    if not classic and not written:
+        _check_defaults(out)
+        out.__init__ = _first_init(out)  # type: ignore[misc]
+        _OWN_INIT.add(out)
+    if classic:
+        _CLASSIC.add(out)
+    return out

@@ -17,7 +17,7 @@ import re
 import stat
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +26,7 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mpc.core.diagnostics import Sink
 from mpc.core.files import special_problem
-from mpc.core.record import maker
+from mpc.core.record import maker, record
 from mpc.core.span import Span
 
 Path_ = tuple[str | int, ...]
@@ -64,7 +64,7 @@ for tag, pattern, first in [
     _Resolver.add_implicit_resolver(tag, re.compile(pattern), list(first))
 
 
-@dataclass(frozen=True)
+@record
 class Limits:
     """How much YAML one file may hold; far above any model definition or SMURF file.
 
@@ -122,7 +122,7 @@ class _Composer(yaml.reader.Reader, yaml.scanner.Scanner, yaml.parser.Parser,
             self.depth -= 1
 
 
-@dataclass
+@record(frozen=False)
 class Document:
     """A loaded YAML file: its data and where each part of it was written.
 

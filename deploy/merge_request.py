@@ -4,12 +4,11 @@ and its description. No git and no network here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from mpc.core.record import record
 from mpc.deploy.gitcmd import scrub
 
 
-@dataclass(frozen=True)
+@record
 class MergeRequest:
     """A merge request from `source` into `target` of the repository at `remote`."""
 

@@ -8,9 +8,9 @@ summary. It reads files and repositories; it writes nothing.
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.core.record import record
 from mpc.core.version import mpc_version
 from mpc.deploy.gitcmd import scrub, without_credentials
 from mpc.deploy.test_outcome import TestOutcome
@@ -40,7 +40,7 @@ def _sha256(path: Path) -> str | None:
         return None
 
 
-@dataclass(frozen=True)
+@record
 class Provenance:
     """What a deployment records. definition: `<commit>[+dirty]` of the definitions, or None;
     inputs: one line per input model; tests: the test summary."""

@@ -13,9 +13,9 @@ import fcntl
 import hashlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.core.record import record
 from mpc.deploy.forges import ForgeAdapter
 from mpc.deploy.gitcmd import EMPTY_TREE, DeployError, Git, without_credentials
 from mpc.deploy.merge_request import MergeRequest
@@ -24,7 +24,7 @@ from mpc.deploy.pictures import link_pictures
 ATTEMPTS = 3
 
 
-@dataclass
+@record(frozen=False)
 class Clone:
     """mpc's clone of a repository. default_branch: the remote's HEAD branch."""
 
@@ -153,7 +153,7 @@ def commit(git: Git, message: str) -> str:
     return git("rev-parse", "HEAD")
 
 
-@dataclass
+@record(frozen=False)
 class Published:
     """What `publish` did. sha: the new commit (None: nothing to commit). output: the
     push's messages (a forge may print the merge request's address there)."""

@@ -3,15 +3,16 @@ pipeline's status.json. Addresses in it are shown ones: without credentials."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from mpc.core.record import record
 from mpc.deploy.forges import ForgeAdapter
 from mpc.deploy.gitcmd import scrub
 from mpc.deploy.merge_request import MergeRequest
 from mpc.deploy.repository import Published
 
 
-@dataclass
+@record(frozen=False)
 class DeployResult:
     """What deploying one model did.
 

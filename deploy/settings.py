@@ -10,17 +10,18 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from mpc.compiler.schema.definition import PipelineSection
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.ir.program import Deployment
 
 DEFAULT_FAILURE_BRANCH = "tests-failed"
 
 
-@dataclass
+@record(frozen=False)
 class DeploySettings:
     """How models are deployed.
 

@@ -9,15 +9,15 @@ submodule is ever checked out inside the model repository.
 from __future__ import annotations
 
 import tarfile
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.core.record import record
 from mpc.deploy.gitcmd import DeployError, Git, without_credentials
 from mpc.deploy.repository import folder_for, locked
 from mpc.ir.program import DeploySubmodule
 
 
-@dataclass(frozen=True)
+@record
 class Pinned:
     """A submodule resolved: the url written into .gitmodules (as in the definition, without
     credentials), the url fetched from (absolute), its branch, its commit, its cache."""

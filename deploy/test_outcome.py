@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.core.record import record
 from mpc.deploy.gitcmd import DeployError
 
 JSON, MARKDOWN = "test_protocol.json", "test_protocol.md"
@@ -24,7 +24,7 @@ _VERDICT = re.compile(r"\A## Model tests of .*: \*\*(passed|failed)\*\*")
 _COUNTS = re.compile(r"\b\d+ (?:passed|failed|skipped)\b(?:[,;]? *\d+ (?:passed|failed|skipped)\b)*")
 
 
-@dataclass(frozen=True)
+@record
 class TestOutcome:
     """failed: the model goes to the failure branch. markdown: the protocol for the merge
     request, if any. counts: `3 passed, 1 failed`, when known. ran: whether a protocol

@@ -35,8 +35,10 @@ from collections.abc import Callable, Iterator, Mapping
 from fnmatch import fnmatchcase
 from typing import Annotated, Any, Union, get_args, get_origin
 
+from mpc.core.record import record
 
-@dataclasses.dataclass(frozen=True, slots=True)
+
+@record(slots=True)
 class Ref:
     """The mark of a field that names an element: the kinds it may be (the first one that has
     the name, in this order), and whether the record defines the name rather than uses it."""

@@ -12,12 +12,13 @@ note naming the mesh. Primitives are exact (analytic) as long as they do not ove
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 import trimesh
 from manifold3d import Error, Manifold, Mesh64, OpType
 
+from mpc.core.record import record
 from mpc.ir.geometry import Box, Cylinder, Mesh, Sphere
 from mpc.ir.inertia import Body, combine, placed
 
@@ -124,7 +125,7 @@ def mesh_name(mesh: Mesh) -> str:
     return mesh.source.uri
 
 
-@dataclass
+@record(frozen=False)
 class Solid:
     """A shape as a solid in its own frame: props (a Body whose mass is the volume: density 1;
     exact for primitives), its manifold, and notes on repairs or the convex-hull fallback

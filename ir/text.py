@@ -319,7 +319,7 @@ def _terminal(name: str) -> str:
         return name
 
 
-@dataclasses.dataclass
+@record(frozen=False)
 class _Builder:
     """Records → Program: classes from the registry, fields checked by their type hints."""
 

@@ -216,7 +216,7 @@ class Where:
         return Where(self.owner, self.path + suffix)
 
 
-@dataclass
+@record(frozen=False)
 class Converter:
     """Value nodes → typed values by the type hints; errors go to `errors` as (span, code, message)."""
 

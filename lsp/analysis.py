@@ -10,7 +10,7 @@ model file. What this does not do: talk LSP (server.py), or build outputs.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 
 from mpc.compiler import front_end, ops_run
@@ -22,6 +22,7 @@ from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import describe, resolved
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.ops import Attach, LoadModel, Op
@@ -33,7 +34,7 @@ from mpc.ir.robot import Robot
 _ORIGINS: dict[tuple[str, tuple[tuple[str, str], ...], int, int], dict[int, tuple[str, Span]]] = {}
 
 
-@dataclass(frozen=True)
+@record
 class Step:
     """An op that ran on known names, with its part's names before and after it (and, for an
     attach, the child part's names as it joins)."""
@@ -44,7 +45,7 @@ class Step:
     child: Names | None = None
 
 
-@dataclass(frozen=True)
+@record
 class Site:
     """A link, joint or other name written in the definition, and what it names."""
 
@@ -53,7 +54,7 @@ class Site:
     defines: bool
 
 
-@dataclass
+@record(frozen=False)
 class Analysis:
     """What one check of a buffer found.
 

@@ -10,16 +10,16 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
+from mpc.core.record import record
 from mpc.lsp.structures import Position, Range
 
 _BREAK = re.compile(r"\r\n|\r|\n")
 
 
-@dataclass
+@record(frozen=False)
 class Document:
     uri: str
     text: str

@@ -28,8 +28,9 @@ A refused frame comes out as a `Frame` with `problem` set, so that the server ca
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import BinaryIO
+
+from mpc.core.record import record
 
 MAX_BODY = 256 * 2**20  # bytes: larger is taken for a damaged header, not read
 MAX_LINE = 8192  # bytes of a header line read at once
@@ -44,7 +45,7 @@ _HEADER = re.compile(rb"([!-9;-~]+)[ \t]*:[ \t]*(.*?)[ \t]*\r?\n", re.DOTALL)
 _UTF8 = {"utf-8", "utf8"}
 
 
-@dataclass(frozen=True)
+@record
 class Frame:
     """One frame of the stream: its body, or why it was refused (and the body is None)."""
 

@@ -7,10 +7,10 @@ What this does not do: format answers (hover.py, navigation.py).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 from mpc.core.packages import PackageResolver
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.robot import Joint, Link, Robot
 from mpc.lsp.analysis import Analysis
@@ -21,7 +21,7 @@ from mpc.lsp.xacro_sources import find_element
 _WORD = re.compile(r"[^\s:\[\],{}\"'#]+")
 
 
-@dataclass(frozen=True)
+@record
 class Target:
     """The word at the cursor. keys: the keys above it; key: its line's key; on_key: the word is
     that key; kinds: what it names (empty: no name); span: where it is (1-based, this buffer)."""

@@ -10,8 +10,10 @@ $.params.position`, `expected an integer ≥ 0 @ $.params.position.line`.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
+
+from mpc.core.record import record
 
 
 class Shape:
@@ -21,7 +23,7 @@ class Shape:
         raise NotImplementedError
 
 
-@dataclass(frozen=True)
+@record
 class Scalar(Shape):
     """A JSON scalar: `kinds` the Python types json.loads gives it, `name` in the problem."""
 
@@ -35,7 +37,7 @@ class Scalar(Shape):
             yield f"expected {self.name} @ {at}"
 
 
-@dataclass(frozen=True)
+@record
 class Obj(Shape):
     """An object with these fields (and any others); `optional` ones may be left out."""
 
@@ -56,7 +58,7 @@ class Obj(Shape):
                 yield from shape.problems(value[name], f"{at}.{name}")
 
 
-@dataclass(frozen=True)
+@record
 class Items(Shape):
     """An array of values of one shape."""
 

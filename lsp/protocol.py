@@ -14,9 +14,9 @@ What a well-formed message asks is the endpoint's to answer (lsp/endpoint.py).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from typing import Any
 
+from mpc.core.record import record
 from mpc.lsp.framing import Frame
 
 PARSE_ERROR = -32700
@@ -30,7 +30,7 @@ REQUEST_CANCELLED = -32800  # LSP's: the client cancelled the request
 MessageId = int | str
 
 
-@dataclass(frozen=True)
+@record
 class Message:
     """A well-formed message. A request has a method and an id, a notification a method and no
     id, a response an id and no method (its result or error in `data`)."""

@@ -9,8 +9,8 @@ valid YAML.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.lsp.structures import Position, Range
 
@@ -59,7 +59,7 @@ def contains(span: Span, line: int, col: int) -> bool:
     return (span.line, span.col) <= (line, col) <= (span.end_line, span.end_col)
 
 
-@dataclass(frozen=True)
+@record
 class Context:
     """What is written at the cursor.
 

@@ -17,12 +17,12 @@ import os
 import re
 import shlex
 import subprocess
-from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from mpc.core.diagnostics import Sink
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.core.version import mpc_version
 
@@ -35,7 +35,7 @@ _PATH = f'export PATH="$PWD/{VENV}/bin:$PATH"'
 _NAME = re.compile(r"^\s*model[-_.]pipeline[-_.]compiler\b", re.IGNORECASE)
 
 
-@dataclass(frozen=True)
+@record
 class Install:
     """How jobs install mpc: `lines` of shell (GitLab `before_script`, one GitHub step);
     `source`, what they install from (for the generated file's header); `files`, the project

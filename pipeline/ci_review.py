@@ -18,9 +18,9 @@ import sys
 import tempfile
 import urllib.error
 import urllib.request
-from dataclasses import dataclass
 from pathlib import Path
 
+from mpc.core.record import record
 from mpc.pipeline import dag
 from mpc.pipeline.plan import Plan
 
@@ -28,7 +28,7 @@ MARK = "<!-- mpc ci review -->"  # the first line of the comment: what made it
 GITLAB_TOKENS = ("MPC_GITLAB_TOKEN", "GITLAB_TOKEN")
 
 
-@dataclass(frozen=True)
+@record
 class Target:
     """The merge request to comment on: forge (gitlab, github), the API's address, the project
     (GitLab's id, GitHub's owner/name), the request's number and its base commit."""

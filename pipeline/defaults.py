@@ -16,17 +16,17 @@ default is reported where it was written.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 # The merge of defaults files, reused so both layers follow one rule.
 from mpc.compiler.inherit import copy_value, forget_spans, merge_value
+from mpc.core.record import record
 from mpc.core.yaml_source import Document
 
 _MERGED = (("test", "default_test"), ("deployment", "default_deployment"))
 
 
-@dataclass(frozen=True)
+@record
 class PipelineDefaults:
     """The `default_…` settings of one pipeline file, applied to each definition it builds."""
 

@@ -12,7 +12,7 @@ import itertools
 import os
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -21,6 +21,7 @@ from mpc.compiler import inherit
 from mpc.core import yaml_source as source
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
 from mpc.core.files import input_problem, project_root, resolved, why_absent
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.core.yaml_source import Document
 from mpc.pipeline import dag, verdicts
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
     from mpc.compiler.schema.definition import PipelineSection
 
 
-@dataclass
+@record(frozen=False)
 class PlannedModel:
     """One entry of `model_definitions`.
 
@@ -56,7 +57,7 @@ class PlannedModel:
         return any(d.severity is Severity.ERROR for d in self.diagnostics)
 
 
-@dataclass
+@record(frozen=False)
 class Plan:
     """A loaded pipeline file: its path, document, settings (the `pipeline` mapping as
     written), the workspace root and the models in the file's order; `section`, the

@@ -20,7 +20,7 @@ import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from mpc.core.cores import usable_cores
 from mpc.core.diagnostics import Diagnostic, Severity
 from mpc.core.files import describe
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.core.version import source_version
 from mpc.pipeline import schedule
@@ -52,7 +53,7 @@ if TYPE_CHECKING:
     from mpc.compiler.driver import Options
 
 
-@dataclass
+@record(frozen=False)
 class RunOptions:
     """What to run: the stages (each with the stages it needs), the models (`only`; empty:
     all), how many workers, whether to ignore the cache, the build folder (None:
@@ -81,7 +82,7 @@ class Reporter(Protocol):
     def close(self) -> None: ...
 
 
-@dataclass
+@record(frozen=False)
 class _Running:
     """A model whose worker runs: its process and the pipe it answers on; `pre`, its
     fingerprint before building (freshness.before_build); the stages it runs and those that

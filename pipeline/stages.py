@@ -14,11 +14,12 @@ is there also when the test stage is cached).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from mpc.core.diagnostics import Diagnostic, Severity, Sink
+from mpc.core.record import record
 
 if TYPE_CHECKING:
     from mpc.compiler.driver import Options
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
 KNOWN = ("compile", "test", "deploy")  # every stage name, in the order they run
 
 
-@dataclass
+@record(frozen=False)
 class StageOutcome:
     """What a stage did for one model.
 
@@ -53,7 +54,7 @@ class StageOutcome:
     cached: bool = False
 
 
-@dataclass
+@record(frozen=False)
 class StageJob:
     """Everything a stage gets for one model (one job per model, shared by its stages).
 
@@ -91,7 +92,7 @@ class StageJob:
     results: dict[str, StageOutcome] = field(default_factory=dict)
 
 
-@dataclass(frozen=True)
+@record
 class Stage:
     """A registered stage: its name, its function, and the stages it needs to have
     succeeded (or been cached) for the same model; otherwise it is skipped."""

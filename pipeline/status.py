@@ -8,15 +8,16 @@ the stage had nothing to do), `interrupted` (the run was stopped).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from mpc.core.diagnostics import Diagnostic, Severity
+from mpc.core.record import record
 
 GOOD = ("ok", "cached")
 
 
-@dataclass
+@record(frozen=False)
 class StageRecord:
     """One stage of one model in this run.
 
@@ -32,7 +33,7 @@ class StageRecord:
     blocked: bool = False
 
 
-@dataclass
+@record(frozen=False)
 class ModelRecord:
     """A model of this run: its definition, parents and the record of each selected stage;
     for a model a worker built, when the worker started (seconds since the run started) and
@@ -54,7 +55,7 @@ class ModelRecord:
         return [*self.warnings, *(d for r in self.stages.values() for d in r.diagnostics)]
 
 
-@dataclass
+@record(frozen=False)
 class RunStatus:
     """The whole run, in the order models finished."""
 

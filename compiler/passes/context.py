@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from mpc.core.diagnostics import Severity, Sink
+from mpc.core.record import record
 from mpc.core.span import Span
 from mpc.ir.names import Names
 from mpc.ir.program import Input
@@ -19,7 +20,7 @@ def _nowhere(_: Input, kind: str, name: str) -> Span | None:
     return None
 
 
-@dataclass
+@record(frozen=False)
 class PassContext:
     """What every pass may use: the diagnostics sink, the input models' names, and whether
     what compiling does not support yet is an error (compile) or a warning (check)."""
