@@ -353,7 +353,7 @@ def _mutable(c: T, slots: bool, kw_only: bool) -> T:
             setattr(out, name, method)
     if not classic and not written:
         _check_defaults(out)
-        out.__init__ = _first_init(out)  # type: ignore[misc]
+        out.__init__ = _first_init(out)
         _OWN_INIT.add(out)
     if classic:
         _CLASSIC.add(out)

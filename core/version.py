@@ -73,7 +73,8 @@ def source_version() -> str:
     h = hashlib.sha256(ver.encode())
     for name, file, _ in files:
         h.update(name.encode())
-        h.update(file.read_bytes())
+        with open(file, "rb") as f:
+            h.update(f.read())
     with contextlib.suppress(OSError):
         kept.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(kept, h.hexdigest()[:16])
@@ -82,17 +83,18 @@ def source_version() -> str:
 
 def source_files() -> list[tuple[str, Path]]:
     """mpc's own source files (Python and grammars), each with its name inside `mpc`."""
-    return [(name, file) for name, file, _ in _source_stats()]
+    return [(name, Path(file)) for name, file, _ in _source_stats()]
 
 
-def _source_stats() -> list[tuple[str, Path, os.stat_result]]:
-    """mpc's own source files, each with its name inside `mpc` and its status, sorted by name.
+def _source_stats() -> list[tuple[str, str | os.PathLike[str], os.stat_result]]:
+    """mpc's own source files, each with its name inside `mpc`, its path and its status, sorted
+    by name. Paths are plain strings: every mpc process asks (a Path each took half the walk).
 
     The packages are found through the `mpc` namespace, not as the folders next to
     `core/`: in a checkout those include tests/, which are not part of mpc.
     """
     out = []
-    packages = _packages(Path(__file__).resolve().parent.parent)
+    packages = _packages(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
     for name in sorted(packages):
         todo = [(packages[name], name)]
         while todo:
@@ -103,11 +105,11 @@ def _source_stats() -> list[tuple[str, Path, os.stat_result]]:
                         if entry.name != "__pycache__":
                             todo.append((entry.path, f"{prefix}/{entry.name}"))
                     elif entry.name.endswith((".py", ".lark")) and entry.is_file():
-                        out.append((f"{prefix}/{entry.name}", Path(entry.path), entry.stat()))
+                        out.append((f"{prefix}/{entry.name}", entry.path, entry.stat()))
     return sorted(out, key=lambda item: item[0])
 
 
-def _packages(top: Path) -> dict[str, str]:
+def _packages(top: str) -> dict[str, str]:
     """The subpackages of `mpc` in `top`: its folders that `import mpc.NAME` finds there."""
     import importlib.util
 
@@ -118,6 +120,6 @@ def _packages(top: Path) -> dict[str, str]:
                 continue
             spec = importlib.util.find_spec(f"mpc.{entry.name}")
             locations = spec.submodule_search_locations if spec is not None else None
-            if locations and Path(next(iter(locations))).resolve() == Path(entry.path).resolve():
+            if locations and os.path.realpath(next(iter(locations))) == os.path.realpath(entry.path):
                 out[entry.name] = entry.path
     return out

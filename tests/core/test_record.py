@@ -298,3 +298,59 @@ def test_subclasses_of_records_with_their_own_or_dataclass_s_init() -> None:
     assert FromInitVar(2, 3).a == 6 and FromInitVar(2, 3, 4).b == 4
     with pytest.raises(dataclasses.FrozenInstanceError):
         FromInitVar(1).b = 2  # type: ignore[misc]
+
+
+@record(frozen=False)
+class State:
+    name: str
+    items: list[int] = dataclasses.field(default_factory=list)
+    count: int = dataclasses.field(default=0, kw_only=True)
+
+    def __post_init__(self) -> None:
+        self.count += len(self.items)
+
+
+@dataclasses.dataclass
+class DataState:
+    name: str
+    items: list[int] = dataclasses.field(default_factory=list)
+    count: int = dataclasses.field(default=0, kw_only=True)
+
+    def __post_init__(self) -> None:
+        self.count += len(self.items)
+
+
+@record(slots=True, frozen=False)
+class SlotState:
+    x: float
+    y: float = 0.0
+
+
+def test_mutable_records_are_made_and_behave_as_dataclass_s() -> None:
+    """@record(frozen=False) is @dataclass's mutable class: the same __init__ (defaults, a fresh
+    default_factory value, keyword-only fields, __post_init__), repr and ==, unhashable, and its
+    fields assignable; dataclass compiles none of its methods when the class is made."""
+    for _ in range(2):  # the first object made puts the compiled __init__ in place
+        mine, theirs = State("a", [1, 2], count=1), DataState("a", [1, 2], count=1)
+        assert repr(mine) == repr(theirs).replace("DataState(", "State(") == \
+            "State(name='a', items=[1, 2], count=3)"
+        assert mine == State("a", [1, 2], count=1) and mine != State("b") and mine != theirs
+        assert State("a").items is not State("a").items
+        mine.name = "b"
+        mine.items.append(3)
+        assert mine == State("b", [1, 2, 3], count=0)
+        with pytest.raises(TypeError, match="unhashable type: 'State'"):
+            hash(mine)
+        with pytest.raises(TypeError, match=r"State.__init__\(\) missing 1 required positional"):
+            State()  # type: ignore[call-arg]
+    assert State.__init__.__code__.co_filename == "<record>"
+    assert str(inspect.signature(State)) == str(inspect.signature(DataState))
+    assert [f.name for f in dataclasses.fields(State)] == ["name", "items", "count"]
+    assert repr(dataclasses.replace(State("a", [1]), name="c")) == \
+        repr(dataclasses.replace(DataState("a", [1]), name="c")).replace("DataState(", "State(")
+    assert not record_module.is_record(State)  # the build cache reads none back
+    state = SlotState(1.0)
+    state.y = 2.0
+    assert state == SlotState(1.0, 2.0) and not hasattr(state, "__dict__")
+    with pytest.raises(TypeError, match="@record\\(bulk=True\\) is frozen"):
+        record(slots=True, bulk=True, frozen=False)
