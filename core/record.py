@@ -181,14 +181,18 @@ def _compiled(source: str, env: dict[str, Any], name: str) -> Callable[..., Any]
 def _init(cls: type) -> Callable[..., None]:
     """The `__init__` dataclass would write for the record `cls` (the same parameters, defaults
     and annotations; each default_factory called for its sentinel; the fields set in order, then
-    `__post_init__`), each field set through its slot's own setter where it has one (twice as
-    fast as object.__setattr__, which the others are set with)."""
+    `__post_init__`), each field of a frozen record set through its slot's own setter where it
+    has one (twice as fast as object.__setattr__, which the others are set with), each field of
+    a mutable one (`_mutable`) assigned."""
     env: dict[str, Any] = {"_set": object.__setattr__}
     params, values = _parameters(cls, env)
     body = []
+    mutable = not cls.__dataclass_params__.frozen
     for f in fields(cls):
         setter = getattr(cls, f.name, None)
-        if isinstance(setter, types.MemberDescriptorType):
+        if mutable:  # as dataclass's own: a plain assignment
+            body.append(f"    self.{f.name} = {values[f.name]}\n")
+        elif isinstance(setter, types.MemberDescriptorType):
             env[f"_s_{f.name}"] = setter.__set__
             body.append(f"    _s_{f.name}(self, {values[f.name]})\n")
         else:
