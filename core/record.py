@@ -314,27 +314,18 @@ def record(cls: Any = None, /, *, slots: bool = False, kw_only: bool = False, bu
         return (lambda c: _mutable(c, slots, kw_only)) if cls is None else _mutable(cls, slots, kw_only)
 
     def wrap(c: T) -> T:
-        written = "__init__" in c.__dict__
         classic = _needs_dataclass_init(c)
         # dataclass writes no method, but a classic record's __init__, and the frozen __setattr__
         # and __delattr__ of a record with a dataclass base (which dataclass requires frozen)
         frozen = classic or any(hasattr(base, "__dataclass_fields__") for base in c.__mro__[1:])
         out = dataclass(c, frozen=frozen, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
-        methods = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
+        methods: list[tuple[str, Any]] = [("__repr__", _repr), ("__eq__", _eq), ("__hash__", _hash)]
         if not frozen:
             methods += [("__setattr__", _frozen_setattr), ("__delattr__", _frozen_delattr)]
             out.__dataclass_params__.frozen = True  # as it is: a frozen dataclass may subclass it
         if slots:  # dataclass's own look each field up anew for every object pickled
             methods += [("__getstate__", _values), ("__setstate__", _setstate)]
-        for name, method in methods:
-            if name not in c.__dict__:
-                setattr(out, name, method)
-        if not classic and not written:
-            _check_defaults(out)
-            out.__init__ = _first_init(out)
-            _OWN_INIT.add(out)
-        if classic:
-            _CLASSIC.add(out)
+        _finish(c, out, methods, classic)
         if bulk:
             _BULK.add(out)
         _RECORDS.add(out)
@@ -349,16 +340,21 @@ def _mutable(c: T, slots: bool, kw_only: bool) -> T:
     class is made (0.2–0.5 ms each class; most of mpc's state classes are imported by every
     process). Unhashable, as dataclass makes a mutable class with ==; no record (`is_record`):
     the build cache reads none back."""
-    written = "__init__" in c.__dict__
     classic = _needs_dataclass_init(c)
     out = dataclass(c, init=classic, repr=False, eq=False, slots=slots, kw_only=kw_only)
-    for name, method in (("__repr__", _repr), ("__eq__", _eq), ("__hash__", None)):
+    _finish(c, out, [("__repr__", _repr), ("__eq__", _eq), ("__hash__", None)], classic)
+    return out
+
+
+def _finish(c: type, out: type, methods: list[tuple[str, Any]], classic: bool) -> None:
+    """Puts on the class `out` that dataclass made of `c` each of `methods` that `c` does not
+    define, and record's `__init__` unless `c` has its own or dataclass wrote it (`classic`)."""
+    for name, method in methods:
         if name not in c.__dict__:
             setattr(out, name, method)
-    if not classic and not written:
+    if classic:
+        _CLASSIC.add(out)
+    elif "__init__" not in c.__dict__:
         _check_defaults(out)
         out.__init__ = _first_init(out)
         _OWN_INIT.add(out)
-    if classic:
-        _CLASSIC.add(out)
-    return out
