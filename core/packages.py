@@ -186,7 +186,6 @@ class PackageResolver:
     projects: list[Path] = field(default_factory=list)
     _cache: dict[str, Path | None] = field(default_factory=dict)
     _real_roots: dict[tuple[Path, ...], Roots] = field(default_factory=dict)
-    _roots_of: dict[Path | None, tuple[tuple[int, ...], Roots]] = field(default_factory=dict)
     _real_dirs: dict[str, str] = field(default_factory=dict)  # the folders of inputs, resolved
     _near: dict[tuple[str, Path], Path | None] = field(default_factory=dict)  # (package, near) → folder
     _named_above: set[Path] = field(default_factory=set)  # packages above a model, by package.xml
@@ -295,13 +294,6 @@ class PackageResolver:
         from mpc.core.files import Roots, package_roots
 
         assert self.search_path is not None
-        # What the roots are made of only grows (a package found, a root or project added): its
-        # sizes tell whether the roots of `base_dir` made before still hold (each mesh asks).
-        stamp = (len(self._cache), len(self._named_above), len(self.roots), len(self.projects),
-                 len(self.package_map), len(self.search_path))
-        known = self._roots_of.get(base_dir)
-        if known is not None and known[0] == stamp:
-            return known[1]
         # A package found on the search path is a root wherever its folder links to: the
         # environment named it, as `--package` names one. One found above the model is a root
         # when its package.xml names it (`_above`).
@@ -312,7 +304,6 @@ class PackageResolver:
         roots = self._real_roots.get(folders)
         if roots is None:
             roots = self._real_roots[folders] = Roots(package_roots(folders, self._real_dirs))
-        self._roots_of[base_dir] = stamp, roots
         return roots
 
     def resolved(self, path: Path) -> Path:
