@@ -21,6 +21,10 @@ slots also pickles its fields as a tuple, in order, as dataclass's own `__getsta
 without looking the fields up for each object. The build cache writes records as their field
 values (`record_values`) and reads them back without running their code (`from_values`:
 compiler/kept_values.py); only classes made here (`is_record`) are read back.
+
+`@record(frozen=False)` is the same for a mutable class (`@dataclass`'s): repr and == from
+here, unhashable, `__init__` compiled for its first object. mpc writes every class of fields
+with one or the other, not `@dataclass` (whose methods a process would compile on import).
 """
 
 from __future__ import annotations
