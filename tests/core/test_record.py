@@ -354,3 +354,17 @@ def test_mutable_records_are_made_and_behave_as_dataclass_s() -> None:
     assert state == SlotState(1.0, 2.0) and not hasattr(state, "__dict__")
     with pytest.raises(TypeError, match="@record\\(bulk=True\\) is frozen"):
         record(slots=True, bulk=True, frozen=False)
+
+
+def test_mpc_makes_its_classes_of_fields_with_record() -> None:
+    """A `@dataclass` compiles its methods when its module is imported (three to six exec calls,
+    0.2–0.9 ms a class): mpc's classes are records. The one exception is hashed by identity."""
+    import re
+
+    from mpc.core.version import source_files
+
+    found = [f"{name}: {m.group(0).strip()}" for name, file in source_files() if name.endswith(".py")
+             for m in re.finditer(r"^[ \t]*@(?:dataclasses\.)?dataclass\b.*$",
+                                  file.read_text(encoding="utf-8"), re.M)]
+    assert found == ["ir/text_types.py: @dataclass(frozen=True, eq=False)  # hashed by identity: "
+                     "printing caches per registry"]
