@@ -55,13 +55,7 @@ class _Version(argparse.Action):
         parser.exit()
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
-    parser.add_argument("--version", action=_Version, help="print mpc's version and exit")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    packages, diagnostics = _input_parents()
-    inputs = [packages, diagnostics]
-    comp = sub.add_parser("compile", parents=inputs, help="compile a model definition into model files")
+def _compile_arguments(comp: argparse.ArgumentParser) -> None:
     comp.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     comp.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>)")
     comp.add_argument("--emit", choices=("files", "ir", "ir-lowered"), default="files",
@@ -72,30 +66,43 @@ def _parser() -> argparse.ArgumentParser:
                            "outputs are not used; the mesh cache is)")
     comp.add_argument("--no-post-processing", action="store_true",
                       help="do not run the definition's post_processing commands")
-    check = sub.add_parser("check", parents=inputs,
-                           help="check definitions (or pipeline files) without building")
+
+
+def _check_arguments(check: argparse.ArgumentParser) -> None:
     check.add_argument("files", type=Path, nargs="+", metavar="FILE",
                        help="model definitions, IR files or pipeline.yml files")
-    schema = sub.add_parser("schema", help="write the JSON Schema of the definition language")
-    schema.add_argument("-o", "--out", type=Path, help="the file to write it to (default: stdout)")
-    # mpc deploy (cli/deploy.py)
-    from mpc.cli.deploy import add_arguments as deploy_arguments
 
-    deploy_arguments(sub.add_parser("deploy", parents=inputs,
-                                    help="deploy a built model to its git repository"))
-    # -- mpc test (checks/) --
-    test = sub.add_parser("test", parents=inputs, help="compile a model definition and run its model tests")
+
+def _schema_arguments(schema: argparse.ArgumentParser) -> None:
+    schema.add_argument("-o", "--out", type=Path, help="the file to write it to (default: stdout)")
+
+
+def _deploy_arguments(deploy: argparse.ArgumentParser) -> None:
+    from mpc.cli.deploy import add_arguments
+
+    add_arguments(deploy)
+
+
+def _test_arguments(test: argparse.ArgumentParser) -> None:
     test.add_argument("definition", type=Path, help="the model definition (YAML), or an IR file (.ir)")
     test.add_argument("--built", type=Path, help="test this compiled output instead of compiling")
     test.add_argument("-o", "--out", type=Path, help="output folder (default: build/<modelname>); with "
                       "--built: where the protocol goes (default: the --built folder)")
-    from mpc.cli.diff import add_arguments as diff_arguments
 
-    diff_arguments(sub.add_parser("diff", help="the semantic changes between two models (exit 1 when "
-                                  "something changed, as diff)"))
-    # -- pipeline runs and CI generation (pipeline/) --
-    run = sub.add_parser("run", parents=inputs,
-                         help="build every model of a pipeline.yml (DAG, cache, parallel workers)")
+
+def _diff_arguments(diff: argparse.ArgumentParser) -> None:
+    from mpc.cli.diff import add_arguments
+
+    add_arguments(diff)
+
+
+def _root_outside(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--allow-root-outside", action="store_true",
+                        help="accept a pipeline `root` outside the pipeline file's folder and its parent "
+                             "(the build folder is <root>/build)")
+
+
+def _run_arguments(run: argparse.ArgumentParser) -> None:
     run.add_argument("pipeline", type=Path, help="the pipeline file")
     run.add_argument("--only", nargs="+", action="extend", default=[], metavar="MODEL",
                      help="build only these models (modelnames or definition files); others' outputs stay")
@@ -113,7 +120,10 @@ def _parser() -> argparse.ArgumentParser:
                      help="with --verify: stages that skipped by their own choice (not applicable) pass")
     run.add_argument("--log-format", choices=("text", "json"), default="text",
                      help="progress: text (live on a terminal, quiet otherwise) or JSON lines on stdout")
-    ci = sub.add_parser("ci", help="write a CI pipeline with one job per model (GitLab or GitHub)")
+    _root_outside(run)
+
+
+def _ci_arguments(ci: argparse.ArgumentParser) -> None:
     systems = ci.add_subparsers(dest="system", required=True, metavar="gitlab|github|job|summary|review")
     gens = []
     for system, what in (("gitlab", "a GitLab CI child pipeline"), ("github", "a GitHub Actions workflow")):
@@ -129,8 +139,9 @@ def _parser() -> argparse.ArgumentParser:
                          help="shell command that installs mpc in a job and puts it on PATH (default: "
                          "the install of this mpc, from the project's requirements.txt or how it was "
                          "installed)")
-    job = systems.add_parser("job", parents=inputs, help="what a generated job runs: one model and "
-                             "stages, with the artifacts of earlier jobs")
+    job = systems.add_parser("job", parents=list(_input_parents()),
+                             help="what a generated job runs: one model and stages, with the artifacts "
+                                  "of earlier jobs")
     job.add_argument("pipeline", type=Path, help="the pipeline file")
     job.add_argument("model", help="the modelname")
     job.add_argument("-o", "--out", type=Path, help="the build folder (default: <root>/build)")
@@ -145,20 +156,53 @@ def _parser() -> argparse.ArgumentParser:
     review.add_argument("pipeline", type=Path, help="the pipeline file")
     review.add_argument("--base", metavar="REV", help="compare with the definitions at this git revision "
                         "(default: the merge request's base)")
-    from mpc.cli.lsp import add_arguments as lsp_arguments
+    for p in (*gens, job, summary, review):
+        _root_outside(p)
 
-    lsp_arguments(sub.add_parser("lsp", parents=[packages],
-                                 help="the language server for editors (LSP over stdio)"))
-    view = sub.add_parser("view", parents=inputs, help="show a model in the browser (a local web viewer)")
+
+def _lsp_arguments(lsp: argparse.ArgumentParser) -> None:
+    from mpc.cli.lsp import add_arguments
+
+    add_arguments(lsp)
+
+
+def _view_arguments(view: argparse.ArgumentParser) -> None:
     view.add_argument("model", type=Path, help="a model definition (YAML or .ir) or a built folder")
     view.add_argument("--compare", metavar="DIR|URL@REF", help="draw this model as a ghost: a folder, "
                       "or a git repository at a branch or commit")
     view.add_argument("--host", default="127.0.0.1", help="the address to bind (default: 127.0.0.1)")
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
-    for p in (run, *gens, job, summary, review):
-        p.add_argument("--allow-root-outside", action="store_true",
-                       help="accept a pipeline `root` outside the pipeline file's folder and its parent "
-                            "(the build folder is <root>/build)")
+
+
+# Each subcommand as `mpc --help` lists it: its help, the options it shares (`_input_parents`:
+# "inputs" both, "packages" --package alone) and what adds its own arguments.
+_SUBCOMMANDS: dict[str, tuple[str, str, Callable[[argparse.ArgumentParser], None]]] = {
+    "compile": ("compile a model definition into model files", "inputs", _compile_arguments),
+    "check": ("check definitions (or pipeline files) without building", "inputs", _check_arguments),
+    "schema": ("write the JSON Schema of the definition language", "", _schema_arguments),
+    "deploy": ("deploy a built model to its git repository", "inputs", _deploy_arguments),
+    "test": ("compile a model definition and run its model tests", "inputs", _test_arguments),
+    "diff": ("the semantic changes between two models (exit 1 when something changed, as diff)", "",
+             _diff_arguments),
+    "run": ("build every model of a pipeline.yml (DAG, cache, parallel workers)", "inputs", _run_arguments),
+    "ci": ("write a CI pipeline with one job per model (GitLab or GitHub)", "", _ci_arguments),
+    "lsp": ("the language server for editors (LSP over stdio)", "packages", _lsp_arguments),
+    "view": ("show a model in the browser (a local web viewer)", "inputs", _view_arguments),
+}
+
+
+def _parser(command: str | None = None) -> argparse.ArgumentParser:
+    """mpc's argument parser; with `command`, that subcommand's alone (the one on the command
+    line: argparse builds every argument and asks gettext for every parser's messages, 15 ms of
+    each mpc process when all ten commands are built)."""
+    parser = argparse.ArgumentParser(prog="mpc", description="mpc, the model pipeline compiler")
+    parser.add_argument("--version", action=_Version, help="print mpc's version and exit")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    packages, diagnostics = _input_parents()
+    parents = {"inputs": [packages, diagnostics], "packages": [packages], "": []}
+    for name, (help_text, shared, add_arguments) in _SUBCOMMANDS.items():
+        if command is None or command == name:
+            add_arguments(sub.add_parser(name, parents=parents[shared], help=help_text))
     return parser
 
 
@@ -268,7 +312,8 @@ def main(argv: list[str] | None = None) -> int:
         # coordinate of 3.4e38) name their source lines, not the user's file: what they point
         # at is a diagnostic where it matters. MPC_DEBUG=1 shows them.
         warnings.simplefilter("ignore")
-    args = _parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    args = _parser(words[0] if words and words[0] in COMMANDS else None).parse_args(argv)
     try:
         with _without_cyclic_gc(args.command):
             command = COMMANDS[args.command]

@@ -32,3 +32,26 @@ def test_every_command_that_reads_definitions_takes_the_same_input_options() -> 
     helps = {name: next(a.help for a in commands[name]._actions if "--package" in a.option_strings)
              for name in (*READERS, "lsp")}
     assert len(set(helps.values())) == 1, helps
+
+
+
+def _described(parser: argparse.ArgumentParser) -> dict[str, list[tuple[object, ...]]]:
+    """The arguments of `parser` ("") and of each of its subcommands, as argparse holds them."""
+    return {name: [(tuple(a.option_strings), a.dest, a.nargs, a.const, a.default, a.type, a.help,
+                    a.metavar, a.required, None if isinstance(a, argparse._SubParsersAction) else a.choices)
+                   for a in sub._actions]
+            for name, sub in {"": parser, **_subcommands(parser)}.items()}
+
+
+def test_a_command_s_parser_built_alone_is_the_one_of_all_commands() -> None:
+    """`mpc COMMAND …` builds that command's arguments alone (cli/main.py `_parser`): the same
+    arguments, options and help as when every command is built (`mpc --help`, a mistyped
+    command); the others are not built."""
+    from mpc.cli.main import COMMANDS
+
+    everything = _described(_parser())
+    assert sorted(name for name in everything if name and " " not in name) == sorted(COMMANDS)
+    for command in COMMANDS:
+        alone = _described(_parser(command))
+        assert alone == {name: arguments for name, arguments in everything.items()
+                         if name in ("", command) or name.startswith(command + " ")}, command
