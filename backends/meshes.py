@@ -491,7 +491,7 @@ def _compute(jobs: list[Job]) -> dict[Path, tuple[str, str]]:
 
     if mesh_worker.active() and sizes is not None and size >= FORKED:  # beside the worker
         costs = _costs(tasks, sizes)
-        mesh_worker.offer([(group, cost) for (_, group), cost in zip(tasks, costs, strict=True)])
+        mesh_worker.offer(_priced(tasks, costs))
         results = [_materialise_all(tasks[i]) for i in sorted(range(len(tasks)), key=costs.__getitem__)]
         mesh_worker.note_digests()
     elif workers < 2 or len(jobs) < 3 or size < FORKED:
@@ -606,7 +606,12 @@ def likely_tasks(robots: list[Robot], exports: Sequence[Any]) -> list[tuple[list
     sizes = _plain_sizes(tasks) or []
     if sum(sizes) < FORKED:
         return []
-    return [(group, cost) for (_, group), cost in zip(tasks, _costs(tasks, sizes), strict=True)]
+    return _priced(tasks, _costs(tasks, sizes))
+
+
+def _priced(tasks: list[Task], costs: list[float]) -> list[tuple[list[Job], float]]:
+    """The jobs of each task with its cost, as the worker takes them (mesh_worker.offer)."""
+    return [(jobs, cost) for (_, jobs), cost in zip(tasks, costs, strict=True)]
 
 
 def mesh_workers() -> int:

@@ -14,7 +14,7 @@ import sys
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import NoReturn
+from typing import NamedTuple, NoReturn
 
 # The rest of mpc is imported by the command that needs it (COMMANDS): `mpc check` turns off
 # the cyclic garbage collector first (_without_cyclic_gc), and no command pays for another's
@@ -174,23 +174,6 @@ def _view_arguments(view: argparse.ArgumentParser) -> None:
     view.add_argument("--port", type=int, default=8080, help="the port (default: 8080; 0: any free one)")
 
 
-# Each subcommand as `mpc --help` lists it: its help, the options it shares (`_input_parents`:
-# "inputs" both, "packages" --package alone) and what adds its own arguments.
-_SUBCOMMANDS: dict[str, tuple[str, str, Callable[[argparse.ArgumentParser], None]]] = {
-    "compile": ("compile a model definition into model files", "inputs", _compile_arguments),
-    "check": ("check definitions (or pipeline files) without building", "inputs", _check_arguments),
-    "schema": ("write the JSON Schema of the definition language", "", _schema_arguments),
-    "deploy": ("deploy a built model to its git repository", "inputs", _deploy_arguments),
-    "test": ("compile a model definition and run its model tests", "inputs", _test_arguments),
-    "diff": ("the semantic changes between two models (exit 1 when something changed, as diff)", "",
-             _diff_arguments),
-    "run": ("build every model of a pipeline.yml (DAG, cache, parallel workers)", "inputs", _run_arguments),
-    "ci": ("write a CI pipeline with one job per model (GitLab or GitHub)", "", _ci_arguments),
-    "lsp": ("the language server for editors (LSP over stdio)", "packages", _lsp_arguments),
-    "view": ("show a model in the browser (a local web viewer)", "inputs", _view_arguments),
-}
-
-
 def _parser(command: str | None = None) -> argparse.ArgumentParser:
     """mpc's argument parser; with `command`, that subcommand's alone (the one on the command
     line: argparse builds every argument and asks gettext for every parser's messages, 15 ms of
@@ -200,9 +183,9 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     packages, diagnostics = _input_parents()
     parents = {"inputs": [packages, diagnostics], "packages": [packages], "": []}
-    for name, (help_text, shared, add_arguments) in _SUBCOMMANDS.items():
+    for name, entry in COMMANDS.items():
         if command is None or command == name:
-            add_arguments(sub.add_parser(name, parents=parents[shared], help=help_text))
+            entry.add_arguments(sub.add_parser(name, parents=parents[entry.shared], help=entry.help))
     return parser
 
 
@@ -269,9 +252,31 @@ def _lsp(args: argparse.Namespace) -> int:
     return lsp.run(args)
 
 
-COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "compile": _compile, "check": _check, "schema": _schema, "test": _test, "diff": _diff, "deploy": _deploy,
-    "run": _run, "ci": _ci, "view": _view, "lsp": _lsp,
+class Command(NamedTuple):
+    """A subcommand: its help as `mpc --help` lists it, the options it shares (`_input_parents`:
+    "inputs" both, "packages" --package alone), what adds its own arguments, and what runs it."""
+
+    help: str
+    shared: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
+
+
+COMMANDS: dict[str, Command] = {  # in the order of `mpc --help`
+    "compile": Command("compile a model definition into model files", "inputs", _compile_arguments,
+                       _compile),
+    "check": Command("check definitions (or pipeline files) without building", "inputs", _check_arguments,
+                     _check),
+    "schema": Command("write the JSON Schema of the definition language", "", _schema_arguments, _schema),
+    "deploy": Command("deploy a built model to its git repository", "inputs", _deploy_arguments, _deploy),
+    "test": Command("compile a model definition and run its model tests", "inputs", _test_arguments, _test),
+    "diff": Command("the semantic changes between two models (exit 1 when something changed, as diff)", "",
+                    _diff_arguments, _diff),
+    "run": Command("build every model of a pipeline.yml (DAG, cache, parallel workers)", "inputs",
+                   _run_arguments, _run),
+    "ci": Command("write a CI pipeline with one job per model (GitLab or GitHub)", "", _ci_arguments, _ci),
+    "lsp": Command("the language server for editors (LSP over stdio)", "packages", _lsp_arguments, _lsp),
+    "view": Command("show a model in the browser (a local web viewer)", "inputs", _view_arguments, _view),
 }
 
 
@@ -316,7 +321,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser(words[0] if words and words[0] in COMMANDS else None).parse_args(argv)
     try:
         with _without_cyclic_gc(args.command):
-            command = COMMANDS[args.command]
+            command = COMMANDS[args.command].run
             if _json_on_stdout(args):
                 from mpc.core.render import json_document
 
