@@ -40,9 +40,12 @@ class Fragments:
         self.namespace_declarations = [f' xmlns{":" + prefix if prefix else ""}="{uri}"'
                                        for prefix, uri in src.root.nsmap.items()]
         self.declared = "".join(self.namespace_declarations)
+        # Whether the text between elements is the text as written (no character reference or
+        # CDATA section could stand in an element's indentation): `indentation` may read it.
+        self.plain = "&" not in src.text and not _has_cdata(src.text)
 
     def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
-        span, tag = self.src.span(el), el.tag
+        tag = el.tag
         xml = etree.tostring(el, encoding="unicode", with_tail=False)
         if self.declared:
             # tostring re-declares every namespace in scope; <robot> declares them already.
@@ -55,9 +58,24 @@ class Fragments:
                 for declaration in self.namespace_declarations:
                     head = head.replace(declaration, "", 1)
                 xml = head + xml[head_end:]
-        if span.col > 1:  # its lines less the indentation of its first
-            xml = xml.replace("\n" + " " * (span.col - 1), "\n")
-        return self.make(tag=tag, xml=xml, refs=self.refs(el), comments=comments, span=span)
+        indentation = self.indentation(el)
+        if indentation:  # its lines less the indentation of its first
+            xml = xml.replace("\n" + " " * indentation, "\n")
+        return self.make(tag=tag, xml=xml, refs=self.refs(el), comments=comments,
+                         span=self.src.lazy_span(el))
+
+    def indentation(self, el: etree._Element) -> int:
+        """The column of `el`'s start tag less one: the length of the text before it on its
+        line. That text ends the text before the element (the tail of the node before it, or its
+        parent's text) when a line break stands there: looking it up in the file (XmlSource.span)
+        costs more than the rest of a fragment."""
+        previous = el.getprevious()
+        before = previous.tail if previous is not None else el.getparent().text
+        if before and self.plain:
+            line_break = before.rfind("\n")
+            if line_break >= 0 and before[line_break + 1:].strip(" \t") == "":
+                return len(before) - line_break - 1
+        return self.src.span(el).col - 1
 
     def refs(self, el: etree._Element) -> tuple[FragmentRef, ...]:
         """Every attribute or text in the fragment that equals a link or joint name, in
@@ -85,6 +103,17 @@ class Fragments:
         if is_link and is_joint:
             return "joint" if "joint" in hint.lower() else "link"
         return "link" if is_link else "joint"
+
+
+def _has_cdata(text: str) -> bool:
+    """Whether `text` holds a CDATA section: each `[` looked at (a search for "<![CDATA["
+    itself takes 60 µs in TALOS's text, one for "[" a microsecond)."""
+    i = text.find("[")
+    while i >= 0:
+        if i >= 2 and text.startswith("<![CDATA[", i - 2):
+            return True
+        i = text.find("[", i + 1)
+    return False
 
 
 def _path(root: etree._Element, node: etree._Element) -> tuple[int, ...]:

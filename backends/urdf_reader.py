@@ -152,11 +152,13 @@ class _Reader:
         """Find the file of every mesh the links name, in one pass before the walk: done at
         each <mesh> among the walk's other work, the same calls took twice their time
         (bench/README.md, 2026-11-28)."""
-        resolver, base_dir, found = self.resolver, self.base_dir, self.mesh_sources
-        for uri in _LINK_MESHES(self.src.root):
-            if uri and uri not in found:
-                source = mesh_source(resolver, uri, base_dir)
-                found[uri] = source, resolver.refusal(source.path, base_dir) if source.path else None
+        resolver, base_dir = self.resolver, self.base_dir
+        sources = {uri: mesh_source(resolver, uri, base_dir)
+                   for uri in dict.fromkeys(_LINK_MESHES(self.src.root)) if uri}
+        # Whether each may be read, once every package they name is found (their roots).
+        refusals = iter(resolver.refusals([s.path for s in sources.values() if s.path is not None], base_dir))
+        self.mesh_sources = {uri: (source, next(refusals) if source.path is not None else None)
+                             for uri, source in sources.items()}
 
     # -- helpers ---------------------------------------------------------------------------
 

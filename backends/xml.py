@@ -60,7 +60,7 @@ class XmlSource:
     file: str
     text: str
     root: etree._Element
-    _lines: list[str] = field(default_factory=list)
+    _lines: list[str] | None = None  # the text's lines, split when a span first needs them
     _quick: bool = False  # whether `_on_line` may be asked (see `parse`)
     _offsets: dict[etree._Element, int] | None = None  # the scan: start tag offsets, once made
     _line_starts: list[int] = field(default_factory=list)
@@ -83,15 +83,16 @@ class XmlSource:
             raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
                            "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
-        src = cls(file, text, root, text.split("\n"), _new_span=maker(Span))
+        src = cls(file, text, root, _new_span=maker(Span))
         # The scan matches every element to its own start tag, and `_on_lines` may look for it,
         # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag;
         # elsewhere the scan skips it with the comment, CDATA or PI that holds it), no name the
         # scan does not see whole (`<:x`, when libxml2 takes it; odd letters), an encoding that
         # writes each `<` of the markup as `<` (not UTF-7's `+ADw-`), and lines that libxml2
-        # counts (past 65535 only with XML_PARSE_BIG_LINES).
+        # counts for each element (past 65535 only with XML_PARSE_BIG_LINES; the last node's
+        # line is the largest, and asked for in less time than the text's lines are counted).
         info = root.getroottree().docinfo
-        src._quick = (not info.doctype and len(src._lines) < 65535
+        src._quick = (not info.doctype and _last_line(root) < 65535
                       and (info.encoding or "").lower() in _PLAIN_ENCODINGS
                       and (text.isascii() or _ODD_START.search(text) is None)
                       and (not _colon_names() or "<:" not in text))
@@ -133,7 +134,7 @@ class XmlSource:
         `<` or no `<name` as the last `<` above it, the tag begins at that `<name`; when it has
         none, at the last `<` above.
         """
-        number, lines = el.sourceline, self._lines
+        number, lines = el.sourceline, self._lines or self._split()
         if not number or number > len(lines) or len(lines[number - 1]) > _LONG_LINE:
             return None
         line, tag = lines[number - 1], el.tag
@@ -170,10 +171,16 @@ class XmlSource:
                 return None
         return (*where, len(local), 0)
 
+    def _split(self) -> list[str]:
+        """The text's lines: split when the first span is asked for (a read that reports
+        nothing may find none: its spans are lazy)."""
+        self._lines = self.text.split("\n")
+        return self._lines
+
     def _above(self, number: int) -> tuple[int, int] | None:
         """(line number, index) of the last `<` above line `number`, when one of the few lines
         right above it has one."""
-        lines = self._lines
+        lines = self._lines or self._split()
         for k in range(number - 2, max(number - 2 - _LOOK_BACK, -1), -1):
             if len(lines[k]) > _LONG_LINE:
                 return None
@@ -217,6 +224,14 @@ class XmlSource:
         for el, (offset, tag) in zip(elements, starts, strict=True):
             if tag.rsplit(":", 1)[-1] == _localname(el):
                 self._offsets[el] = offset
+
+
+def _last_line(root: etree._Element) -> int:
+    """The line lxml gives the last node inside `root` (0 when it gives none)."""
+    node = root
+    while len(node):
+        node = node[-1]
+    return node.sourceline or 0
 
 
 @functools.cache

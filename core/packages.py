@@ -33,6 +33,8 @@ from mpc.core.reads import note_package
 from mpc.core.record import record
 
 if TYPE_CHECKING:
+    from collections.abc import Iterable
+
     from mpc.core.files import Roots
 
 
@@ -280,13 +282,21 @@ class PackageResolver:
         command line) may also name the files of its model folder: the folder above
         `base_dir` when that is one of the format folders mpc and Phobos write side by side
         (`urdf/`, `sdf/`, `smurf/` beside `meshes/`)."""
+        return self._refusal(path, self._package_roots(base_dir))
+
+    def refusals(self, paths: Iterable[Path], base_dir: Path | None = None) -> list[str | None]:
+        """`refusal(path, base_dir)` of each of `paths`, with the roots gathered once: the
+        meshes of a model, once every package they name has been found."""
+        roots = self._package_roots(base_dir)
+        return [self._refusal(path, roots) for path in paths]
+
+    def _refusal(self, path: Path, roots: Roots) -> str | None:
         from mpc.core.files import input_problem, plain_stat
 
         found = plain_stat(path, self._real_dirs)
         if found is False or (found is True and not path.exists()):
             return None
-        return input_problem(path, self._package_roots(base_dir), self._real_dirs,
-                             None if found is True else found)
+        return input_problem(path, roots, self._real_dirs, None if found is True else found)
 
     def _package_roots(self, base_dir: Path | None) -> Roots:
         """The package roots and `base_dir`, resolved once for every mesh of a model (their

@@ -18,6 +18,7 @@ import random
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 from lxml import etree
@@ -287,3 +288,20 @@ def test_a_fragment_names_each_link_and_joint_by_its_kind(tmp_path: Path) -> Non
         [((), "reference", "link", "b"), ((0,), None, "joint", "b"), ((1,), "link", "link", "a"),
          ((1,), "joint", "joint", "b"), ((3,), None, "link", "b")],
         [((0,), "name", "joint", "b"), ((1,), None, "link", "b")]]
+
+
+@pytest.mark.parametrize(("before", "xml"), [
+    ("\n  ", '<gazebo reference="a">\n  <x/>\n</gazebo>'),  # less its start tag's indentation
+    ("\n\t  ", '<gazebo reference="a">\n <x/>\n  </gazebo>'),  # 3 characters, as its column says
+    # Text before the tag that is no indentation as written: its column (6, 13 and 23) decides.
+    ("\n  <!--c--><![CDATA[\n  ]]>", '<gazebo reference="a">\n    <x/>\n  </gazebo>'),
+    ("\n  &#32;&#32;", '<gazebo reference="a">\n    <x/>\n  </gazebo>'),
+    ("\n  <material name='m'/>", '<gazebo reference="a">\n    <x/>\n  </gazebo>'),
+], ids=["spaces", "a tab", "a CDATA section", "character references", "an element"])
+def test_a_fragment_keeps_its_lines_less_the_indentation_of_its_start_tag(
+        tmp_path: Path, before: str, xml: str) -> None:
+    data = (f'<robot name="r">\n  <link name="a"/>{before}<gazebo reference="a">\n'
+            '    <x/>\n  </gazebo>\n</robot>\n').encode()
+    robot = urdf_reader.read_text(data, "r.urdf", tmp_path, Sink(), PackageResolver())
+    assert robot is not None
+    assert [f.xml for f in robot.fragments] == [xml]

@@ -238,6 +238,7 @@ def test_what_the_reader_makes_is_what_dataclass_s_init_makes(tmp_path: Path) ->
     class call (record's __init__), and holds what dataclass's own __init__ makes of the same
     values, for every class listed."""
     from mpc.backends import urdf_reader
+    from mpc.backends.xml import XmlSource
     from mpc.core.diagnostics import Sink
 
     path = tmp_path / "r.urdf"
@@ -245,7 +246,9 @@ def test_what_the_reader_makes_is_what_dataclass_s_init_makes(tmp_path: Path) ->
     robot = urdf_reader.read(path, Sink())
     assert robot is not None
     seen: set[str] = set()
-    stack: list[object] = [robot]
+    # The reader's spans are found when asked for (LazySpan), by the parsed file's maker.
+    parsed = XmlSource.parse(FULL.encode(), str(path))
+    stack: list[object] = [robot, parsed.span(parsed.root)]
     while stack:
         item = stack.pop()
         if isinstance(item, dict):
