@@ -317,10 +317,11 @@ class _Reader:
         if not name:
             self.error(root, "E0403", f"<robot> in '{file}' has no 'name' attribute")
         names, children = self.fragments, list(root)  # kept: lxml makes each proxy once then
-        for el in children:  # every name first: fragments and mimics refer to them
-            if el.tag == "link":
+        tags = [el.tag for el in children]  # each a new string (or function) lxml makes when asked
+        for el, tag in zip(children, tags, strict=True):  # every name first: fragments, mimics name them
+            if tag == "link":
                 names.link_names.add(el.get("name", ""))
-            elif el.tag == "joint":
+            elif tag == "joint":
                 names.joint_names.add(el.get("name", ""))
         names.names, names.both = names.link_names | names.joint_names, names.link_names & names.joint_names
 
@@ -329,18 +330,17 @@ class _Reader:
         materials: dict[str, Material] = {}
         fragments: list[Fragment] = []
         pending: list[str] = []
-        for el in children:
-            if el.tag is etree.Comment:
-                pending.append(str(el.text))
-                continue
-            if not isinstance(el.tag, str):
+        for el, tag in zip(children, tags, strict=True):
+            if tag.__class__ is not str:
+                if tag is etree.Comment:
+                    pending.append(str(el.text))
                 continue
             comments, pending = tuple(pending), []
-            if el.tag == "link":
+            if tag == "link":
                 self.add(links, self.link(el, comments), el, "link")
-            elif el.tag == "joint":
+            elif tag == "joint":
                 self.add(joints, self.joint(el, comments), el, "joint")
-            elif el.tag == "material":
+            elif tag == "material":
                 self.add(materials, self.material(el, comments, "<robot>"), el, "material")
             else:
                 fragments.append(self.fragment(el, comments))
