@@ -83,6 +83,8 @@ class XmlSource:
             raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
                            "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
+        if "\r" in text:  # a line ends at CR LF, CR or LF, as libxml2 counts lines (and Python reads text)
+            text = text.replace("\r\n", "\n").replace("\r", "\n")
         src = cls(file, text, root, _new_span=maker(Span))
         # The scan matches every element to its own start tag, and `_on_lines` may look for it,
         # when the text has no DOCTYPE (its internal subset may hold a `<name` that is no tag;

@@ -15,7 +15,7 @@ import pytest
 
 from mpc.backends import urdf
 from mpc.core.diagnostics import Sink
-from mpc.core.span import Span
+from mpc.core.span import Span, source_line
 
 PAD = "<!--" + "x" * 2000 + "-->"  # 2007 characters: the line is longer than any searched whole
 BODY = ('<robot name="r">' + PAD + '<link name="a"/><link name="b"><visual><geometry><box size="1 1 1"/>'
@@ -57,3 +57,15 @@ def test_a_start_tag_that_begins_on_a_long_line_and_ends_on_the_next_is_located(
     _, sink, file = _read(tmp_path, text)
     [error] = sink.diagnostics
     assert error.code == "E0422" and error.span == Span(file, 2, 10, 2, 15)
+
+
+@pytest.mark.parametrize("end", ["\n", "\r\n", "\r"], ids=["LF", "CR LF", "CR"])
+def test_an_error_is_located_at_its_line_whatever_ends_the_lines(tmp_path: Path, end: str) -> None:
+    """libxml2 ends a line at CR LF, CR or LF (as XML says); so do spans and the quoted line."""
+    lines = ['<robot name="r">', '  <link name="a"/>', '  <joint name="j" type="bogus">',
+             '    <parent link="a"/><child link="b"/>', "  </joint>", '  <link name="b"/>', "</robot>"]
+    robot, sink, file = _read(tmp_path, end.join(lines) + end)
+    [error] = sink.diagnostics
+    assert robot is None and error.code == "E0422"
+    assert error.span == Span(file, 3, 25, 3, 30)  # `  <joint name="j" type="` is 24 long
+    assert source_line(file, 3) == lines[2]
