@@ -12,20 +12,20 @@ from collections.abc import Callable
 from lxml import etree
 
 from mpc.backends.xml import XmlSource
-from mpc.ir.fragments import Fragment, FragmentRef, RefKind
+from mpc.ir.fragments import Fragment, FragmentRef, RefKind, lazy_fragment
 
 
 class Fragments:
     """The fragments of one URDF file, made as the reader meets them.
 
     names: every link and joint name of the file (`link_names`, `joint_names`: each kind;
-    `both`: those of a link and a joint), set before the first fragment is made. make,
-    make_ref: the makers of the records (core/record.py maker).
+    `both`: those of a link and a joint), set before the first fragment is made and never
+    changed after (a fragment's references are found when first asked for). make_ref: the
+    maker of FragmentRef (core/record.py maker).
     """
 
-    def __init__(self, src: XmlSource, make: Callable[..., Fragment],
-                 make_ref: Callable[..., FragmentRef]) -> None:
-        self.src, self.make, self.make_ref = src, make, make_ref
+    def __init__(self, src: XmlSource, make_ref: Callable[..., FragmentRef]) -> None:
+        self.src, self.make_ref = src, make_ref
         self.link_names: set[str] = set()
         self.joint_names: set[str] = set()
         self.names: set[str] = set()
@@ -45,6 +45,8 @@ class Fragments:
         self.plain = "&" not in src.text and not _has_cdata(src.text)
 
     def fragment(self, el: etree._Element, comments: tuple[str, ...] = ()) -> Fragment:
+        """The fragment of `el`, its references found when first asked for: only a rename or a
+        cut asks (ir/fragments.py: LazyFragment)."""
         tag = el.tag
         xml = etree.tostring(el, encoding="unicode", with_tail=False)
         if self.declared:
@@ -61,8 +63,7 @@ class Fragments:
         indentation = self.indentation(el)
         if indentation:  # its lines less the indentation of its first
             xml = xml.replace("\n" + " " * indentation, "\n")
-        return self.make(tag=tag, xml=xml, refs=self.refs(el), comments=comments,
-                         span=self.src.lazy_span(el))
+        return lazy_fragment(tag, xml, comments, self.src.lazy_span(el), self, el)
 
     def indentation(self, el: etree._Element) -> int:
         """The column of `el`'s start tag less one: the length of the text before it on its

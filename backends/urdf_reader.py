@@ -74,7 +74,7 @@ def _makers() -> SimpleNamespace:
     import: `mpc check` imports this module on every save. Each class opts in to it with
     `@record(..., bulk=True)` (the list: tests/core/test_record.py BULK)."""
     return SimpleNamespace(
-        pose=maker(Pose), fragment=maker(Fragment), ref=maker(FragmentRef), robot=maker(Robot),
+        pose=maker(Pose), ref=maker(FragmentRef), robot=maker(Robot),
         link=maker(Link), inertial=maker(Inertial), inertia=maker(Inertia), box=maker(Box),
         cylinder=maker(Cylinder), sphere=maker(Sphere), mesh=maker(Mesh), visual=maker(Visual),
         collision=maker(Collision), material=maker(Material), joint=maker(Joint), limit=maker(Limit),
@@ -143,7 +143,7 @@ class _Reader:
         # The elements that hold a comment somewhere inside (most hold none).
         self.commented = {parent for comment in src.root.iter(etree.Comment)
                           for parent in comment.iterancestors()}
-        self.fragments = Fragments(src, self.new.fragment, self.new.ref)
+        self.fragments = Fragments(src, self.new.ref)
         self.fragment = self.fragments.fragment
         self.joint_names = self.fragments.joint_names  # filled by robot(), first
         self.locate_meshes()

@@ -34,13 +34,11 @@ from enum import Enum
 from pathlib import PosixPath, PurePath, PurePosixPath
 from typing import Any
 
-from mpc.core.record import from_values, is_record, record_values
-from mpc.core.span import LazySpan, Span
+from mpc.core.record import from_values, is_record, record_of, record_values
 
 # Where the classes of kept values live: the IR and the ground floor (spans, diagnostics).
 _MODULE = re.compile(r"mpc\.(core|ir)(\.[a-z_][a-z0-9_]*)*")
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-_KEPT_AS: dict[type, type] = {LazySpan: Span}  # a LazySpan is kept as the Span it finds
 
 
 class BadValue(ValueError):
@@ -97,7 +95,7 @@ class _Encoder:
         return [v if type(v) in _SCALARS else encode(v) for v in values]
 
     def _how(self, cls: type) -> Callable[[Any], Any]:
-        kept = _KEPT_AS.get(cls, cls)
+        kept = record_of(cls) or cls  # a lazy twin (a LazySpan) is kept as the record it finds
         tag = f"{kept.__module__}:{kept.__qualname__}"
         if not _MODULE.fullmatch(kept.__module__) or not _NAME.fullmatch(kept.__qualname__):
             raise TypeError(f"a value of type {tag} is not kept")

@@ -45,6 +45,7 @@ _RECORDS: set[type] = set()  # every class made by @record
 _BULK: set[type] = set()  # those made in bulk: @record(slots=True, bulk=True)
 _OWN_INIT: set[type] = set()  # those whose __init__ record writes
 _CLASSIC: set[type] = set()  # those that keep dataclass's frozen class (an InitVar, say)
+_STANDS_FOR: dict[type, type] = {}  # each lazy twin → the record class it stands for (`lazy_twin`)
 
 
 def _names(cls: type) -> tuple[str, ...]:
@@ -70,6 +71,23 @@ def _values(obj: Any) -> tuple[Any, ...]:
 def is_record(cls: type) -> bool:
     """Whether `cls` was made by @record (not a subclass of one that was not)."""
     return cls in _RECORDS
+
+
+def lazy_twin(of: type) -> Callable[[T], T]:
+    """Class decorator: the decorated subclass of the record class `of` is one of its values
+    some of whose fields are found when first asked for (core/span.py: LazySpan; ir/fragments.py:
+    LazyFragment). It is no record class of its own (`is_record`): the build cache keeps it, and
+    `settle_spans` walks it, as the record it stands for (`record_of`)."""
+    def register(cls: T) -> T:
+        _STANDS_FOR[cls] = of
+        return cls
+    return register
+
+
+def record_of(cls: type) -> type | None:
+    """The record class whose values the objects of `cls` are: `cls` itself, or the record its
+    lazy twin stands for (`lazy_twin`); None for any other class."""
+    return cls if cls in _RECORDS else _STANDS_FOR.get(cls)
 
 
 def bulk_records() -> frozenset[type]:

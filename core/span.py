@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Protocol, cast
 
 from mpc.core.files import quotable
-from mpc.core.record import is_record, record, record_values
+from mpc.core.record import lazy_twin, record, record_of, record_values
 
 
 @record(slots=True, bulk=True)
@@ -72,6 +72,7 @@ class Locator(Protocol):
     def span(self, node: Any, attr: str | None = None, /) -> Span: ...
 
 
+@lazy_twin(Span)
 class LazySpan(Span):
     """A Span whose position is found when it is first asked for (`lazy_span`, `located_span`).
 
@@ -159,7 +160,7 @@ def settle_spans(value: object) -> int:
             stack.extend(item.values())  # type: ignore[attr-defined]
         elif kind in (tuple, list, set, frozenset):
             stack.extend(item)  # type: ignore[call-overload]
-        elif is_record(kind):
+        elif record_of(kind) is not None:  # asking a lazy twin (a fragment) for its values finds them
             stack.extend(record_values(item))
     return found
 
