@@ -5,14 +5,14 @@ six for a frozen class, 0.5–0.8 ms a class on our machines. The IR has over a 
 classes, and every mpc process imports most of them (issue 3: `mpc check` on each editor
 save; issue 34: a warm rebuild, 30 ms of its 0.35 s). So dataclass writes no method of a
 record: repr, == and hash are the functions below (fields in order, the class's qualified
-name, equal only to the same class, tuple hash), and so are the frozen `__setattr__` and
-`__delattr__`; `__init__` is compiled when the first record of the class is made (most classes
-are never made in a process), from the class's fields as dataclass would write it (the same
-parameters, defaults, default_factory, keyword-only fields, `__post_init__`), each field set
-through its slot's own setter where it has one (twice as fast as object.__setattr__, which
-dataclass's frozen `__init__` goes through). `dataclasses.fields`, `replace` and `asdict` and
-every repr-based digest are unchanged. A record with an InitVar or a field left out of
-`__init__` keeps dataclass's own frozen class, and so do its subclasses.
+name, equal only to the same class or its lazy twin (`lazy_twin`), tuple hash), and so are the
+frozen `__setattr__` and `__delattr__`; `__init__` is compiled when the first record of the
+class is made (most classes are never made in a process), from the class's fields as dataclass
+would write it (the same parameters, defaults, default_factory, keyword-only fields,
+`__post_init__`), each field set through its slot's own setter where it has one (twice as fast
+as object.__setattr__, which dataclass's frozen `__init__` goes through). `dataclasses.fields`,
+`replace` and `asdict` and every repr-based digest are unchanged. A record with an InitVar or a
+field left out of `__init__` keeps dataclass's own frozen class, and so do its subclasses.
 
 Code that makes records by the thousand (a reader) asks for a `maker`, which skips the class
 call too: a quarter of its time. Only classes that opt in with `@record(slots=True,
@@ -76,8 +76,9 @@ def is_record(cls: type) -> bool:
 def lazy_twin(of: type) -> Callable[[T], T]:
     """Class decorator: the decorated subclass of the record class `of` is one of its values
     some of whose fields are found when first asked for (core/span.py: LazySpan; ir/fragments.py:
-    LazyFragment). It is no record class of its own (`is_record`): the build cache keeps it, and
-    `settle_spans` walks it, as the record it stands for (`record_of`)."""
+    LazyFragment). It is no record class of its own (`is_record`): it is equal to, hashes and
+    prints as the record of the same fields, and the build cache keeps it, and `settle_spans`
+    walks it, as the record it stands for (`record_of`)."""
     def register(cls: T) -> T:
         _STANDS_FOR[cls] = of
         return cls
@@ -142,12 +143,14 @@ def _builder(cls: type) -> Callable[[list[Any]], Any]:
 
 def _repr(self: Any) -> str:
     items = ", ".join(f"{f.name}={getattr(self, f.name)!r}" for f in fields(self) if f.repr)
-    return f"{type(self).__qualname__}({items})"
+    cls = type(self)
+    return f"{_STANDS_FOR.get(cls, cls).__qualname__}({items})"  # a lazy twin as its record
 
 
 def _eq(self: Any, other: object) -> bool:
-    if other.__class__ is not self.__class__:
-        return NotImplemented
+    mine, theirs = self.__class__, other.__class__
+    if theirs is not mine and _STANDS_FOR.get(theirs, theirs) is not _STANDS_FOR.get(mine, mine):
+        return NotImplemented  # equal only to the same record (or its lazy twin)
     return _values(self) == _values(other)
 
 

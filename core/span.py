@@ -41,19 +41,6 @@ class Span:
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.col}"
 
-    # Written here, not by @record, so that a LazySpan is a Span like any other: equal to the
-    # Span of the same place, with its hash and repr.
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Span):
-            return NotImplemented
-        return _fields(self) == _fields(other)
-
-    def __hash__(self) -> int:
-        return hash(_fields(self))
-
-    def __repr__(self) -> str:
-        return "Span(file={!r}, line={!r}, col={!r}, end_line={!r}, end_col={!r})".format(*_fields(self))
-
     @classmethod
     def of_file(cls, file: str) -> Span:
         """The span of a whole file, for errors that concern the file itself."""

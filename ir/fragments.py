@@ -8,10 +8,9 @@ dropping it.
 
 from __future__ import annotations
 
-from operator import attrgetter
 from typing import Any, Literal, Protocol
 
-from mpc.core.record import from_values, lazy_twin, record
+from mpc.core.record import from_values, lazy_twin, record, record_values
 from mpc.core.span import Span
 
 RefKind = Literal["link", "joint"]
@@ -54,22 +53,6 @@ class Fragment:
         """The link (or joint) names this fragment refers to."""
         return frozenset(r.name for r in self.refs if r.kind == kind)
 
-    # Written here, not by @record, so that a LazyFragment is a Fragment like any other: equal
-    # to the Fragment of the same element, with its hash and repr.
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Fragment):
-            return NotImplemented
-        return _fields(self) == _fields(other)
-
-    def __hash__(self) -> int:
-        return hash(_fields(self))
-
-    def __repr__(self) -> str:
-        return "Fragment(tag={!r}, xml={!r}, refs={!r}, comments={!r}, span={!r})".format(*_fields(self))
-
-
-_fields = attrgetter("tag", "xml", "refs", "comments", "span")
-
 
 class RefFinder(Protocol):
     """What finds a lazy fragment's references (backends/urdf_fragments.py: Fragments)."""
@@ -107,7 +90,7 @@ class LazyFragment(Fragment):
         return refs
 
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        return _plain, (list(_fields(self)),)
+        return _plain, (list(record_values(self)),)
 
 
 _set_tag, _set_xml, _set_refs, _set_comments, _set_span = (
