@@ -13,7 +13,8 @@ terabyte, and a macro that calls itself twice per level expands 2⁴⁰ times. T
 - **The whole expansion** (`watched`): a watchdog ends it when it has run `MAX_SECONDS`, or
   when the process has grown by `MAX_MEMORY` bytes since it started (E0673). It raises in
   the expanding thread between two steps of Python code: macros, loops and comprehensions,
-  whose single steps the first guard keeps small.
+  whose single steps the first guard keeps small. No `except Exception` catches it, and it is
+  raised again until the expansion has ended.
 The limits are far above what a robot model computes (the largest xacro models of ROS
 packages expand in about a second and never need a megabit integer).
 """
@@ -40,6 +41,9 @@ MAX_WIDTH = 10_000  # a field's width or precision in a format
 MAX_SECONDS = 60.0
 MAX_MEMORY = 2 << 30  # bytes the process may grow by while one expansion runs
 _POLL = 0.05
+# After raising, how long the watchdog waits for the block to end before raising again: an
+# exception raised while a destructor or a weakref callback runs is printed and dropped.
+_AGAIN = 0.5
 BOUNDED = "__mpc_bounded"  # the name the transformed code calls (a user's `__` names are refused)
 
 
@@ -47,8 +51,13 @@ class TooLarge(Exception):
     """An expression asked for more than a limit; the message says what."""
 
 
-class ExpansionTooLong(Exception):
-    """Raised in the expanding thread by the watchdog (`watched`); `reason` says which limit."""
+class ExpansionTooLong(BaseException):
+    """Raised in the expanding thread by the watchdog (`watched`); `reason` says which limit.
+
+    A BaseException, as KeyboardInterrupt is: xacro reads a literal by trying int, float and
+    bool in turn under `except Exception: pass`, so an Exception raised there was swallowed and
+    the expansion ran on (a model of 2²² macro calls, stopped at 1 s, still ran 17 minutes
+    later, at 1.9 GB)."""
 
     reason = ""
 
@@ -209,7 +218,8 @@ def _resident_bytes() -> int:
 @contextlib.contextmanager
 def watched() -> Iterator[None]:
     """Run the block (one expansion) under the watchdog: past MAX_SECONDS, or MAX_MEMORY more
-    resident memory than at its start, ExpansionTooLong is raised in this thread."""
+    resident memory than at its start, ExpansionTooLong is raised in this thread, and raised
+    again each `_AGAIN` seconds until the block is left."""
     target = threading.get_ident()
     lock = threading.Lock()
     done = threading.Event()
@@ -219,16 +229,18 @@ def watched() -> Iterator[None]:
     def watch() -> None:
         while not done.wait(_POLL):
             elapsed, grown = time.monotonic() - start, _resident_bytes() - base
-            why = (f"it ran for more than {MAX_SECONDS:g} s" if elapsed > MAX_SECONDS else
-                   f"it took more than {MAX_MEMORY >> 20:,} MiB of memory" if grown > MAX_MEMORY else "")
+            why = fired[0] if fired else (
+                f"it ran for more than {MAX_SECONDS:g} s" if elapsed > MAX_SECONDS else
+                f"it took more than {MAX_MEMORY >> 20:,} MiB of memory" if grown > MAX_MEMORY else "")
             if why:
                 with lock:
-                    if not done.is_set():
-                        ExpansionTooLong.reason = why
-                        fired.append(why)
-                        ctypes.pythonapi.PyThreadState_SetAsyncExc(
-                            ctypes.c_ulong(target), ctypes.py_object(ExpansionTooLong))
-                return
+                    if done.is_set():
+                        return
+                    ExpansionTooLong.reason = why
+                    fired.append(why)
+                    ctypes.pythonapi.PyThreadState_SetAsyncExc(
+                        ctypes.c_ulong(target), ctypes.py_object(ExpansionTooLong))
+                done.wait(_AGAIN)  # and again, until the block is left
 
     watcher = threading.Thread(target=watch, name="mpc-xacro-watchdog", daemon=True)
     watcher.start()

@@ -57,7 +57,7 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
     import xacro
 
     from mpc.backends.xacro_guard import guarded, refusal_of
-    from mpc.backends.xacro_limits import watched
+    from mpc.backends.xacro_limits import ExpansionTooLong, watched
 
     if not path.is_file():
         sink.error(origin or Span.of_file(str(path)), "E0601", f"xacro file '{path}' does not exist")
@@ -75,7 +75,7 @@ def expand(path: Path, sink: Sink, resolver: PackageResolver, args: tuple[tuple[
             sink.error(Span(where, e.lineno, e.offset + 1), "E0620", f"xacro cannot read '{where}': "
                        f"{xml.parsers.expat.ErrorString(e.code)}")
             return None
-        except Exception as e:
+        except (Exception, ExpansionTooLong) as e:  # the watchdog's is no Exception (xacro_limits)
             where = _current_file(path)
             if (refused := refusal_of(e)) is not None:
                 sink.error(_locate(where, refused.needle) or origin or Span.of_file(where), refused.code,

@@ -6,13 +6,14 @@ runs too long or grows the process too much is stopped; each is E0673, and the p
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 from xml.sax.saxutils import escape
 
 import pytest
 
 from mpc.backends import xacro_limits
-from mpc.backends.xacro_limits import bounded_code
+from mpc.backends.xacro_limits import ExpansionTooLong, bounded_code, watched
 from mpc.backends.xacro_reader import expand
 from mpc.core.diagnostics import Sink
 from mpc.core.packages import PackageResolver
@@ -94,6 +95,49 @@ def test_an_expansion_that_runs_too_long_is_stopped_and_the_next_one_runs(
     time.sleep(0.2)  # nothing left pending in this thread
     text, said = _expand(tmp_path / "fine", '<link name="${2 * 21}"/>')
     assert said == [] and text is not None and '<link name="42"/>' in text
+
+
+def _spinner(deadline: float) -> Callable[[], None]:
+    """Python code that runs until `deadline`: each of its checks for a pending exception is
+    inside it, so inside whatever `try` the caller puts around it."""
+    def spin() -> None:
+        while time.monotonic() < deadline:
+            time.sleep(0.001)
+    return spin
+
+
+def test_the_watchdog_s_exception_passes_through_except_exception(monkeypatch: pytest.MonkeyPatch) -> None:
+    """xacro reads a literal by trying int, float and bool in turn, each under `except
+    Exception: pass`, and an expansion spends much of its time there: the exception must not
+    end in it (it did, now and then, and the expansion ran on for many minutes)."""
+    monkeypatch.setattr(xacro_limits, "MAX_SECONDS", 0.2)
+    deadline = time.monotonic() + 10  # without the fix, the loop ends here: the test fails, not hangs
+    spin = _spinner(deadline)
+    with pytest.raises(ExpansionTooLong), watched():
+        while time.monotonic() < deadline:
+            try:  # noqa: SIM105 (as xacro writes it)
+                spin()
+            except Exception:
+                pass
+    assert time.monotonic() < deadline - 8
+
+
+def test_an_exception_the_expansion_swallows_is_raised_again(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An exception raised while a destructor or a weakref callback runs is printed and dropped:
+    the watchdog raises it again until the expansion has ended."""
+    monkeypatch.setattr(xacro_limits, "MAX_SECONDS", 0.2)
+    deadline = time.monotonic() + 10
+    spin, swallowed = _spinner(deadline), 0
+    with pytest.raises(ExpansionTooLong), watched():
+        while True:
+            try:
+                spin()
+                break
+            except ExpansionTooLong:
+                swallowed += 1
+                if swallowed > 1:
+                    raise
+    assert swallowed == 2 and time.monotonic() < deadline - 8
 
 
 def test_an_expansion_that_grows_the_process_too_much_is_stopped(tmp_path: Path,
