@@ -137,7 +137,7 @@ def _innermost(e: BaseException) -> BaseException:
     return e
 
 
-def _message(e: Exception) -> str:
+def _message(e: BaseException) -> str:
     """xacro's own words: its message, or (where it only names the type) the wrapped error's."""
     said = str(e.args[0]).strip() if e.args and e.args[0] else ""
     inner = _innermost(e)
@@ -148,7 +148,7 @@ def _message(e: Exception) -> str:
     return text.splitlines()[0].strip()
 
 
-def _hint(e: Exception) -> str | None:
+def _hint(e: BaseException) -> str | None:
     from xacro.substitution_args import ArgException
 
     if isinstance(_innermost(e), ArgException):
