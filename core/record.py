@@ -78,11 +78,18 @@ def lazy_twin(of: type) -> Callable[[T], T]:
     some of whose fields are found when first asked for (core/span.py: LazySpan; ir/fragments.py:
     LazyFragment). It is no record class of its own (`is_record`): it is equal to, hashes and
     prints as the record of the same fields, and the build cache keeps it, and `settle_spans`
-    walks it, as the record it stands for (`record_of`)."""
+    walks it, as the record it stands for (`record_of`). It pickles and copies as that record
+    (every field found first)."""
     def register(cls: T) -> T:
         _STANDS_FOR[cls] = of
+        cls.__reduce__ = _reduce_as_record  # type: ignore[method-assign]
         return cls
     return register
+
+
+def _reduce_as_record(self: Any) -> tuple[Callable[..., Any], tuple[Any, ...]]:
+    """A lazy twin's pickle: the record it stands for, made from its fields (`from_values`)."""
+    return from_values, (_STANDS_FOR[type(self)], list(_values(self)))
 
 
 def record_of(cls: type) -> type | None:

@@ -10,7 +10,6 @@ import os
 import types
 from collections.abc import Callable
 from functools import lru_cache
-from operator import attrgetter
 from pathlib import Path
 from typing import Any, Protocol, cast
 
@@ -47,7 +46,6 @@ class Span:
         return cls(file, 1, 1)
 
 
-_fields = attrgetter("file", "line", "col", "end_line", "end_col")
 _POSITION = frozenset({"line", "col", "end_line", "end_col"})
 _set_file, _set_line, _set_col, _set_end_line, _set_end_col = (
     Span.__dict__[name].__set__ for name in ("file", "line", "col", "end_line", "end_col"))
@@ -93,9 +91,6 @@ class LazySpan(Span):
         _set_find(self, None)  # lets the parsed file go
         _set_node(self, None)
         return object.__getattribute__(self, name)
-
-    def __reduce__(self) -> tuple[type[Span], tuple[Any, ...]]:
-        return Span, _fields(self)
 
 
 _set_find, _set_node, _set_attr = (LazySpan.__dict__[name].__set__ for name in ("_find", "_node", "_attr"))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any, Literal, Protocol
 
-from mpc.core.record import from_values, lazy_twin, record, record_values
+from mpc.core.record import lazy_twin, record
 from mpc.core.span import Span
 
 RefKind = Literal["link", "joint"]
@@ -89,18 +89,11 @@ class LazyFragment(Fragment):
         _set_node(self, None)
         return refs
 
-    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
-        return _plain, (list(record_values(self)),)
-
 
 _set_tag, _set_xml, _set_refs, _set_comments, _set_span = (
     Fragment.__dict__[name].__set__ for name in ("tag", "xml", "refs", "comments", "span"))
 _set_finder, _set_node = (LazyFragment.__dict__[name].__set__ for name in ("_finder", "_node"))
 _new = object.__new__
-
-
-def _plain(values: list[Any]) -> Fragment:
-    return from_values(Fragment, values)
 
 
 def lazy_fragment(tag: str, xml: str, comments: tuple[str, ...], span: Span | None,
