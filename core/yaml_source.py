@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import re
 import stat
+from bisect import bisect_right
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import field
@@ -163,14 +164,42 @@ class Document:
         return self.values.get(tuple(path)) or self.span(path)
 
 
-def _span(file: str, node: Node) -> Span:
-    s, e = node.start_mark, node.end_mark
-    return Span(file, s.line + 1, s.column + 1, e.line + 1, e.column + 1)
+class _Lines:
+    """Positions in `text` as editors and mpc's quoting count its lines: broken at \\n, \\r\\n and
+    \\r (LSP's line breaks, and Python's reading of a text file). PyYAML, reading YAML 1.1, also
+    breaks lines at U+0085, U+2028 and U+2029, so its marks' lines and columns are past any of
+    those; a mark's index (its character in the text) is the same for both."""
+
+    def __init__(self, text: str) -> None:
+        self.starts = [0, *(m.end() for m in _LINE_BREAK.finditer(text))]
+
+    def position(self, index: int) -> tuple[int, int]:
+        """The 1-based line and column of character `index`."""
+        line = bisect_right(self.starts, index) - 1
+        return line + 1, index - self.starts[line] + 1
+
+
+_LINE_BREAK = re.compile("\r\n|\r|\n")
+_YAML_ONLY_BREAK = re.compile("[\x85\u2028\u2029]")  # a line break to PyYAML alone (_Lines)
+
+
+def _yaml_lines(text: str) -> _Lines | None:
+    """The `_Lines` of `text` when PyYAML's marks count its lines otherwise, else None."""
+    return _Lines(text) if _YAML_ONLY_BREAK.search(text) else None
+
+
+def _mark_position(mark: yaml.Mark | None, text: str) -> tuple[int, int]:
+    """The 1-based line and column of `mark` in `text` (1, 1 without one)."""
+    if mark is None:
+        return 1, 1
+    lines = _yaml_lines(text)
+    return lines.position(mark.index) if lines else (mark.line + 1, mark.column + 1)
 
 
 class _Builder:
-    def __init__(self, doc: Document, sink: Sink, limits: Limits = LIMITS) -> None:
+    def __init__(self, doc: Document, sink: Sink, limits: Limits = LIMITS, text: str = "") -> None:
         self.doc, self.sink, self.limits = doc, sink, limits
+        self.lines = _yaml_lines(text)
         # Span's maker (core/record.py): a span for every key and value, on each keystroke in
         # `mpc lsp` (a thousand for a TALOS definition).
         self.new_span = maker(Span)
@@ -179,20 +208,22 @@ class _Builder:
         self.open: set[int] = set()  # the nodes being built: an alias to one of them is a cycle
 
     def span(self, node: Node) -> Span:
-        """`_span(file, node)`, made by the maker."""
+        """Where `node` is written, made by the maker."""
         s, e = node.start_mark, node.end_mark
+        if self.lines is not None:
+            return self.new_span(self.doc.file, *self.lines.position(s.index), *self.lines.position(e.index))
         return self.new_span(self.doc.file, s.line + 1, s.column + 1, e.line + 1, e.column + 1)
 
     def scalar(self, node: ScalarNode, path: Path_) -> Any:
         v, tag = node.value, node.tag
         if len(v) > self.limits.scalar:
-            self.sink.error(_span(self.doc.file, node), "E0111", f"a value of {len(v)} characters; "
+            self.sink.error(self.span(node), "E0111", f"a value of {len(v)} characters; "
                             f"at most {self.limits.scalar} are read")
             self.unusable = True
             return None
         if tag == "tag:yaml.org,2002:str":
             if "\0" in v:
-                self.sink.error(_span(self.doc.file, node), "E0106", "a NUL character in a string: "
+                self.sink.error(self.span(node), "E0106", "a NUL character in a string: "
                                 "no file, link, joint or other name can hold one")
                 self.unusable = True
             return v
@@ -203,7 +234,7 @@ class _Builder:
         if tag == "tag:yaml.org,2002:int":
             self.doc.numbers[path] = v
             if len(v.lstrip("+-")) > self.limits.digits:
-                self.sink.error(_span(self.doc.file, node), "E0112", f"an integer of {len(v)} "
+                self.sink.error(self.span(node), "E0112", f"an integer of {len(v)} "
                                 f"digits; at most {self.limits.digits} are read")
                 self.unusable = True
                 return None
@@ -212,7 +243,7 @@ class _Builder:
             self.doc.numbers[path] = v
             low = v.lower().lstrip("+")
             return float(low.replace(".inf", "inf").replace(".nan", "nan"))
-        self.sink.error(_span(self.doc.file, node), "E0105", f"unsupported YAML tag '{tag}'")
+        self.sink.error(self.span(node), "E0105", f"unsupported YAML tag '{tag}'")
         return v
 
     def build(self, node: Node, path: Path_) -> Any:
@@ -221,7 +252,7 @@ class _Builder:
         self.nodes += 1
         if self.nodes > self.limits.nodes:  # aliases expand to copies: billion laughs stop here
             keyed = next((path[:n] for n in range(len(path), 0, -1) if path[:n] in self.doc.keys), None)
-            where = self.doc.keys[keyed] if keyed else _span(self.doc.file, node)
+            where = self.doc.keys[keyed] if keyed else self.span(node)
             self.sink.error(where, "E0109", f"the aliases expand to more than {self.limits.nodes} "
                             "values")
             self.unusable = True
@@ -230,7 +261,7 @@ class _Builder:
         if isinstance(node, ScalarNode):
             return self.scalar(node, path)
         if id(node) in self.open:
-            self.sink.error(_span(self.doc.file, node), "E0108", "a recursive alias: the value "
+            self.sink.error(self.span(node), "E0108", "a recursive alias: the value "
                             "contains itself")
             self.unusable = True
             return None
@@ -252,13 +283,13 @@ class _Builder:
                               else [value_node])
                 continue
             if not isinstance(key_node, ScalarNode):
-                self.sink.error(_span(self.doc.file, key_node), "E0105",
+                self.sink.error(self.span(key_node), "E0105",
                                 "a mapping key must be a plain value, not a list or mapping")
                 continue
             key = key_node.value
             key_path = (*path, key)
             if key in out:
-                self.sink.error(_span(self.doc.file, key_node), "E0103", f"duplicate key '{key}'",
+                self.sink.error(self.span(key_node), "E0103", f"duplicate key '{key}'",
                                 notes=((self.doc.keys[key_path], "first written here"),))
                 continue
             self.doc.keys[key_path] = self.span(key_node)
@@ -444,17 +475,16 @@ def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS, fast: bool 
         loader = _Composer(text, limits)  # the reader checks the characters already
         node = loader.get_single_node()
     except yaml.reader.ReaderError as e:
-        line, col = _position(text, e.position)
+        line, col = _Lines(text).position(e.position)
         sink.error(Span(file, line, col), "E0107", f"a non-printable character (#x{e.character:04x}) "
                    "in YAML; write it escaped in a double-quoted string")
         return None
     except _Limit as e:
-        line, col = (e.mark.line + 1, e.mark.column + 1) if e.mark else (1, 1)
+        line, col = _mark_position(e.mark, text)
         sink.error(Span(file, line, col), e.code, e.message)
         return None
     except yaml.MarkedYAMLError as e:
-        mark = e.problem_mark or e.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+        line, col = _mark_position(e.problem_mark or e.context_mark, text)
         what = e.problem or e.context or "syntax error"
         sink.error(Span(file, line, col), "E0102", f"malformed YAML: {what}")
         return None
@@ -467,17 +497,13 @@ def loads(text: str, file: str, sink: Sink, limits: Limits = LIMITS, fast: bool 
     if node is None:
         sink.error(Span.of_file(file), "E0104", f"'{file}' is empty")
         return None
-    return _document(node, file, sink, limits)
+    return _document(node, file, sink, limits, text)
 
 
-def _document(node: Node, file: str, sink: Sink, limits: Limits) -> Document | None:
+def _document(node: Node, file: str, sink: Sink, limits: Limits, text: str = "") -> Document | None:
+    """The Document of `node`; `text`: what PyYAML composed it from (libyaml composes no text
+    with a line break of YAML's alone: `_DIFFERENT`)."""
     doc = Document(file, None)
-    builder = _Builder(doc, sink, limits)
+    builder = _Builder(doc, sink, limits, text)
     doc.data = builder.build(node, ())
     return None if builder.unusable else doc
-
-
-def _position(text: str, offset: int) -> tuple[int, int]:
-    """1-based line and column of character `offset` of `text`."""
-    line = text.count("\n", 0, offset) + 1
-    return line, offset - (text.rfind("\n", 0, offset) + 1) + 1
