@@ -85,6 +85,13 @@ class _Writer:
                 text += f' {key}="{self.escape(value)}"'
         return text
 
+    def named(self, name: str | None, extra: Attrs) -> str:
+        """`attrs([("name", name), *extra])`, without the list for the commonest case: a link,
+        visual or collision with its name alone."""
+        if extra:
+            return self.attrs([("name", name), *extra])
+        return f' name="{self.escape(name)}"' if name is not None else ""
+
     def comments(self, ind: str, comments: tuple[str, ...]) -> None:
         for c in comments:
             self.out.append(f"{ind}<!--{c}-->")
@@ -167,7 +174,7 @@ class _Writer:
 
     def shape(self, ind: str, tag: str, item: Visual | Collision) -> None:
         d = ind + IND
-        head = f"{ind}<{tag}{self.attrs([('name', item.name), *item.extra_attrs])}>"
+        head = f"{ind}<{tag}{self.named(item.name, item.extra_attrs)}>"
         if item.origin is not None:
             head += "\n" + self.origin(d, item.origin)
         self.out.append(f"{head}\n{self.geometry(d, item.geometry, item.geometry_attrs)}")
@@ -183,7 +190,7 @@ class _Writer:
     def link(self, ind: str, link: Link) -> None:
         if link.comments:
             self.comments(ind, link.comments)
-        head = f"{ind}<link{self.attrs([('name', link.name), *link.extra_attrs])}"
+        head = f"{ind}<link{self.named(link.name, link.extra_attrs)}"
         body = link.inertial or link.visuals or link.collisions or link.extras
         if not body and not link.inner_comments:
             self.out.append(head + "/>")
@@ -205,7 +212,10 @@ class _Writer:
     def joint(self, ind: str, joint: Joint) -> None:
         if joint.comments:
             self.comments(ind, joint.comments)
-        attrs = self.attrs([("name", joint.name), ("type", joint.type), *joint.extra_attrs])
+        if joint.extra_attrs:
+            attrs = self.attrs([("name", joint.name), ("type", joint.type), *joint.extra_attrs])
+        else:
+            attrs = f' name="{self.escape(joint.name)}" type="{self.escape(joint.type)}"'
         self.out.append(f"{ind}<joint{attrs}>")
         d, number = ind + IND, self.number
         if joint.inner_comments:
