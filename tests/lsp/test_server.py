@@ -87,6 +87,15 @@ def test_diagnostics_are_mpc_checks_at_their_range(server: Client, folder: Path)
     assert elbo["severity"] == 1 and elbo["source"] == "mpc"
 
 
+def test_a_line_break_of_yaml_alone_leaves_diagnostics_on_the_editor_s_lines(server: Client,
+                                                                             folder: Path) -> None:
+    """U+2028 breaks a line for PyYAML (YAML 1.1) but not in the editor: the unknown joint
+    'elbo' is on the editor's line 19, one below where it is without the comment."""
+    _, diagnostics = opened(server, folder / "separator.yml", "# a note\u2028\n" + DEFINITION)
+    elbo = next(d for d in diagnostics if "'elbo'" in d["message"])
+    assert elbo["range"] == {"start": {"line": 19, "character": 4}, "end": {"line": 19, "character": 8}}
+
+
 def test_a_missing_mesh_file_is_reported_as_mpc_check_reports_it(server: Client, tmp_path: Path) -> None:
     alone = tmp_path  # the arm without its meshes folder
     shutil.copy(EXAMPLES / "arm.urdf", alone / "arm.urdf")
