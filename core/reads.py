@@ -22,6 +22,8 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from mpc.core.files import real_path
+
 # File types that are code, not inputs: modules imported while building.
 _CODE_SUFFIXES = frozenset({".py", ".pyc", ".so", ".pyd", ".pth", ".pyi", ".typed", ".lark"})
 _SYSTEM = ("/proc/", "/sys/", "/dev/", "/etc/")
@@ -77,6 +79,7 @@ class ReadRecorder:
         looked for and not found included. first: only among the first so many files read; without
         it, the files of programs noted (`note_files`) too."""
         out = {Path(p) for p in self.programs} if first is None else set()
+        real_dirs: dict[str, str] = {}  # the inputs' folders, resolved once (a model's meshes share them)
         for text in itertools.islice(self.read, first):
             if text in self.written or text.startswith(_SYSTEM) or text.startswith(self.ignore):
                 continue
@@ -86,7 +89,7 @@ class ReadRecorder:
             data = f"{os.sep}share{os.sep}" in text
             if text.startswith(self.code_as_named) and not data:
                 continue  # no realpath for the many files read from the installation
-            real = os.path.realpath(text)
+            real = real_path(text, real_dirs)
             if real.startswith(self.code) and f"{os.sep}share{os.sep}" not in real:
                 continue
             try:
