@@ -369,9 +369,13 @@ class KeptBuild:
             folders += (str(rel / name) for name in dirs)
             for name in found:
                 source = Path(here) / name
-                if source.is_symlink() or not source.is_file():
+                try:
+                    st = os.lstat(source)  # a regular file, no link: its lstat is its stat
+                except OSError:
                     return None
-                noted = cache.written_copy(source)  # a mesh out of the cache, unchanged since
+                if not stat.S_ISREG(st.st_mode):
+                    return None
+                noted = cache.written_copy(st)  # a mesh out of the cache, unchanged since
                 if noted is None:
                     with open(source, "rb") as f:
                         noted = hashlib.file_digest(f, "sha256").hexdigest(), None

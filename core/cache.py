@@ -100,13 +100,14 @@ def note_written(path: Path, digest: str, origin: Path | None = None) -> None:
 def written_digest(path: Path) -> str | None:
     """The SHA-256 noted for `path` (`note_written`) if it is still that file, unchanged (any
     write changes its status time); else None."""
-    noted = written_copy(path)
+    noted = written_copy(os.stat(path))
     return noted[0] if noted is not None else None
 
 
-def written_copy(path: Path) -> tuple[str, Path | None] | None:
-    """(the SHA-256, the origin) noted for `path` if it is still that file, unchanged; else None."""
-    return _written.get(status(os.stat(path)))
+def written_copy(st: os.stat_result) -> tuple[str, Path | None] | None:
+    """(the SHA-256, the origin) noted for the file whose status is `st` if it is still the
+    file noted, unchanged; else None."""
+    return _written.get(status(st))
 
 
 def status(st: os.stat_result) -> tuple[int, int, int, int, int]:
