@@ -63,10 +63,10 @@ def main(reps: int = 30) -> None:
     print(f"  total {statistics.median(total):6.2f} ms   (target < 30 ms)")
     lxml_ms = statistics.median(lxml_alone)
     print(f"  lxml parse + serialize alone {lxml_ms:6.2f} ms: mpc's read + emit is "
-          f"{statistics.median(total) / lxml_ms:.1f}× (target ≤ 4×; load average {os.getloadavg()[0]:.1f})")
+          f"{statistics.median(total) / lxml_ms:.2f}× (target ≤ 4×; load average {os.getloadavg()[0]:.1f})")
     cpu_ms, lxml_cpu_ms = statistics.median(cpu), statistics.median(lxml_cpu)
     print(f"  CPU time: mpc {cpu_ms:6.2f} ms, lxml {lxml_cpu_ms:6.2f} ms: "
-          f"{cpu_ms / lxml_cpu_ms:.1f}× (target ≤ 4×)")
+          f"{cpu_ms / lxml_cpu_ms:.2f}× (target ≤ 4×)")
 
 
 if __name__ == "__main__":
