@@ -11,6 +11,7 @@ and mpc's IR (with the parsed file its spans hold) right after its write. Until 
 IR was freed when the next read's result replaced it, so every read ran beside the previous
 read's IR and then freed it, cold: 0.6-0.9 ms more per repetition than freeing it at once,
 which lxml's side never paid (bench/README.md, 2026-11-28).
+
 Run: python bench/bench_urdf.py [repetitions]
 """
 

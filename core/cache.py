@@ -105,8 +105,8 @@ def written_digest(path: Path) -> str | None:
 
 
 def written_copy(st: os.stat_result) -> tuple[str, Path | None] | None:
-    """(the SHA-256, the origin) noted for the file whose status is `st` if it is still the
-    file noted, unchanged; else None."""
+    """(the SHA-256, the origin) noted for the file whose status (`os.stat`) is `st`, if that
+    file is unchanged since; else None."""
     return _written.get(status(st))
 
 
