@@ -31,9 +31,10 @@ import sys
 import threading
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from mpc.backends.plain_meshes import Job
+if TYPE_CHECKING:  # not imported before the worker starts: it would load the IR first
+    from mpc.backends.plain_meshes import Job
 
 _LENGTH = 4  # bytes of a message's length, before its pickle
 
@@ -46,7 +47,7 @@ _read = b""  # what the build read of `_digests` beyond the last whole line
 
 def start() -> None:
     """Start the worker, when there is none. The build asks for it when it has two cores or
-    more of its own (backends/meshes.py `forks_beside`).
+    more of its own (core/cores.py `forks_beside`).
 
     A fresh interpreter, not a fork: a fork of the build shares its memory until either writes
     a page, and the build's front end, which writes to most of its pages, then copied them one
@@ -160,7 +161,8 @@ def _serve(jobs: int, digests: int) -> None:
             arrived.notify()
 
     threading.Thread(target=receive, daemon=True).start()
-    import numpy  # noqa: F401  # while the build checks its definition
+    import lxml.etree  # noqa: F401  # while the build checks its definition: what a job needs
+    import numpy  # noqa: F401
 
     from mpc.backends.plain_meshes import materialise
     from mpc.core.cache import written_digest

@@ -25,7 +25,7 @@ from mpc.backends.mujoco_meshes import problem as mujoco_problem
 from mpc.backends.mujoco_meshes import verdict as mujoco_verdict
 from mpc.backends.plain_meshes import Job
 from mpc.backends.smurf_forms import named_shapes
-from mpc.core.cores import usable_cores
+from mpc.core.cores import WORKERS, mesh_workers, shared
 from mpc.core.diagnostics import Sink
 from mpc.core.files import why_absent
 from mpc.core.numbers import zero_small
@@ -499,7 +499,7 @@ def _compute(jobs: list[Job]) -> dict[Path, tuple[str, str]]:
     elif sizes is not None and size < LIGHT:
         from mpc.backends.mesh_fork import beside_a_fork, may_fork
 
-        if _share is None and may_fork():
+        if not shared() and may_fork():
             results = beside_a_fork(tasks, _costs(tasks, sizes), _materialise_all,
                                     lambda task: [dest for _, _, dest in task[1]])
         else:  # `mpc run`'s builds use the other cores already
@@ -562,17 +562,6 @@ def _materialise_all(task: Task) -> dict[Path, tuple[str, str]]:
     return {dest: problem for dest, problem in found.items() if problem}
 
 
-WORKERS = "MPC_MESH_WORKERS"
-_share: int | None = None  # the cores of one of `mpc run`'s builds side by side (share_cores)
-
-
-def forks_beside() -> bool:
-    """Whether a build may make its plain meshes in a process beside it (mesh_fork.py,
-    mesh_worker.py): it has two cores or more of its own (not one of `mpc run`'s builds), and
-    MPC_MESH_WORKERS asks for no number of processes."""
-    return _share is None and not os.environ.get(WORKERS, "").isdigit() and usable_cores() >= 2
-
-
 def likely_tasks(robots: list[Robot], exports: Sequence[Any]) -> list[tuple[list[Job], float]]:
     """The plain mesh jobs the exports will most likely ask of the input models' meshes, grouped
     by source, with their costs: each mesh as read, in each export's mesh format, when that is
@@ -612,23 +601,6 @@ def likely_tasks(robots: list[Robot], exports: Sequence[Any]) -> list[tuple[list
 def _priced(tasks: list[Task], costs: list[float]) -> list[tuple[list[Job], float]]:
     """The jobs of each task with its cost, as the worker takes them (mesh_worker.offer)."""
     return [(jobs, cost) for (_, jobs), cost in zip(tasks, costs, strict=True)]
-
-
-def mesh_workers() -> int:
-    """How many processes compute one build's meshes: MPC_MESH_WORKERS when it is a positive
-    number, else the build's share of the cores (`mpc run -jN`), else every core this process
-    may run on."""
-    given = os.environ.get(WORKERS, "")
-    if given.isdigit() and int(given) > 0:
-        return int(given)
-    return _share or usable_cores()
-
-
-def share_cores(builds: int) -> None:
-    """`builds` builds run side by side (`mpc run -jN`): each computes its meshes on its share
-    of the cores, not on all of them (N pools of every core only fight over them)."""
-    global _share
-    _share = max(1, usable_cores() // max(1, builds))
 
 
 def _start_method(heavy: bool = True) -> str:

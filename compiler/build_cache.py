@@ -91,6 +91,12 @@ _FINE_NS, _COARSE_NS = 20_000_000, 2_000_000_000
 Files = list[tuple[str, str | None]]  # (path, SHA-256 of its bytes, or None: looked for, missing)
 
 
+def kept_folder(path: Path) -> Path:
+    """Where the build of the definition at `path`, compiled from this working folder, is kept."""
+    where = json.dumps([str(path), os.getcwd()])
+    return cache.cache_dir("builds") / hashlib.sha256(where.encode()).hexdigest()
+
+
 class KeptBuild:
     """One compilation's use of the build cache: the build kept for its definition (when all it
     depends on is as it was), and the recording of what this compilation reads."""
@@ -134,9 +140,7 @@ class KeptBuild:
             sorted((k, v) for k, v in user_environment().items() if k not in _SESSION),
             *([] if options.post_processing else ["no post_processing"]),
         ])
-        name = hashlib.sha256(json.dumps(where).encode()).hexdigest()
-        kept = cls(cache.cache_dir("builds") / name, hashlib.sha256(key.encode()).hexdigest(),
-                   options)
+        kept = cls(kept_folder(path), hashlib.sha256(key.encode()).hexdigest(), options)
         kept._load()
         return kept
 

@@ -233,18 +233,21 @@ def replace_folder(new: Path, out: Path) -> str | None:
 
 def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
+    from mpc.backends import mesh_worker
     from mpc.compiler.build_cache import KeptBuild
 
-    with stage("lower"):
-        kept = KeptBuild.open(path, options)                   # the last build, if it still holds
-    if kept is not None:
-        kept.report_refused(sink, Span.of_file(str(path)))     # an entry not read (W0650)
-    if kept is not None and kept.outputs_hold and not sink.werror:
-        done = _write_kept(kept, path, sink, options)           # its outputs, as they were
-        if done is not None:
-            return done
-    before = len(sink.diagnostics)
+    if _first_build(path, options):
+        mesh_worker.start()  # imports numpy while the build looks for its kept build and reads its definition
     try:  # a mesh worker the build starts (backends/mesh_worker.py) ends with its mesh stages
+        with stage("lower"):
+            kept = KeptBuild.open(path, options)                   # the last build, if it still holds
+        if kept is not None:
+            kept.report_refused(sink, Span.of_file(str(path)))     # an entry not read (W0650)
+        if kept is not None and kept.outputs_hold and not sink.werror:
+            done = _write_kept(kept, path, sink, options)           # its outputs, as they were
+            if done is not None:
+                return done
+        before = len(sink.diagnostics)
         with kept.recording(sink) if kept is not None else contextlib.nullcontext():
             with stage("lower"):
                 definition = Span.of_file(str(path))
@@ -274,8 +277,6 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
             with stage("write"):
                 written = emit(program, robot, out, sink, options.target)  # emit, rename into place
     finally:
-        from mpc.backends import mesh_worker
-
         mesh_worker.stop()
     if not written:
         return Result(program, robot)
@@ -283,6 +284,17 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
         with stage("keep"):                                    # for the next build
             kept.keep(program, robot, sink.diagnostics[before:model_end], out, sink.diagnostics[model_end:])
     return Result(program, robot, out)
+
+
+def _first_build(path: Path, options: Options) -> bool:
+    """Whether the build is sure to read its definition and most likely to make meshes: no build
+    of the definition is kept (its first, or the cache was emptied), and it may make them in a
+    process beside it (core/cores.py). A pipeline's builds (`options.defaults`) are not kept."""
+    from mpc.compiler.build_cache import kept_folder
+    from mpc.core.cores import forks_beside
+
+    return (options.defaults is None and options.models is None and forks_beside()
+            and not (kept_folder(path) / "entry").exists())
 
 
 def _write_kept(kept: KeptBuild, path: Path, sink: Sink, options: Options) -> Result | None:
@@ -324,7 +336,7 @@ def _program_and_robot(path: Path, sink: Sink, options: Options,
     """The front end and the ops: (program, robot), either None after errors. `program_done`
     is called when the front end has said all it says."""
     from mpc.backends import mesh_worker
-    from mpc.backends.meshes import forks_beside
+    from mpc.core.cores import forks_beside
 
     if forks_beside():
         mesh_worker.start()  # imports numpy while the front end runs, then makes the meshes it is given

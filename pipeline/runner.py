@@ -237,8 +237,8 @@ class Runner:
                        defaults=self.plan.defaults, post_processing=self.opts.post_processing)
 
     def _start(self, name: str, pre: str, cached: list[str], side_by_side: int) -> None:
-        from mpc.backends.meshes import share_cores
         from mpc.core.cache import cache_dir
+        from mpc.core.cores import share_cores
         from mpc.pipeline import worker
 
         _preload(self.shared)

@@ -13,12 +13,14 @@ import filecmp
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 import trimesh
 
-from mpc.backends.meshes import mesh_workers, share_cores
+from mpc.compiler.options import Options
+from mpc.core.cores import mesh_workers, share_cores
 from mpc.core.diagnostics import Sink
 from tests.conftest import compile_file, definition, write
 from tests.mpc_command import mpc_process
@@ -88,8 +90,8 @@ def test_a_pool_writes_what_one_process_writes(tmp_path: Path, monkeypatch: pyte
 def _two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
     """The build has the machine to itself, of two cores (not one of `mpc run`'s), and has
     loaded no MuJoCo (another test in this process may have: it is unloaded for the test)."""
-    monkeypatch.setattr("mpc.backends.meshes.usable_cores", lambda: 2)
-    monkeypatch.setattr("mpc.backends.meshes._share", None)
+    monkeypatch.setattr("mpc.core.cores.usable_cores", lambda: 2)
+    monkeypatch.setattr("mpc.core.cores._share", None)
     monkeypatch.delitem(sys.modules, "mujoco", raising=False)
 
 
@@ -159,9 +161,10 @@ def test_the_worker_makes_the_input_models_meshes_and_ends_with_the_build(
     trace = tmp_path / "trace-worker"
     trace.touch()
 
-    def started() -> None:
+    def started() -> None:  # asked for twice: as the build starts, and before its front end
         start()
-        pids.append(mesh_worker._pid)
+        if mesh_worker._pid not in pids:
+            pids.append(mesh_worker._pid)
 
     def after_the_worker(jobs: list[meshes.Job]) -> dict[Path, tuple[str, str]]:
         deadline = time.monotonic() + 60
@@ -183,6 +186,35 @@ def test_the_worker_makes_the_input_models_meshes_and_ends_with_the_build(
     assert parsed["ball.stl"] == worker and set(parsed.values()) <= {worker, os.getpid()}
     assert not mesh_worker.active() and not Path(f"/proc/{worker}").exists()
     _same_tree(alone, out)
+
+
+def test_a_first_build_starts_the_worker_before_it_looks_for_its_kept_build(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A definition with no kept build starts its worker as the build starts, so that the
+    worker imports numpy while the build looks for a kept build and reads the definition. One
+    built before starts none until its kept build is found not to hold: its kept outputs are
+    most likely all it writes. Each worker is gone when its build returns."""
+    from mpc.backends import mesh_worker
+    from mpc.compiler.build_cache import KeptBuild
+
+    _two_cores(monkeypatch)
+    monkeypatch.delenv("MPC_MESH_WORKERS")
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    running: list[bool] = []  # whether a worker ran as each build looked for its kept build
+    open_ = KeptBuild.open
+
+    def opened(cls: type[KeptBuild], path: Path, options: Options) -> KeptBuild | None:
+        running.append(mesh_worker.active())
+        return open_(path, options)
+
+    monkeypatch.setattr(KeptBuild, "open", classmethod(opened))
+    spec = _robot(tmp_path, fine=True)
+    time.sleep(0.05)  # files changed as a build starts may change after it read them: it is not kept
+    for _ in range(2):
+        sink = Sink()
+        assert compile_file(spec, tmp_path / "out", sink).out is not None, sink.summary()
+        assert not mesh_worker.active()
+    assert running == [True, False]
 
 
 def test_what_the_forked_child_cannot_make_is_said_as_one_process_says_it(
@@ -256,7 +288,7 @@ def test_mpc_compile_forks_its_pool(tmp_path: Path) -> None:
 def test_the_workers_of_a_build(monkeypatch: pytest.MonkeyPatch) -> None:
     cores = len(os.sched_getaffinity(0))
     monkeypatch.delenv("MPC_MESH_WORKERS")
-    monkeypatch.setattr("mpc.backends.meshes._share", None)
+    monkeypatch.setattr("mpc.core.cores._share", None)
     assert mesh_workers() == cores
     share_cores(2)  # mpc run -j2
     assert mesh_workers() == max(1, cores // 2)
