@@ -3,14 +3,24 @@
 The floor is what any compiler of the definition must do: start Python with numpy and lxml,
 read and decode each distinct source mesh once (a binary STL with `numpy.frombuffer`, an
 ASCII STL with numpy's float parser, a DAE parsed by lxml with `huge_tree` and its number
-arrays by numpy), and write each output file once (as many bytes as mpc writes). It runs as a
-program of its own, in a fresh process, beside `mpc compile` with an empty cache, in turns
-(floor, mpc, floor, mpc, …): the ratio of each pair, and their median, hold when the
-machine's speed drifts. The warm `--force` rebuild (the mesh cache filled, the kept build read
-for its program only) is timed too: right after each cold build, and in a row of its own once
-the cache has settled (two seconds after the last build: what mpc remembers of a file by its
-status is kept for other processes only when the file is older than that, core/cache.py), as
-a rebuild minutes after the last one finds it. Each figure is printed beside its goal.
+arrays by numpy), and write each output file once (as many bytes as mpc writes, into a new
+folder: a cold build makes its files, it does not overwrite them). It runs as a program of its
+own, in a fresh process, beside `mpc compile` with an empty cache, in turns (floor, mpc, floor,
+mpc, …): the ratio of each pair, and their median, hold when the machine's speed drifts.
+
+Each pair runs in folders of its own (the floor's output; mpc's cache and output), and nothing
+is deleted until the end. Until 2026-11-28 the floor overwrote the files of its first run,
+and the cache and output of the last build were deleted just before each cold build. On this
+development machine (ext4 mounted with `discard`, in a VM) a file made soon after many were
+deleted can cost 0.8 ms instead of 0.03 ms: mpc's 88 output meshes took 68-81 ms there against
+24-27 ms in a folder of their own, while the floor, overwriting, made no file at all
+(bench/README.md, 2026-11-28).
+
+The warm `--force` rebuild (the mesh cache filled, the kept build read for its program only)
+is timed too: right after each cold build, and in a row of its own once the cache has settled
+(two seconds after the last build: what mpc remembers of a file by its status is kept for
+other processes only when the file is older than that, core/cache.py), as a rebuild minutes
+after the last one finds it. Each figure is printed beside its goal.
 
 Run: python bench/bench_floor.py [DEFINITION] [--runs N]
 (no DEFINITION: the 88-link assembly of bench_assembly.py, TALOS + UR5 + a mirrored arm)
@@ -21,7 +31,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import statistics
 import subprocess
 import sys
@@ -30,7 +39,7 @@ import time
 from pathlib import Path
 
 FLOOR = r'''
-import json, sys
+import json, os, sys
 import numpy as np
 from lxml import etree
 
@@ -51,8 +60,11 @@ for path in plan["sources"]:
             np.fromstring(element.text or "", dtype=np.float32, sep=" ")
         for element in root.iter("{*}p", "{*}vcount"):
             np.fromstring(element.text or "", dtype=np.int64, sep=" ")
+out = sys.argv[2]
+for folder in sorted({path.rpartition("/")[0] for path, _ in plan["outputs"]}):
+    os.makedirs(f"{out}/{folder}", exist_ok=True)
 for path, size in plan["outputs"]:
-    with open(path, "wb") as f:
+    with open(f"{out}/{path}", "wb") as f:
         f.write(bytes(size))
 '''
 
@@ -82,7 +94,7 @@ def plan(spec: Path, tmp: Path) -> dict[str, list]:
     result = compile_model(spec, Sink(), Options(out=tmp / "plan-out"))
     assert result.out is not None and result.robot is not None, "the definition does not compile"
     sources = sorted({str(u.mesh.source.path) for u in mesh_uses(result.robot) if u.mesh.source.path})
-    outputs = [(str(tmp / "floor-out" / p.relative_to(result.out)), p.stat().st_size)
+    outputs = [(p.relative_to(result.out).as_posix(), p.stat().st_size)
                for p in sorted(result.out.rglob("*")) if p.is_file()]
     return {"sources": sources, "outputs": outputs}
 
@@ -108,27 +120,28 @@ def main() -> None:
         spec = args.definition.resolve() if args.definition else assembly(tmp)
         work = plan(spec, tmp)
         (tmp / "plan.json").write_text(json.dumps(work))
-        (tmp / "floor-out").mkdir()
-        for folder in {Path(p).parent for p, _ in work["outputs"]}:
-            folder.mkdir(parents=True, exist_ok=True)
         (tmp / "floor.py").write_text(FLOOR)
         env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-        floor_cmd = [sys.executable, str(tmp / "floor.py"), str(tmp / "plan.json")]
-        out, cache = tmp / "out", tmp / "cache"
-        mpc_cmd = [sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o", str(out)]
-        mpc_env = {**env, "MPC_CACHE_DIR": str(cache)}
-        timed(floor_cmd, env)  # bytecode compiled, files in the page cache
-        timed(mpc_cmd, mpc_env)
+
+        def floor_run(run: str) -> tuple[float, float]:
+            return timed([sys.executable, str(tmp / "floor.py"), str(tmp / "plan.json"),
+                          str(tmp / run / "floor-out")], env)
+
+        def mpc_run(run: str, *flags: str) -> tuple[float, float]:
+            return timed([sys.executable, "-m", "mpc.cli.main", "compile", str(spec), "-o",
+                          str(tmp / run / "out"), *flags], {**env, "MPC_CACHE_DIR": str(tmp / run / "cache")})
+
+        floor_run("warm-up")  # bytecode compiled, files in the page cache
+        mpc_run("warm-up")
         floors, colds, warms = [], [], []
-        for _ in range(args.runs):
-            floors.append(timed(floor_cmd, env))
-            shutil.rmtree(cache, ignore_errors=True)
-            shutil.rmtree(out, ignore_errors=True)
-            colds.append(timed(mpc_cmd, mpc_env))
-            warms.append(timed([*mpc_cmd, "--force"], mpc_env))
+        for run in map(str, range(args.runs)):  # a folder each: nothing is deleted before a run
+            floors.append(floor_run(run))
+            colds.append(mpc_run(run))
+            warms.append(mpc_run(run, "--force"))
         time.sleep(2.5)
-        timed([*mpc_cmd, "--force"], mpc_env)  # what a rebuild remembers of the files, remembered
-        settled = [timed([*mpc_cmd, "--force"], mpc_env) for _ in range(args.runs)]
+        last = str(args.runs - 1)
+        mpc_run(last, "--force")  # what a rebuild remembers of the files, remembered
+        settled = [mpc_run(last, "--force") for _ in range(args.runs)]
         ratios = [c[0] / f[0] for f, c in zip(floors, colds, strict=True)]
         cpu_ratios = [c[1] / f[1] for f, c in zip(floors, colds, strict=True)]
         floor, cold, warm = (statistics.median(r[0] for r in runs) for runs in (floors, colds, warms))
