@@ -1,9 +1,11 @@
 """A process started as a cold build starts, which makes the build's plain mesh jobs beside it.
 
 A cold build's meshes cost more than half of what its inputs, ops and writers cost, and all of
-that runs on one core before the mesh stage starts. The worker is started before the front end
-(`start`: a fresh interpreter running this module), imports numpy and the plain mesh path
-while the build imports and checks the definition, and is given jobs as soon as they are
+that runs on one core before the mesh stage starts. The worker is started as the build starts
+when no build of the definition is kept (its first, or the cache was emptied), else before
+the front end (`start`: a fresh interpreter running this module); it imports numpy and the
+plain mesh path while the build opens its cache and imports and checks the definition (this
+module imports nothing of the IR until then), and is given jobs as soon as they are
 known: those the input models give as they are read (`offer` after the front end: their meshes
 in the exports' formats), then, at the mesh stage, the build's own (those of the meshes the ops
 changed). It makes them the costliest first; the build makes its own the cheapest first. Each
