@@ -21,6 +21,7 @@ wrote must load in MuJoCo, a USD layer in usd-core.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import itertools
 import math
@@ -247,13 +248,18 @@ class Outputs:
     files: int = 0
     _sdf_seen: int = 0
 
-    def check(self, out: Path, label: str) -> None:
+    def check(self, out: Path, label: str, inputs: frozenset[str] = frozenset()) -> None:
+        """inputs: the SHA-256 of each file the case gave mpc; a DAE of the same bytes is the
+        user's mesh copied as it is, judged as mpc's reader judged it (`copy_problem`)."""
         for path in sorted(out.rglob("*")):
             if not path.is_file() or path.suffix not in (".urdf", ".sdf", ".xml", ".dae", ".config", ".smurf",
                                                          ".yml", ".usda", ".usdc"):
                 continue
             self.files += 1
-            problem = output_problem(path) if path.suffix not in (".usda", ".usdc") else None
+            if path.suffix == ".dae" and hashlib.sha256(path.read_bytes()).hexdigest() in inputs:
+                problem = copy_problem(path)
+            else:
+                problem = output_problem(path) if path.suffix not in (".usda", ".usdc") else None
             if problem is None and path.parent.name in ("mjcf", "usd") and path.suffix != ".dae":
                 problem = consumer_refuses(path)
             if problem is not None:
@@ -332,6 +338,22 @@ def consumer_refuses(path: Path) -> str | None:
     return None
 
 
+def copy_problem(path: Path) -> str | None:
+    """Why a mesh mpc copied as it is (a DAE) is unsound, or None: XML that libxml2, mpc's
+    reader, does not find well-formed. expat (`output_problem`) keeps XML 1.0's names before
+    its fifth edition: a user's DAE may hold a name that only the fifth edition allows (a
+    U+FEFF in an attribute's name), which libxml2 and tinyxml2 (Gazebo's) read."""
+    from lxml import etree
+
+    from mpc.core.span import hardened_parser
+
+    try:
+        etree.parse(str(path), hardened_parser(huge=True))
+    except etree.XMLSyntaxError as e:
+        return f"not well-formed XML: {e}"
+    return None
+
+
 def output_problem(path: Path) -> str | None:
     """Why a file mpc wrote is unsound, or None: XML (URDF, SDF, MJCF, DAE) that is not
     well-formed for a namespace-aware parser (expat), a number in it that is not finite; YAML
@@ -401,6 +423,8 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
     if (case / "meshes").is_dir() and not (case / "meshes").is_symlink():
         (case / "meshes/link.stl").symlink_to("/proc/self/environ")  # for mutations that name it
     before = {p for p in case.rglob("*")}
+    inputs = frozenset(hashlib.sha256(p.read_bytes()).hexdigest() for p in before
+                       if p.is_file() and not p.is_symlink())
     pipeline = kind == "pipeline" or (kind == "loop" and run == "pipeline.yml")
     args = [command if not pipeline or command == "check" else "run", str(case / run),
             "-o", str(case / "out")]
@@ -432,7 +456,7 @@ def run_case(seeds: Seeds, base: Path, kind: str, edits: list[Edit], command: st
                 data = p.read_bytes()
                 assert b"ghp_" not in data and b"PATH=" not in data and SECRET.encode() not in data, p
         if status == 0 and outputs is not None:
-            outputs.check(case / "out", f"{kind} {command} {edits}")
+            outputs.check(case / "out", f"{kind} {command} {edits}", inputs)
     shutil.rmtree(case, ignore_errors=True)
     return status
 

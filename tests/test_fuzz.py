@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.fuzzing import KINDS, OPS, TOKENS, Edit, Outputs, Seeds, output_problem, run_case
+from tests.fuzzing import KINDS, OPS, TOKENS, Edit, Outputs, Seeds, copy_problem, output_problem, run_case
 
 EDITS = st.lists(st.builds(Edit, st.sampled_from(OPS), st.floats(0, 1), st.integers(0, len(TOKENS) - 1)),
                  min_size=1, max_size=3)
@@ -63,6 +63,32 @@ def test_the_output_checks_accept_names_that_read_as_numbers(tmp_path: Path) -> 
     path = tmp_path / "a.urdf"
     path.write_text('<robot name="nan"><link name="inf"/></robot>')
     assert output_problem(path) is None
+
+
+def test_a_mesh_copied_as_it_is_is_judged_by_the_reader_that_read_it(tmp_path: Path) -> None:
+    """XML 1.0's fifth edition allows a U+FEFF in a name; expat, the judge of the XML mpc
+    writes itself, keeps the older rules. A user's DAE copied as it is is judged by libxml2,
+    which read it (and tinyxml2, Gazebo's reader, takes it too); what no reader takes is still
+    refused."""
+    path = tmp_path / "m.dae"
+    path.write_text('<COLLADA x\ufeffy="1"/>', encoding="utf-8")
+    assert (output_problem(path) or "").startswith("not well-formed XML")
+    assert copy_problem(path) is None
+    path.write_text('<COLLADA x<y="1"/>')
+    assert (copy_problem(path) or "").startswith("not well-formed XML")
+
+
+def test_a_dae_with_a_fifth_edition_name_is_copied_and_judged_as_the_users(
+        seeds: Seeds, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """bench/fuzz.py's seed 1145: a U+FEFF inserted into an attribute's name of the DAE, which
+    the SDF export copies as it is. The build succeeds and its outputs pass the judge."""
+    monkeypatch.setenv("MPC_CACHE_DIR", str(tmp_path / "cache"))
+    base = tmp_path / "a/b/cases"
+    base.mkdir(parents=True)
+    outputs = Outputs(tmp_path / "kept", sdf_every=1)
+    assert run_case(seeds, base, "dae", [Edit("insert", 0.8971745659701676, 35)], "compile", outputs) == 0
+    assert outputs.invalid == []
+    assert outputs.consumers_refuse() == []
 
 
 XACRO_PAYLOADS = [i for i, token in enumerate(TOKENS) if token.startswith(("${", "$(", "<xacro:"))]
