@@ -163,6 +163,9 @@ def _serve(jobs: int, digests: int) -> None:
             arrived.notify()
 
     threading.Thread(target=receive, daemon=True).start()
+    from mpc.core.heap import keep_freed
+
+    keep_freed()  # what a job frees, the next one reuses (core/heap.py)
     import lxml.etree  # noqa: F401  # while the build checks its definition: what a job needs
     import numpy  # noqa: F401
 

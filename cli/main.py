@@ -319,6 +319,10 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("ignore")
     words = sys.argv[1:] if argv is None else argv
     args = _parser(words[0] if words and words[0] in COMMANDS else None).parse_args(argv)
+    if _process_ends and args.command in ("compile", "run"):  # builds (`run` forks one a model)
+        from mpc.core.heap import keep_freed
+
+        keep_freed()  # what a mesh job frees, the next one reuses (core/heap.py)
     try:
         with _without_cyclic_gc(args.command):
             command = COMMANDS[args.command].run
