@@ -488,10 +488,12 @@ def _compute(jobs: list[Job]) -> dict[Path, tuple[str, str]]:
     sizes = _plain_sizes(tasks)
     size = sum(sizes) if sizes is not None else LIGHT  # not all plain: the pool's
     from mpc.backends import mesh_worker
+    from mpc.core import meanwhile
 
     if mesh_worker.active() and sizes is not None and size >= FORKED:  # beside the worker
         costs = _costs(tasks, sizes)
         mesh_worker.offer(_priced(tasks, costs))
+        meanwhile.now()  # the build's work that needs no mesh, while the worker starts on these
         results = [_materialise_all(tasks[i]) for i in sorted(range(len(tasks)), key=costs.__getitem__)]
         mesh_worker.note_digests()
     elif workers < 2 or len(jobs) < 3 or size < FORKED:

@@ -121,6 +121,8 @@ class KeptBuild:
         self._sink: Sink | None = None  # where this build reports, from `recording`
         self._said_before = 0
         self.started = time.time_ns()
+        # `encode_model`'s program and robot, their JSON and the paths it names
+        self._encoded: tuple[Program, Robot, tuple[bytes, bytes] | None, list[PurePath]] | None = None
 
     @classmethod
     def open(cls, path: Path, options: Options) -> KeptBuild | None:
@@ -320,11 +322,10 @@ class KeptBuild:
                 packages = {(p, n): f for p, n, f in self.header["packages"]} | packages
                 model_json, named = (self._program_json, self._robot_json), self.header["named"]
             else:
-                paths = list[PurePath]()
-                try:
-                    model_json = dumps(program, paths), dumps(robot, paths)
-                except (TypeError, ValueError, RecursionError):
+                encoded, paths = self.encode_model(program, robot)
+                if encoded is None:
                     return  # a value that cannot be kept: the next build runs in full
+                model_json = encoded
                 named = [(p, *_where(p)) for p in sorted(set(map(str, paths)) - opened)]
             try:
                 diagnostics = _kept_diagnostics(model_diagnostics)
@@ -354,6 +355,20 @@ class KeptBuild:
                 cache.store_entry(self.entry, data)
             cache.trace(f"keep build {self.folder.name}")
             self._remove_old_outputs(header["outputs"])
+
+    def encode_model(self, program: Program, robot: Robot
+                     ) -> tuple[tuple[bytes, bytes] | None, list[PurePath]]:
+        """The JSON `keep` writes of the program and the robot (None when a value in them cannot
+        be kept), and the paths they name; made once for them, which a build does while its mesh
+        worker starts on the meshes (core/meanwhile.py)."""
+        if self._encoded is None or self._encoded[0] is not program or self._encoded[1] is not robot:
+            paths = list[PurePath]()
+            try:
+                encoded: tuple[bytes, bytes] | None = dumps(program, paths), dumps(robot, paths)
+            except (TypeError, ValueError, RecursionError):
+                encoded = None
+            self._encoded = program, robot, encoded, paths
+        return self._encoded[2], self._encoded[3]
 
     def _keep_outputs(self, out: Path, diagnostics: list[Diagnostic],
                       model_files: set[str]) -> dict[str, Any] | None:

@@ -235,6 +235,7 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
     """Compile the definition at `path`; diagnostics go to `sink`."""
     from mpc.backends import mesh_worker
     from mpc.compiler.build_cache import KeptBuild
+    from mpc.core import meanwhile
 
     if _first_build(path, options):
         mesh_worker.start()  # imports numpy while the build looks for its kept build and reads its definition
@@ -273,11 +274,14 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
             with stage("apply ops"):
                 check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
                 check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
+            if kept is not None and mesh_worker.active():  # its model, kept while the worker starts on meshes
+                meanwhile.later(functools.partial(kept.encode_model, program, robot))
             out = _out(options, program.modelname)
             with stage("write"):
                 written = emit(program, robot, out, sink, options.target)  # emit, rename into place
     finally:
         mesh_worker.stop()
+        meanwhile.drop()
     if not written:
         return Result(program, robot)
     if kept is not None:
