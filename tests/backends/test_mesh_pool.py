@@ -217,6 +217,43 @@ def test_a_first_build_starts_the_worker_before_it_looks_for_its_kept_build(
     assert running == [True, False]
 
 
+def test_a_first_build_encodes_its_kept_model_before_it_makes_meshes_beside_its_worker(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Beside a worker, the build gives it every job of its mesh stage and encodes the model it
+    keeps (core/meanwhile.py) before it makes any mesh itself; once, and what it keeps is what a
+    build without a worker keeps: the next build takes it and writes the same files."""
+    from mpc.backends import mesh_worker, plain_meshes
+    from mpc.compiler import build_cache
+
+    events: list[str] = []  # each value encoded for the kept build, each mesh the build made
+    dumps, materialise = build_cache.dumps, plain_meshes.materialise
+    monkeypatch.setattr(build_cache, "dumps", lambda *a: (events.append("encode"), dumps(*a))[1])
+    monkeypatch.setattr(plain_meshes, "materialise", lambda jobs: (events.append("mesh"), materialise(jobs))[1])
+    outs = []
+    for workers in ("1", None):
+        folder = tmp_path / f"workers-{workers}"
+        folder.mkdir()
+        spec = _robot(folder, fine=True)
+        if workers is None:
+            _two_cores(monkeypatch)
+            monkeypatch.delenv("MPC_MESH_WORKERS")
+        monkeypatch.setenv("MPC_CACHE_DIR", str(folder / "cache"))
+        time.sleep(0.05)  # files changed as a build starts may change after it read them: it is not kept
+        events.clear()
+        sink = Sink()
+        assert compile_file(spec, folder / "out", sink).out is not None, sink.summary()
+        assert not mesh_worker.active()
+        # the program and the robot, first beside the worker; after the meshes without one
+        assert events[:2] == (["encode", "encode"] if workers is None else ["mesh", "mesh"]), events
+        assert events.count("encode") == 3 and events.count("mesh") == 4, events  # (and the diagnostics)
+        outs.append(folder / "out")
+        events.clear()
+        again = compile_file(spec, folder / "again", Sink())  # the kept build, its outputs as they were
+        assert again.out is not None and "encode" not in events and "mesh" not in events
+        _same_tree(folder / "out", folder / "again")
+    _same_tree(*outs)
+
+
 def test_what_the_forked_child_cannot_make_is_said_as_one_process_says_it(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A broken STL among the child's jobs (the three smaller meshes; no worker started ahead):
