@@ -228,7 +228,8 @@ def test_a_first_build_encodes_its_kept_model_before_it_makes_meshes_beside_its_
     events: list[str] = []  # each value encoded for the kept build, each mesh the build made
     dumps, materialise = build_cache.dumps, plain_meshes.materialise
     monkeypatch.setattr(build_cache, "dumps", lambda *a: (events.append("encode"), dumps(*a))[1])
-    monkeypatch.setattr(plain_meshes, "materialise", lambda jobs: (events.append("mesh"), materialise(jobs))[1])
+    monkeypatch.setattr(plain_meshes, "materialise",
+                        lambda jobs: (events.append("mesh"), materialise(jobs))[1])
     outs = []
     for workers in ("1", None):
         folder = tmp_path / f"workers-{workers}"
