@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-_pending: list[Callable[[], None]] = []
+_pending: list[Callable[[], object]] = []
 
 
-def later(work: Callable[[], None]) -> None:
+def later(work: Callable[[], object]) -> None:
     """Do `work` at the next `now`."""
     _pending.append(work)
 
