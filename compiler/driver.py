@@ -274,7 +274,8 @@ def compile_model(path: Path, sink: Sink, options: Options) -> Result:
             with stage("apply ops"):
                 check_closed(robot, sink, program.span)  # meshes that an op left open (W0582)
                 check_empty(robot, sink, program.span)   # mesh files without triangles (W0505)
-            if kept is not None and mesh_worker.active():  # its model, kept while the worker starts on meshes
+            if kept is not None and not (kept.model_used or kept.program_used) and mesh_worker.active():
+                # the model it keeps, encoded while the worker starts on the meshes
                 meanwhile.later(functools.partial(kept.encode_model, program, robot))
             out = _out(options, program.modelname)
             with stage("write"):

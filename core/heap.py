@@ -10,8 +10,8 @@ its own and unmaps it when it is freed, and returns the top of the heap once 128
 free (thresholds it raises only as far as the largest block freed so far). A mesh job
 allocates and frees megabytes at a time (a DAE's tree and number arrays, the triangles, the
 STL's bytes), so each job's memory was new to the process: the kernel zeroes every page of it
-and maps it at the first touch, a page fault each. UR5's upperarm.dae took 2,700 faults and 6
-of its 28 ms each time it was derived (bench/README.md, 2026-11-28). A build lives for
+and maps it at the first touch, a page fault each. UR5's upperarm.dae took 2,200–2,500 faults
+and 5 of its 27 ms each time it was derived (bench/README.md, 2026-11-28). A build lives for
 seconds: it keeps what it frees and its later jobs reuse those pages. Its peak is what it
 was; the memory is only not given back before the process ends.
 """
