@@ -78,8 +78,10 @@ class XmlSource:
             message = re.sub(r", line \d+, column \d+$", "", str(e.msg).strip())
             raise XmlError(message, max(line, 1), max(col, 1)) from None
         # Entities stay unexpanded (no DTD is read): one kept in a fragment would make the
-        # output not well-formed, so a file that uses any is refused here.
-        for entity in root.iter(etree.Entity):
+        # output not well-formed, so a file that uses any is refused here. Only a file with a
+        # DOCTYPE may hold one: without, libxml2 refuses every entity it does not define.
+        info = root.getroottree().docinfo
+        for entity in root.iter(etree.Entity) if info.doctype else ():
             raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
                            "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
@@ -93,7 +95,6 @@ class XmlSource:
         # writes each `<` of the markup as `<` (not UTF-7's `+ADw-`), and lines that libxml2
         # counts for each element (past 65535 only with XML_PARSE_BIG_LINES; the last node's
         # line is the largest, and asked for in less time than the text's lines are counted).
-        info = root.getroottree().docinfo
         src._quick = (not info.doctype and _last_line(root) < 65535
                       and (info.encoding or "").lower() in _PLAIN_ENCODINGS
                       and (text.isascii() or _ODD_START.search(text) is None)
@@ -297,6 +298,9 @@ def fmt_float(x: float) -> str:
     """The shortest text that reads back as exactly `x`; integers without '.0'."""
     if x == 0.0:
         return "0"
+    if x.__class__ is float:  # repr writes an integer below 1e16 with '.0', larger ones with 'e'
+        text = repr(x)
+        return text[:-2] if text.endswith(".0") else text
     if math.isfinite(x) and x.is_integer() and abs(x) < 1e16:
         return str(int(x))
     return repr(x)
