@@ -6,6 +6,7 @@ import math
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -83,3 +84,9 @@ def test_numbers_read_back_exactly(x: float) -> None:
 def test_numbers_are_short() -> None:
     assert [fmt_float(x) for x in (0.0, -0.0, 1.0, -2.0, 0.1, 1e-6, math.pi, 1e16)] == [
         "0", "0", "1", "-2", "0.1", "1e-06", "3.141592653589793", "1e+16"]
+    # the largest integers written whole, the smallest with an exponent; not finite as Python
+    # writes it; numpy's floats as Python's (a computed inertia may be one)
+    assert [fmt_float(x) for x in (1e15, -9007199254740992.0, 1.5e16, float("inf"), -float("inf"))] == [
+        "1000000000000000", "-9007199254740992", "1.5e+16", "inf", "-inf"]
+    assert [fmt_float(x) for x in (np.float64(3.0), np.float64(-1e15), np.float64(0.0))] == [
+        "3", "-1000000000000000", "0"]
