@@ -81,9 +81,10 @@ class XmlSource:
         # output not well-formed, so a file that uses any is refused here. Only a file with a
         # DOCTYPE may hold one: without, libxml2 refuses every entity it does not define.
         info = root.getroottree().docinfo
-        for entity in root.iter(etree.Entity) if info.doctype else ():
-            raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
-                           "the text itself)", entity.sourceline or 1, 1)
+        if info.doctype:
+            for entity in root.iter(etree.Entity):
+                raise XmlError(f"entity reference '{entity.text}' (mpc expands no entities; write "
+                               "the text itself)", entity.sourceline or 1, 1)
         text = data.decode("utf-8", errors="replace")
         if "\r" in text:  # a line ends at CR LF, CR or LF, as libxml2 counts lines (and Python reads text)
             text = text.replace("\r\n", "\n").replace("\r", "\n")
